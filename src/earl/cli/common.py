@@ -1,0 +1,48 @@
+"""What several commands share: finding the spec file and reading `--param NAME=VALUE`."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from earl.lang.loader import ParameterValue, locate_spec
+
+EXIT_USAGE = 2
+
+
+class UsageError(Exception):
+    """A mistake in how the command was called; exit code 2."""
+
+
+def spec_path(text: str) -> Path:
+    path = locate_spec(Path(text))
+    if not path.exists():
+        raise UsageError(f"no such file: {text}")
+    if path.is_dir():
+        raise UsageError(f"{text} is a directory without a system.earl; name the .earl file")
+    return path
+
+
+def parse_parameter(text: str) -> tuple[str, ParameterValue]:
+    """`N=3` → ("N", 3); numbers and true/false are typed, anything else is a string."""
+    name, sep, raw = text.partition("=")
+    if not sep or not name.strip().isidentifier():
+        raise UsageError(f"--param expects NAME=VALUE, e.g. --param N=3, not `{text}`")
+    raw = raw.strip()
+    value: ParameterValue
+    if raw in ("true", "false"):
+        value = raw == "true"
+    else:
+        try:
+            value = int(raw)
+        except ValueError:
+            try:
+                value = float(raw)
+            except ValueError:
+                value = raw
+    return name.strip(), value
+
+
+def usage_error(message: str) -> int:
+    sys.stderr.write(f"earl: error: {message}\n")
+    return EXIT_USAGE

@@ -1,0 +1,73 @@
+"""`earl fmt FILE…`: print, check or rewrite specifications in canonical form."""
+
+from __future__ import annotations
+
+import argparse
+import difflib
+import sys
+from pathlib import Path
+from typing import Any
+
+from earl.cli.common import UsageError, spec_path, usage_error
+from earl.cli.output import print_diagnostics
+from earl.diagnostics import EarlError
+from earl.lang.loader import load
+
+
+def register(commands: Any) -> None:
+    parser = commands.add_parser(
+        "fmt",
+        help="print a specification in canonical form",
+        description="Print each FILE in canonical form: four-space indentation, one declaration per line, "
+        "the parts of every subsystem in the manual's order. Comments are kept.",
+        epilog="exit codes: 0 done (or canonical with --check), 1 invalid or not canonical, 2 usage error",
+    )
+    parser.add_argument("files", metavar="FILE", nargs="+", help=".earl files")
+    mode = parser.add_mutually_exclusive_group()
+    mode.add_argument("--check", action="store_true", help="print nothing; exit 1 when a file is not canonical")
+    mode.add_argument("--write", "-w", action="store_true", help="rewrite the files in place")
+    mode.add_argument("--diff", action="store_true", help="show what would change, as a unified diff")
+    parser.set_defaults(run=run)
+
+
+def run(arguments: argparse.Namespace) -> int:
+    try:
+        paths = [spec_path(f) for f in arguments.files]
+    except UsageError as error:
+        return usage_error(str(error))
+    status = 0
+    for path in paths:
+        try:
+            system = load(path)
+        except EarlError as error:
+            print_diagnostics(error.diagnostics, error.sources)
+            status = 1
+            continue
+        original = path.read_text(encoding="utf-8")
+        canonical = system.to_earl()
+        if arguments.check:
+            if original != canonical:
+                sys.stderr.write(f"{path}: not canonical (run `earl fmt --write {path}`)\n")
+                status = 1
+        elif arguments.write:
+            if original != canonical:
+                _write(path, canonical)
+                sys.stderr.write(f"{path}: reformatted\n")
+        elif arguments.diff:
+            diff = difflib.unified_diff(
+                original.splitlines(keepends=True),
+                canonical.splitlines(keepends=True),
+                str(path),
+                f"{path} (canonical)",
+            )
+            sys.stdout.writelines(diff)
+        else:
+            sys.stdout.write(canonical)
+    return status
+
+
+def _write(path: Path, text: str) -> None:
+    """Replace the file atomically so an interrupted write never loses the spec."""
+    temporary = path.with_name(f".{path.name}.earl-fmt")
+    temporary.write_text(text, encoding="utf-8")
+    temporary.replace(path)

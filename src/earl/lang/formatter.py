@@ -1,0 +1,302 @@
+"""Canonical `.earl` text for a model: what `earl fmt` prints and `System.to_earl()` returns.
+
+Canonical means: four-space indentation, one declaration per line, the parts of a
+subsystem in the order of manual §2.2 (period, parameters, buffers, memory,
+predicates, functions, stages, behaviours, FSM), top-level declarations in the
+order they were written, comments kept where they were.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+from earl.model.elements import (
+    FSM,
+    Agent,
+    BasicBehaviour,
+    Duration,
+    Import,
+    InputBuffer,
+    Link,
+    LinkEnd,
+    Memory,
+    OutputBuffer,
+    Parameter,
+    PartialTransitionFunction,
+    PrimitivePredicate,
+    Robot,
+    StageSet,
+    State,
+    Subsystem,
+    System,
+    Transition,
+)
+from earl.model.expressions import ElementReference
+from earl.model.location import Comments
+from earl.model.text import expression_text, family_text, index_text, literal_text, reference_text
+from earl.model.types import DataType, StructType, TypeAlias, type_text
+
+INDENT = "    "
+
+
+class _Printer:
+    def __init__(self) -> None:
+        self.lines: list[str] = []
+
+    def blank(self) -> None:
+        if self.lines and self.lines[-1] != "":
+            self.lines.append("")
+
+    def line(self, depth: int, text: str, comments: Comments | None = None) -> None:
+        if comments is not None:
+            for comment in comments.leading:
+                self.lines.append(f"{INDENT * depth}{comment}")
+            if comments.trailing:
+                text = f"{text}  {comments.trailing}"
+        self.lines.append(f"{INDENT * depth}{text}")
+
+    def text(self) -> str:
+        while self.lines and self.lines[-1] == "":
+            self.lines.pop()
+        return "\n".join(self.lines) + "\n"
+
+
+def duration_text(duration: Duration) -> str:
+    return f"{literal_text(duration.value)} {duration.unit}"
+
+
+def data_type_text(data_type: DataType) -> str:
+    return type_text(data_type)
+
+
+def _references(references: Iterable[ElementReference]) -> str:
+    return ", ".join(reference_text(r) for r in references)
+
+
+def _pf_set(references: Iterable[ElementReference]) -> str:
+    return "{" + _references(references) + "}"
+
+
+def link_end_text(end: LinkEnd) -> str:
+    parts = []
+    if end.agent is not None:
+        parts.append(reference_text(end.agent))
+    parts.append(reference_text(end.subsystem))
+    indices = "".join(f"[{index_text(i)}]" for i in end.buffer.indices)
+    parts.append(f"{end.buffer.name}{indices}")
+    return ".".join(parts)
+
+
+def format_system(system: System) -> str:
+    """The whole system as canonical text, imports kept as `import` lines."""
+    printer = _Printer()
+    for comment in system.comments.leading:
+        printer.line(0, comment)
+    printer.line(0, f"system {system.name}")
+    declared = system.order if _order_is_complete(system) else _default_order(system)
+    for import_ in system.imports:
+        printer.blank()
+        _import(printer, import_)
+    for declaration in declared:
+        printer.blank()
+        if isinstance(declaration, Parameter):
+            _parameter(printer, 0, declaration)
+        elif isinstance(declaration, StructType):
+            _struct(printer, declaration)
+        elif isinstance(declaration, TypeAlias):
+            printer.line(0, f"type {declaration.name} = {data_type_text(declaration.data_type)}", declaration.comments)
+        elif isinstance(declaration, Robot):
+            _robot(printer, declaration)
+        elif isinstance(declaration, Agent):
+            _agent(printer, declaration)
+        elif isinstance(declaration, Link):
+            _link(printer, 0, declaration)
+    if system.comments.closing:
+        printer.blank()
+        for comment in system.comments.closing:
+            printer.line(0, comment)
+    return printer.text()
+
+
+def _from_root(system: System, element: object) -> bool:
+    """True for declarations of the root file (or built in Python), not of an imported one."""
+    location = getattr(element, "location", None)
+    return location is None or system.source_file is None or location.file == system.source_file
+
+
+def _order_is_complete(system: System) -> bool:
+    mine = [*system.parameters, *system.types, *system.agents, *system.links, *system.robots]
+    mine = [d for d in mine if _from_root(system, d)]
+    return len(mine) == len(system.order) and all(any(d is o for o in system.order) for d in mine)
+
+
+def _default_order(system: System) -> list[object]:
+    everything = [*system.parameters, *system.types, *system.agents, *system.links, *system.robots]
+    return [d for d in everything if _from_root(system, d)]
+
+
+def _import(printer: _Printer, import_: Import) -> None:
+    printer.line(0, f"import {literal_text(import_.path)}", import_.comments)
+
+
+def _parameter(printer: _Printer, depth: int, parameter: Parameter) -> None:
+    text = f"param {parameter.name}: {data_type_text(parameter.data_type)} = {expression_text(parameter.value)}"
+    printer.line(depth, text, parameter.comments)
+
+
+def _struct(printer: _Printer, struct: StructType) -> None:
+    if not struct.fields:
+        printer.line(0, f"struct {struct.name} {{}}", struct.comments)
+        return
+    printer.line(0, f"struct {struct.name} {{", struct.comments)
+    for field in struct.fields:
+        optional = "?" if field.optional else ""
+        printer.line(1, f"{field.name}: {data_type_text(field.data_type)}{optional}", field.comments)
+    printer.line(0, "}")
+
+
+def _robot(printer: _Printer, robot: Robot) -> None:
+    printer.line(0, f"{robot.name}/r {{", robot.comments)
+    for agent in robot.agents:
+        printer.line(1, reference_text(agent))
+    for link in robot.links:
+        printer.line(1, f"link {link.name}")
+    printer.line(0, "}")
+
+
+def _agent(printer: _Printer, agent: Agent) -> None:
+    printer.line(0, f"{family_text(agent.name, agent.family)}/a {{", agent.comments)
+    for parameter in agent.parameters:
+        _parameter(printer, 1, parameter)
+    for index, subsystem in enumerate(agent.subsystems):
+        if index or agent.parameters:
+            printer.blank()
+        _subsystem(printer, subsystem)
+    if agent.links:
+        printer.blank()
+    for link in agent.links:
+        _link(printer, 1, link)
+    printer.line(0, "}")
+
+
+def _link(printer: _Printer, depth: int, link: Link) -> None:
+    text = f"link {link.name_text}: {link_end_text(link.source)} -> {link_end_text(link.destination)}"
+    printer.line(depth, text, link.comments)
+
+
+def _subsystem(printer: _Printer, subsystem: Subsystem) -> None:
+    header = (
+        "cs"
+        if subsystem.kind.value == "cs"
+        else f"{family_text(subsystem.name, subsystem.family)}/{subsystem.kind.value}"
+    )
+    printer.line(1, f"{header} {{", subsystem.comments)
+    depth = 2
+    groups: list[list[object]] = [
+        [*([subsystem.period] if subsystem.period else []), *subsystem.parameters],
+        [*subsystem.input_buffers, *subsystem.output_buffers],
+        list(subsystem.memories),
+        list(subsystem.primitive_predicates),
+        list(subsystem.partial_transition_functions),
+        list(subsystem.stage_sets),
+    ]
+    first = True
+    for group in groups:
+        if not group:
+            continue
+        if not first:
+            printer.blank()
+        first = False
+        for item in group:
+            _body_item(printer, depth, item)
+    for behaviour in subsystem.basic_behaviours:
+        if not first:
+            printer.blank()
+        first = False
+        _basic_behaviour(printer, depth, behaviour)
+    if subsystem.fsm is not None:
+        if not first:
+            printer.blank()
+        _fsm(printer, depth, subsystem.fsm)
+    printer.line(1, "}")
+
+
+def _body_item(printer: _Printer, depth: int, item: object) -> None:
+    if isinstance(item, Duration):
+        printer.line(depth, f"period {duration_text(item)}")
+    elif isinstance(item, Parameter):
+        _parameter(printer, depth, item)
+    elif isinstance(item, InputBuffer):
+        text = f"{family_text(item.name, item.family)}/ib: {data_type_text(item.data_type)}"
+        if item.queue is not None:
+            text += f" fifo {expression_text(item.queue.capacity)} overflow {item.queue.overflow}"
+        printer.line(depth, text, item.comments)
+    elif isinstance(item, OutputBuffer):
+        printer.line(
+            depth, f"{family_text(item.name, item.family)}/ob: {data_type_text(item.data_type)}", item.comments
+        )
+    elif isinstance(item, Memory):
+        text = f"{family_text(item.name, item.family)}/m: {data_type_text(item.data_type)}"
+        if item.initial_value is not None:
+            text += f" = {expression_text(item.initial_value)}"
+        printer.line(depth, text, item.comments)
+    elif isinstance(item, PrimitivePredicate):
+        printer.line(depth, f"{item.name}/pp = {expression_text(item.expression)}", item.comments)
+    elif isinstance(item, PartialTransitionFunction):
+        reads = _references(item.reads)
+        writes = _references(item.writes)
+        arrow = f"{reads} -> {writes}".strip()
+        text = f"{item.name}/pf({arrow})"
+        if item.implementation is not None:
+            text += f" = python {literal_text(item.implementation.path)}"
+        printer.line(depth, text, item.comments)
+    elif isinstance(item, StageSet):
+        printer.line(depth, f"stage {item.name} = {_pf_set(item.functions)}", item.comments)
+
+
+def _basic_behaviour(printer: _Printer, depth: int, behaviour: BasicBehaviour) -> None:
+    printer.line(depth, f"{behaviour.name}/bb {{", behaviour.comments)
+    stages = " then ".join(_pf_set(stage) for stage in behaviour.transition_function.stages)
+    printer.line(depth + 1, f"tf = {stages}")
+    printer.line(depth + 1, f"tc = {expression_text(behaviour.terminal_condition.expression)}")
+    if behaviour.error_condition is not None:
+        printer.line(depth + 1, f"ec = {expression_text(behaviour.error_condition.expression)}")
+    printer.line(depth, "}")
+
+
+def _fsm(printer: _Printer, depth: int, fsm: FSM) -> None:
+    printer.line(depth, "fsm {", fsm.comments)
+    printer.line(depth + 1, f"initial {fsm.initial}")
+    for state in fsm.states:
+        _state(printer, depth + 1, state)
+    if fsm.transitions:
+        printer.blank()
+    for transition in fsm.transitions:
+        _transition(printer, depth + 1, transition)
+    if fsm.assumptions:
+        printer.blank()
+    for assumption in fsm.assumptions:
+        printer.line(depth + 1, f"assume {expression_text(assumption.expression)}", assumption.comments)
+    printer.line(depth, "}")
+
+
+def _state(printer: _Printer, depth: int, state: State) -> None:
+    text = f"state {state.name}: {state.behaviour}/bb"
+    group = []
+    if state.obligatory:
+        group.append(f"obligatory {_references(state.obligatory)}")
+    if state.optional:
+        group.append(f"optional {_references(state.optional)}")
+    if state.timeout is not None:
+        group.append(f"timeout {duration_text(state.timeout)}")
+    if group:
+        text += " { " + "  ".join(group) + " }"
+    printer.line(depth, text, state.comments)
+
+
+def _transition(printer: _Printer, depth: int, transition: Transition) -> None:
+    source = transition.source if transition.source is not None else "*"
+    text = f"{source} -> {transition.destination} when {expression_text(transition.condition.expression)}"
+    if transition.priority is not None:
+        text += f" priority {transition.priority}"
+    printer.line(depth, text, transition.comments)

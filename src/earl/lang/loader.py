@@ -1,0 +1,194 @@
+"""Loading a specification: files and their imports, merged into one System, then resolved."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+
+from earl.diagnostics import Diagnostic, EarlError, Severity, SourceMap
+from earl.lang.parser import decode, parse_text
+from earl.lang.transformer import ParsedFile
+from earl.model.elements import Agent, Import, Link, Parameter, Robot, System
+from earl.model.location import SourceLocation
+from earl.model.types import StructType, TypeAlias
+
+ParameterValue = bool | int | float | str
+
+
+def _display_path(path: Path) -> str:
+    """Paths in messages are relative to the working directory when they can be."""
+    try:
+        return str(path.resolve().relative_to(Path.cwd().resolve()))
+    except ValueError:
+        return str(path)
+
+
+def read_file(path: Path, sources: SourceMap, location: SourceLocation | None = None) -> ParsedFile:
+    shown = _display_path(path)
+    try:
+        data = path.read_bytes()
+    except FileNotFoundError:
+        raise EarlError(
+            [Diagnostic(Severity.ERROR, f"no such file: {shown}", location, code="EARL-S030")], sources
+        ) from None
+    except IsADirectoryError:
+        raise EarlError(
+            [
+                Diagnostic(
+                    Severity.ERROR,
+                    f"{shown} is a directory, not an `.earl` file",
+                    location,
+                    code="EARL-S030",
+                    hint="name the specification file, or a directory holding `system.earl`",
+                )
+            ],
+            sources,
+        ) from None
+    except OSError as error:
+        raise EarlError(
+            [Diagnostic(Severity.ERROR, f"cannot read {shown}: {error.strerror}", location, code="EARL-S030")],
+            sources,
+        ) from None
+    try:
+        text = decode(data, shown)
+    except EarlError as error:
+        error.sources = sources
+        raise
+    return parse_text(text, shown, sources)
+
+
+def locate_spec(path: Path) -> Path:
+    """A directory stands for the `system.earl` inside it (`earl run examples/pick_and_place`)."""
+    if path.is_dir() and (path / "system.earl").is_file():
+        return path / "system.earl"
+    return path
+
+
+def load_files(path: Path, sources: SourceMap) -> tuple[ParsedFile, list[ParsedFile]]:
+    """The root file and every file it imports (depth first, each once), cycles refused."""
+    root = read_file(path, sources)
+    imported: list[ParsedFile] = []
+    seen: dict[Path, ParsedFile] = {path.resolve(): root}
+
+    def visit(parsed: ParsedFile, file_path: Path, chain: list[Path]) -> None:
+        for declaration in parsed.declarations:
+            if not isinstance(declaration, Import):
+                continue
+            target = (file_path.parent / declaration.path).resolve()
+            if target in chain:
+                cycle = " -> ".join(_display_path(p) for p in [*chain[chain.index(target) :], target])
+                raise EarlError(
+                    [
+                        Diagnostic(
+                            Severity.ERROR,
+                            f"import cycle: {cycle}",
+                            declaration.location,
+                            code="EARL-S031",
+                            hint="move what both files need into a third file that imports neither",
+                        )
+                    ],
+                    sources,
+                )
+            if target in seen:
+                continue
+            child = read_file(target, sources, declaration.location)
+            if child.system_name is not None:
+                raise EarlError(
+                    [
+                        Diagnostic(
+                            Severity.ERROR,
+                            f"`{declaration.path}` declares `system {child.system_name}`; an imported file "
+                            "holds declarations only",
+                            child.system_location,
+                            code="EARL-S032",
+                            hint="remove the `system` line from the imported file",
+                        )
+                    ],
+                    sources,
+                )
+            seen[target] = child
+            visit(child, target, [*chain, target])
+            imported.append(child)
+
+    visit(root, path, [path.resolve()])
+    return root, imported
+
+
+def merge(root: ParsedFile, imported: list[ParsedFile], sources: SourceMap) -> System:
+    """One System holding the declarations of all files; only the root's keep their order for printing."""
+    if root.system_name is None:
+        raise EarlError(
+            [
+                Diagnostic(
+                    Severity.ERROR,
+                    "a specification starts with `system NAME`",
+                    SourceLocation(root.path, 1, 1, 1, 1),
+                    code="EARL-S033",
+                    hint="add a first line such as `system pickAndPlace`",
+                )
+            ],
+            sources,
+        )
+    system = System(root.system_name, location=root.system_location)
+    system.comments.leading = list(root.header_comments)
+    system.comments.closing = list(root.closing_comments)
+    for parsed in [*imported, root]:
+        for declaration in parsed.declarations:
+            if isinstance(declaration, Import):
+                if parsed is root:
+                    system.imports.append(declaration)
+                continue
+            if isinstance(declaration, Parameter):
+                system.parameters.append(declaration)
+            elif isinstance(declaration, (StructType, TypeAlias)):
+                system.types.append(declaration)
+            elif isinstance(declaration, Robot):
+                system.robots.append(declaration)
+            elif isinstance(declaration, Agent):
+                system.agents.append(declaration)
+            elif isinstance(declaration, Link):
+                system.links.append(declaration)
+            if parsed is root:
+                system.order.append(declaration)
+    return system
+
+
+def load(path: str | Path, parameters: Mapping[str, ParameterValue] | None = None) -> System:
+    """Read, parse and resolve a specification; raise `EarlError` with every problem found."""
+    from earl.lang.resolver import resolve
+
+    sources = SourceMap()
+    spec = locate_spec(Path(path))
+    root, imported = load_files(spec, sources)
+    system = merge(root, imported, sources)
+    system.source_file = root.path
+    diagnostics = resolve(system, parameters or {})
+    errors = [d for d in diagnostics if d.severity is Severity.ERROR]
+    if errors:
+        raise EarlError(errors, sources)
+    system.sources = sources
+    return system
+
+
+def loads(text: str, path: str = "<text>", parameters: Mapping[str, ParameterValue] | None = None) -> System:
+    """Like `load`, for text in memory; imports are resolved against the working directory."""
+    from earl.lang.resolver import resolve
+
+    sources = SourceMap()
+    root = parse_text(text, path, sources)
+    if any(isinstance(d, Import) for d in root.declarations):
+        base = Path(path).parent if path != "<text>" else Path.cwd()
+        imported: list[ParsedFile] = []
+        for declaration in root.declarations:
+            if isinstance(declaration, Import):
+                _, more = load_files(base / declaration.path, sources)
+                imported.extend([*more, read_file(base / declaration.path, sources, declaration.location)])
+    else:
+        imported = []
+    system = merge(root, imported, sources)
+    system.source_file = path
+    errors = [d for d in resolve(system, parameters or {}) if d.severity is Severity.ERROR]
+    if errors:
+        raise EarlError(errors, sources)
+    system.sources = sources
+    return system

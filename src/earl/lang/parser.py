@@ -1,0 +1,188 @@
+"""Reading `.earl` text: bytes to text, text to declarations, comments kept for the formatter."""
+
+from __future__ import annotations
+
+from functools import lru_cache
+from importlib import resources
+from typing import Any
+
+from lark import Lark, Token
+from lark.exceptions import UnexpectedInput, VisitError
+
+from earl.diagnostics import Diagnostic, EarlError, Severity, SourceMap
+from earl.lang.syntax_errors import translate
+from earl.lang.transformer import ElementBuilder, ParsedFile, SpecificationSyntaxError
+from earl.model.location import SourceLocation
+
+#: Larger files are refused before parsing: a spec of a thousand agents is far smaller.
+MAX_FILE_BYTES = 32 * 1024 * 1024
+
+
+class _CommentCollector:
+    """Lark calls this for every comment token; the parse that is running owns the list."""
+
+    def __init__(self) -> None:
+        self.comments: list[Token] = []
+
+    def __call__(self, token: Token) -> Token:
+        self.comments.append(token)
+        return token
+
+
+_collector = _CommentCollector()
+
+
+@lru_cache(maxsize=1)
+def _parser() -> Lark:
+    grammar = resources.files("earl.lang").joinpath("earl.lark").read_text(encoding="utf-8")
+    return Lark(
+        grammar,
+        parser="lalr",
+        propagate_positions=True,
+        maybe_placeholders=False,
+        strict=True,  # a shift/reduce conflict in the grammar is an error, never a silent choice
+        lexer_callbacks={"COMMENT": _collector},
+    )
+
+
+@lru_cache(maxsize=1)
+def keyword_terminals() -> dict[str, str]:
+    """Terminal name → keyword text, for messages and did-you-mean hints."""
+    result: dict[str, str] = {}
+    for terminal in _parser().terminals:
+        pattern = terminal.pattern
+        if pattern.type == "str" and pattern.value.isidentifier():
+            result[terminal.name] = pattern.value
+    return result
+
+
+def decode(data: bytes, path: str) -> str:
+    """The text of a spec file, or an error saying why these bytes are not one."""
+    location = SourceLocation(path, 1, 1, 1, 1)
+    if len(data) > MAX_FILE_BYTES:
+        raise EarlError(
+            [
+                Diagnostic(
+                    Severity.ERROR,
+                    f"the file is {len(data) / 2**20:.1f} MiB; specifications larger than "
+                    f"{MAX_FILE_BYTES // 2**20} MiB are refused",
+                    location,
+                    code="EARL-S020",
+                    hint="split the system into files joined with `import`",
+                )
+            ]
+        )
+    if b"\x00" in data[:8192]:
+        raise EarlError(
+            [
+                Diagnostic(
+                    Severity.ERROR,
+                    "this is a binary file, not an `.earl` specification",
+                    location,
+                    code="EARL-S021",
+                    hint="an `.earl` specification is UTF-8 text",
+                )
+            ]
+        )
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as error:
+        line = data[: error.start].count(b"\n") + 1
+        column = error.start - (data.rfind(b"\n", 0, error.start) + 1) + 1
+        raise EarlError(
+            [
+                Diagnostic(
+                    Severity.ERROR,
+                    f"the file is not UTF-8 text: byte 0x{data[error.start]:02x} cannot be decoded",
+                    SourceLocation(path, line, column, line, column + 1),
+                    code="EARL-S022",
+                    hint="save the file as UTF-8",
+                )
+            ]
+        ) from None
+    return text.removeprefix("\ufeff")
+
+
+def parse_text(text: str, path: str = "<text>", sources: SourceMap | None = None) -> ParsedFile:
+    """The declarations of one file, or an `EarlError` with one located diagnostic."""
+    sources = sources if sources is not None else SourceMap()
+    sources.add(path, text)
+    parser = _parser()
+    _collector.comments = []
+    try:
+        tree = parser.parse(text)
+    except UnexpectedInput as error:
+        raise EarlError([translate(error, path, text, keyword_terminals())], sources) from None
+    comments = _collector.comments
+    try:
+        parsed: ParsedFile = ElementBuilder(path).transform(tree)
+    except VisitError as error:
+        if isinstance(error.orig_exc, SpecificationSyntaxError):
+            raise EarlError([error.orig_exc.diagnostic], sources) from None
+        raise
+    except SpecificationSyntaxError as error:
+        raise EarlError([error.diagnostic], sources) from None
+    if parsed.system_location is not None:
+        header_line = parsed.system_location.line
+        parsed.header_comments = [str(c) for c in comments if (c.line or 1) <= header_line]
+        comments = [c for c in comments if (c.line or 1) > header_line]
+    parsed.closing_comments = attach_comments(parsed.declarations, comments, path)
+    return parsed
+
+
+def _statements(declarations: list[Any]) -> list[Any]:
+    """Every element that can carry comments, in any order (sorted later)."""
+    found: list[Any] = []
+    stack = list(declarations)
+    while stack:
+        element = stack.pop()
+        if hasattr(element, "comments") and getattr(element, "location", None) is not None:
+            found.append(element)
+        for attribute in (
+            "fields",
+            "subsystems",
+            "links",
+            "parameters",
+            "input_buffers",
+            "output_buffers",
+            "memories",
+            "primitive_predicates",
+            "partial_transition_functions",
+            "stage_sets",
+            "basic_behaviours",
+            "states",
+            "transitions",
+            "assumptions",
+        ):
+            stack.extend(getattr(element, attribute, None) or [])
+        fsm = getattr(element, "fsm", None)
+        if fsm is not None:
+            stack.append(fsm)
+    return found
+
+
+def attach_comments(declarations: list[Any], comments: list[Token], path: str) -> list[str]:
+    """Give each comment to the element it sits above, or ends the line of; return those after the last."""
+    closing: list[str] = []
+    if not comments:
+        return closing
+    elements = sorted(_statements(declarations), key=lambda e: (e.location.line, e.location.column))
+    by_line: dict[int, Any] = {}
+    for element in elements:
+        by_line.setdefault(element.location.line, element)
+    starts = [e.location.line for e in elements]
+    from bisect import bisect_left
+
+    for comment in comments:
+        text = str(comment)
+        line = comment.line or 1
+        owner = by_line.get(line)
+        if owner is not None and (comment.column or 1) > owner.location.column:
+            owner.comments.trailing = text
+            continue
+        position = bisect_left(starts, line)
+        if position < len(elements):
+            elements[position].comments.leading.append(text)
+        else:
+            closing.append(text)
+    return closing

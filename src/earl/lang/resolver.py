@@ -1,0 +1,868 @@
+"""Name resolution: every name a spec uses must denote a declared element of the right kind.
+
+The resolver walks the declared model once, with the parameters and family
+indices in scope, and reports each unknown, duplicate or misused name at the
+place it was written, with a did-you-mean hint where one helps.  It never
+changes the model; `earl.model.expand` can rely on a system it accepted.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+from earl.diagnostics import Diagnostic, Severity, did_you_mean
+from earl.model.elements import (
+    FSM,
+    Agent,
+    Family,
+    Link,
+    LinkEnd,
+    Parameter,
+    Subsystem,
+    System,
+)
+from earl.model.expressions import (
+    BUILTIN_FUNCTIONS,
+    Call,
+    ConstantError,
+    ElementReference,
+    Expression,
+    FieldAccess,
+    Name,
+    Quantifier,
+    Read,
+    Star,
+    children,
+    evaluate_constant,
+)
+from earl.model.kinds import KIND_TITLES, Kind
+from earl.model.location import SourceLocation
+from earl.model.text import reference_text
+from earl.model.types import PRIMITIVE_TYPES, ArrayType, DataType, PrimitiveType, StructType, TypeReference
+
+Value = bool | int | float | str
+
+#: A family larger than this is almost certainly a typo (`1..1000000`), and would exhaust memory.
+MAX_FAMILY_MEMBERS = 100_000
+
+#: Parameter types and the Python values they accept.
+PARAMETER_TYPES: dict[str, tuple[type, ...]] = {
+    "boolean": (bool,),
+    "int": (int,),
+    "int8": (int,),
+    "int16": (int,),
+    "int32": (int,),
+    "int64": (int,),
+    "uint8": (int,),
+    "uint16": (int,),
+    "uint32": (int,),
+    "uint64": (int,),
+    "double": (int, float),
+    "float32": (int, float),
+    "float64": (int, float),
+    "string": (str,),
+}
+
+
+@dataclass(frozen=True)
+class IndexRange:
+    """An index variable while a family body is resolved: every value from first to last."""
+
+    first: int
+    last: int
+
+    def values(self) -> range:
+        return range(self.first, self.last + 1)
+
+
+Scope = dict[str, "Value | IndexRange"]
+
+
+@dataclass
+class _Declared:
+    element: Any
+    family: IndexRange | None
+
+
+@dataclass
+class _SubsystemTable:
+    """The elements of one subsystem by kind and name."""
+
+    subsystem: Subsystem
+    by_kind: dict[Kind, dict[str, _Declared]] = field(default_factory=dict)
+
+    def lookup(self, kind: Kind) -> dict[str, _Declared]:
+        if kind in (Kind.MEMORY_INPUT, Kind.MEMORY_OUTPUT):
+            kind = Kind.MEMORY
+        return self.by_kind.setdefault(kind, {})
+
+
+@dataclass
+class _AgentTable:
+    agent: Agent
+    family: IndexRange | None
+    scope: Scope
+    subsystems: dict[tuple[str, Kind], tuple[_SubsystemTable, IndexRange | None]] = field(default_factory=dict)
+
+
+class Resolver:
+    def __init__(self, system: System, overrides: Mapping[str, Value]) -> None:
+        self.system = system
+        self.overrides = dict(overrides)
+        self.diagnostics: list[Diagnostic] = []
+        self.types: dict[str, Any] = {}
+        self.agents: dict[str, _AgentTable] = {}
+
+    # ------------------------------------------------------------------ reporting
+    def error(self, message: str, location: SourceLocation | None, code: str, hint: str | None = None) -> None:
+        self.diagnostics.append(Diagnostic(Severity.ERROR, message, location, code=code, hint=hint))
+
+    def duplicate(self, what: str, location: SourceLocation | None, first: SourceLocation | None) -> None:
+        where = f" (first declared at line {first.line})" if first is not None else ""
+        self.error(f"{what} is declared twice{where}", location, "EARL-R002", "give each element its own name")
+
+    # ------------------------------------------------------------------ the walk
+    def run(self) -> list[Diagnostic]:
+        scope: Scope = {}
+        self._parameters(self.system.parameters, scope, overrides=self.overrides)
+        for name in self.overrides:
+            if not any(p.name == name for p in self.system.parameters):
+                known = [p.name for p in self.system.parameters]
+                self.error(
+                    f"there is no system parameter `{name}` to set",
+                    None,
+                    "EARL-R001",
+                    did_you_mean(name, known) or f"system parameters: {', '.join(known) or 'none'}",
+                )
+        self._types(scope)
+        for agent in self.system.agents:
+            self._declare_agent(agent, scope)
+        for table in self.agents.values():
+            self._agent_body(table)
+        self._links(self.system.links, scope, agent=None)
+        self._robots()
+        return self.diagnostics
+
+    def _parameters(self, parameters: Sequence[Parameter], scope: Scope, overrides: Mapping[str, Value] = {}) -> None:
+        seen: dict[str, Parameter] = {}
+        for parameter in parameters:
+            if parameter.name in seen:
+                self.duplicate(f"parameter `{parameter.name}`", parameter.location, seen[parameter.name].location)
+                continue
+            seen[parameter.name] = parameter
+            type_name = getattr(parameter.data_type, "name", "?")
+            if not isinstance(parameter.data_type, PrimitiveType) or type_name not in PARAMETER_TYPES:
+                self.error(
+                    f"parameter `{parameter.name}` must have a primitive type, not `{type_name}`",
+                    parameter.data_type.location or parameter.location,
+                    "EARL-R003",
+                    "parameters are `int`, `double`, `boolean` or `string` (or a sized integer or float)",
+                )
+                continue
+            if parameter.name in overrides:
+                value: Value = overrides[parameter.name]
+            else:
+                try:
+                    value = evaluate_constant(parameter.value, _values(scope))
+                except ConstantError as problem:
+                    self.error(str(problem), problem.location or parameter.location, "EARL-R004")
+                    continue
+            accepted = PARAMETER_TYPES[type_name]
+            if not isinstance(value, accepted) or (isinstance(value, bool) and bool not in accepted):
+                self.error(
+                    f"parameter `{parameter.name}` is `{type_name}` but its value is {value!r}",
+                    parameter.value.location or parameter.location,
+                    "EARL-R005",
+                )
+                continue
+            if type_name in ("double", "float32", "float64"):
+                value = float(value)
+            scope[parameter.name] = value
+
+    # ------------------------------------------------------------------ data types
+    def _types(self, scope: Scope) -> None:
+        for definition in self.system.types:
+            if definition.name in PRIMITIVE_TYPES:
+                self.error(
+                    f"`{definition.name}` is a primitive type and cannot be redefined",
+                    definition.location,
+                    "EARL-R010",
+                )
+            elif definition.name in self.types:
+                self.duplicate(f"type `{definition.name}`", definition.location, self.types[definition.name].location)
+            else:
+                self.types[definition.name] = definition
+        for definition in self.system.types:
+            if isinstance(definition, StructType):
+                names: dict[str, Any] = {}
+                for member in definition.fields:
+                    if member.name in names:
+                        self.duplicate(
+                            f"field `{member.name}` of `{definition.name}`",
+                            member.location,
+                            names[member.name].location,
+                        )
+                    names[member.name] = member
+                    self.data_type(member.data_type, scope)
+            else:
+                self.data_type(definition.data_type, scope)
+        self._type_cycles()
+
+    def _type_cycles(self) -> None:
+        """A struct that contains itself (other than through a variable array) has no finite size."""
+
+        def direct(data_type: DataType) -> Iterable[str]:
+            if isinstance(data_type, TypeReference):
+                yield data_type.name
+            elif isinstance(data_type, ArrayType) and data_type.size is not None:
+                yield from direct(data_type.element)
+
+        reported: set[str] = set()
+        for name, definition in self.types.items():
+            stack = [(name, [name])]
+            visited: set[str] = set()
+            while stack:
+                current, path = stack.pop()
+                node = self.types.get(current)
+                if node is None:
+                    continue
+                contained = (
+                    [t for f in node.fields for t in direct(f.data_type)]
+                    if isinstance(node, StructType)
+                    else list(direct(node.data_type))
+                )
+                for child in contained:
+                    if child == name and name not in reported:
+                        reported.update(path)
+                        cycle = " -> ".join([*path, name])
+                        self.error(
+                            f"type `{name}` contains itself ({cycle}), so it has no finite size",
+                            definition.location,
+                            "EARL-R011",
+                            "break the cycle with a variable array (`T[]`) or an optional field in another type",
+                        )
+                    elif child not in visited:
+                        visited.add(child)
+                        stack.append((child, [*path, child]))
+
+    def data_type(self, data_type: DataType, scope: Scope) -> None:
+        if isinstance(data_type, TypeReference):
+            if data_type.name not in self.types:
+                self.error(
+                    f"unknown data type `{data_type.name}`",
+                    data_type.location,
+                    "EARL-R012",
+                    did_you_mean(data_type.name, [*self.types, *PRIMITIVE_TYPES])
+                    or "declare it with `struct` or `type`, or import the file that does",
+                )
+        elif isinstance(data_type, ArrayType):
+            self.data_type(data_type.element, scope)
+            if data_type.size is not None:
+                size = self.constant_integer(data_type.size, scope, "an array size")
+                if size is not None and size < 0:
+                    self.error(
+                        f"an array size must not be negative, here it is {size}", data_type.size.location, "EARL-R013"
+                    )
+
+    def structural_type(self, data_type: DataType) -> DataType | StructType | None:
+        """The type behind aliases: a primitive, an array or a struct; None when unknown."""
+        seen: set[str] = set()
+        while isinstance(data_type, TypeReference):
+            if data_type.name in seen:
+                return None
+            seen.add(data_type.name)
+            definition = self.types.get(data_type.name)
+            if definition is None:
+                return None
+            if isinstance(definition, StructType):
+                return definition
+            data_type = definition.data_type
+        return data_type
+
+    # ------------------------------------------------------------------ constants and families
+    def constant_integer(self, expression: Expression, scope: Scope, what: str) -> int | None:
+        if any(isinstance(scope.get(n.name), IndexRange) for n in _names(expression)):
+            return None  # depends on a family index; checked per member where it matters
+        try:
+            value = evaluate_constant(expression, _values(scope))
+        except ConstantError as problem:
+            self.error(f"{what} must be a constant: {problem}", problem.location or expression.location, "EARL-R014")
+            return None
+        if isinstance(value, bool) or not isinstance(value, int):
+            self.error(f"{what} must be a whole number, not {value!r}", expression.location, "EARL-R014")
+            return None
+        return value
+
+    def family_range(self, family: Family | None, scope: Scope) -> IndexRange | None:
+        if family is None:
+            return None
+        if family.index in scope:
+            self.error(
+                f"the index `{family.index}` is already in use here",
+                family.location,
+                "EARL-R015",
+                "give the inner family another index letter",
+            )
+        first = self.constant_integer(family.first, scope, "the first index of a family")
+        last = self.constant_integer(family.last, scope, "the last index of a family")
+        if first is None or last is None:
+            return IndexRange(1, 0)
+        if first < 0:
+            self.error(
+                f"a family index starts at 0 or more, not {first}",
+                family.first.location or family.location,
+                "EARL-R016",
+            )
+            return IndexRange(1, 0)
+        if last < first:
+            self.error(
+                f"the family range {first}..{last} is empty",
+                family.location,
+                "EARL-R016",
+                "the last index must not be smaller than the first",
+            )
+            return IndexRange(1, 0)
+        if last - first + 1 > MAX_FAMILY_MEMBERS:
+            self.error(
+                f"the family range {first}..{last} has {last - first + 1:,} members; at most {MAX_FAMILY_MEMBERS:,} are allowed",
+                family.location,
+                "EARL-R017",
+            )
+            return IndexRange(1, 0)
+        return IndexRange(first, last)
+
+    def index_values(self, expression: Expression, scope: Scope) -> list[int] | None:
+        """Every value an index expression takes over the family indices in scope."""
+        for name in _names(expression):
+            if name.name not in scope:
+                self.unknown_name(name, scope)
+                return None
+        ranged = sorted({n.name for n in _names(expression) if isinstance(scope.get(n.name), IndexRange)})
+        ranges = [scope[name].values() for name in ranged]  # type: ignore[union-attr]
+        if any(len(r) == 0 for r in ranges):
+            return []
+        if _product_size(ranges) > 10_000:
+            return None
+        values: list[int] = []
+        base = _values(scope)
+        for combination in itertools.product(*ranges):
+            try:
+                value = evaluate_constant(expression, {**base, **dict(zip(ranged, combination, strict=False))})
+            except ConstantError as problem:
+                self.error(f"an index must be a whole-number expression: {problem}", problem.location, "EARL-R014")
+                return None
+            if isinstance(value, bool) or not isinstance(value, int):
+                self.error(f"an index must be a whole number, not {value!r}", expression.location, "EARL-R014")
+                return None
+            values.append(value)
+        return values
+
+    def unknown_name(self, name: Name, scope: Scope) -> None:
+        self.error(
+            f"`{name.name}` is not a parameter or family index in scope here",
+            name.location,
+            "EARL-R020",
+            did_you_mean(name.name, list(scope))
+            or "declare it with `param`, or write an element with its kind (`x/pp`)",
+        )
+
+    # ------------------------------------------------------------------ agents and subsystems
+    def _declare_agent(self, agent: Agent, scope: Scope) -> None:
+        if agent.name in self.agents:
+            self.duplicate(f"agent `{agent.name}/a`", agent.location, self.agents[agent.name].agent.location)
+            return
+        inner: Scope = dict(scope)
+        family = self.family_range(agent.family, scope)
+        if agent.family is not None and family is not None:
+            inner[agent.family.index] = family
+        self._parameters(agent.parameters, inner)
+        table = _AgentTable(agent, family, inner)
+        self.agents[agent.name] = table
+        for subsystem in agent.subsystems:
+            key = (subsystem.name, subsystem.kind)
+            if key in table.subsystems:
+                what = (
+                    "the Control Subsystem `cs`"
+                    if subsystem.kind is Kind.CONTROL_SUBSYSTEM
+                    else f"`{subsystem.name}/{subsystem.kind.value}`"
+                )
+                self.duplicate(
+                    f"{what} of `{agent.name}/a`", subsystem.location, table.subsystems[key][0].subsystem.location
+                )
+                continue
+            sub_scope = dict(inner)
+            sub_family = self.family_range(subsystem.family, inner)
+            if subsystem.family is not None and sub_family is not None:
+                sub_scope[subsystem.family.index] = sub_family
+            self._parameters(subsystem.parameters, sub_scope)
+            sub_table = self._subsystem_table(subsystem, sub_scope)
+            sub_table.scope = sub_scope  # type: ignore[attr-defined]
+            table.subsystems[key] = (sub_table, sub_family)
+
+    def _subsystem_table(self, subsystem: Subsystem, scope: Scope) -> _SubsystemTable:
+        table = _SubsystemTable(subsystem)
+        groups: list[tuple[Kind, Sequence[Any]]] = [
+            (Kind.INPUT_BUFFER, subsystem.input_buffers),
+            (Kind.OUTPUT_BUFFER, subsystem.output_buffers),
+            (Kind.MEMORY, subsystem.memories),
+            (Kind.PRIMITIVE_PREDICATE, subsystem.primitive_predicates),
+            (Kind.PARTIAL_TRANSITION_FUNCTION, subsystem.partial_transition_functions),
+            (Kind.BASIC_BEHAVIOUR, subsystem.basic_behaviours),
+        ]
+        for kind, elements in groups:
+            names = table.lookup(kind)
+            for element in elements:
+                if element.name in names:
+                    self.duplicate(
+                        f"`{element.name}/{kind.value}`", element.location, names[element.name].element.location
+                    )
+                    continue
+                family = self.family_range(getattr(element, "family", None), scope)
+                names[element.name] = _Declared(element, family)
+                if hasattr(element, "data_type"):
+                    self.data_type(element.data_type, scope)
+        return table
+
+    def _agent_body(self, table: _AgentTable) -> None:
+        for sub_table, _family in table.subsystems.values():
+            self._subsystem_body(table, sub_table, sub_table.scope)  # type: ignore[attr-defined]
+        self._links(table.agent.links, table.scope, agent=table)
+
+    def _subsystem_body(self, agent: _AgentTable, table: _SubsystemTable, scope: Scope) -> None:
+        subsystem = table.subsystem
+        owner = f"{agent.agent.name}/a.{'cs' if subsystem.kind is Kind.CONTROL_SUBSYSTEM else subsystem.name + '/' + subsystem.kind.value}"
+        for buffer in subsystem.input_buffers:
+            if buffer.queue is not None:
+                capacity = self.constant_integer(buffer.queue.capacity, scope, "a FIFO capacity")
+                if capacity is not None and capacity < 1:
+                    self.error(
+                        f"a FIFO holds at least one message, not {capacity}",
+                        buffer.queue.capacity.location,
+                        "EARL-R018",
+                    )
+        for memory in subsystem.memories:
+            if memory.initial_value is not None:
+                self.expression(memory.initial_value, table, scope, owner, reads_allowed=False)
+        for predicate in subsystem.primitive_predicates:
+            self.expression(predicate.expression, table, scope, owner)
+        for function in subsystem.partial_transition_functions:
+            for reference in function.reads:
+                self.reference(
+                    reference,
+                    table,
+                    scope,
+                    owner,
+                    (Kind.INPUT_BUFFER, Kind.MEMORY_INPUT),
+                    "read by a Partial Transition Function",
+                    star=True,
+                )
+            for reference in function.writes:
+                self.reference(
+                    reference,
+                    table,
+                    scope,
+                    owner,
+                    (Kind.MEMORY_OUTPUT, Kind.OUTPUT_BUFFER),
+                    "written by a Partial Transition Function",
+                    star=True,
+                )
+        stage_names: dict[str, Any] = {}
+        for stage in subsystem.stage_sets:
+            if stage.name in stage_names:
+                self.duplicate(f"stage `{stage.name}`", stage.location, stage_names[stage.name].location)
+            stage_names[stage.name] = stage
+            for reference in stage.functions:
+                self.reference(reference, table, scope, owner, (Kind.PARTIAL_TRANSITION_FUNCTION,), "in a stage")
+        for behaviour in subsystem.basic_behaviours:
+            for stage_functions in behaviour.transition_function.stages:
+                for reference in stage_functions:
+                    self.reference(
+                        reference, table, scope, owner, (Kind.PARTIAL_TRANSITION_FUNCTION,), "in a transition function"
+                    )
+            self.expression(behaviour.terminal_condition.expression, table, scope, owner)
+            if behaviour.error_condition is not None:
+                self.expression(behaviour.error_condition.expression, table, scope, owner)
+        if subsystem.fsm is not None:
+            self._fsm(subsystem.fsm, table, scope, owner)
+
+    def _fsm(self, fsm: FSM, table: _SubsystemTable, scope: Scope, owner: str) -> None:
+        states: dict[str, Any] = {}
+        for state in fsm.states:
+            if state.name in states:
+                self.duplicate(f"state `{state.name}`", state.location, states[state.name].location)
+                continue
+            states[state.name] = state
+            behaviours = table.lookup(Kind.BASIC_BEHAVIOUR)
+            if state.behaviour not in behaviours:
+                self.error(
+                    f"state `{state.name}` names `{state.behaviour}/bb`, which `{owner}` does not declare",
+                    state.behaviour_location or state.location,
+                    "EARL-R030",
+                    did_you_mean(state.behaviour, behaviours) or f"declare `{state.behaviour}/bb {{ tf = … tc = … }}`",
+                )
+            for reference in [*state.obligatory, *state.optional]:
+                self.reference(reference, table, scope, owner, (Kind.INPUT_BUFFER,), "in a buffer group", star=True)
+        if fsm.initial not in states:
+            self.error(
+                f"the initial state `{fsm.initial}` is not a state of this FSM",
+                fsm.location,
+                "EARL-R031",
+                did_you_mean(fsm.initial, states) or f"add `state {fsm.initial}: {fsm.initial}/bb`",
+            )
+        for transition in fsm.transitions:
+            for end in ([transition.source] if transition.source is not None else []) + [transition.destination]:
+                if end not in states:
+                    self.error(
+                        f"transition `{transition.name}/t` names the state `{end}`, which this FSM does not declare",
+                        transition.location,
+                        "EARL-R032",
+                        did_you_mean(end, states),
+                    )
+            self.expression(transition.condition.expression, table, scope, owner)
+        for assumption in fsm.assumptions:
+            self.expression(assumption.expression, table, scope, owner)
+
+    # ------------------------------------------------------------------ references and expressions
+    def reference(
+        self,
+        reference: ElementReference,
+        table: _SubsystemTable,
+        scope: Scope,
+        owner: str,
+        allowed: Sequence[Kind],
+        role: str,
+        star: bool = False,
+    ) -> _Declared | None:
+        text = reference_text(reference)
+        if reference.kind not in allowed:
+            permitted = ", ".join(f"`/{k.value}`" for k in allowed)
+            hint = None
+            if reference.kind is Kind.OUTPUT_BUFFER and Kind.INPUT_BUFFER in allowed:
+                hint = "an Output Buffer is written, not read; read what it is computed from in memory (`/mi`)"
+            elif reference.kind in (Kind.MEMORY_OUTPUT,) and Kind.MEMORY_INPUT in allowed:
+                hint = f"memory is read through `mi`: `{reference.name}/mi`"
+            elif reference.kind is Kind.MEMORY_INPUT and Kind.MEMORY_OUTPUT in allowed:
+                hint = f"memory is written through `mo`: `{reference.name}/mo`"
+            self.error(f"`{text}` cannot be {role}; expected {permitted}", reference.location, "EARL-R021", hint)
+            return None
+        declared = table.lookup(reference.kind).get(reference.name)
+        if declared is None:
+            candidates = table.lookup(reference.kind)
+            hint = did_you_mean(reference.name, candidates)
+            if hint is None:
+                other = [k for k, names in table.by_kind.items() if reference.name in names and k is not reference.kind]
+                if other:
+                    kind = Kind.MEMORY_INPUT if other[0] is Kind.MEMORY and Kind.MEMORY_INPUT in allowed else other[0]
+                    hint = (
+                        f"there is `{reference.name}/{other[0].value}`; write `{reference.name}/{kind.value}`"
+                        if kind in allowed
+                        else f"there is `{reference.name}/{other[0].value}`, but that cannot be {role}"
+                    )
+            title = KIND_TITLES[
+                Kind.MEMORY if reference.kind in (Kind.MEMORY_INPUT, Kind.MEMORY_OUTPUT) else reference.kind
+            ]
+            self.error(f"`{owner}` has no {title} `{reference.name}`", reference.location, "EARL-R022", hint)
+            return None
+        self._indices(reference, declared.family, scope, star)
+        return declared
+
+    def _indices(self, reference: ElementReference, family: IndexRange | None, scope: Scope, star: bool) -> None:
+        text = reference_text(reference)
+        if family is None:
+            if reference.indices:
+                self.error(
+                    f"`{reference.name}/{reference.kind.value}` is a single element, not a family; drop the `[…]`",
+                    reference.location,
+                    "EARL-R023",
+                )
+            return
+        if not reference.indices:
+            self.error(
+                f"`{reference.name}/{reference.kind.value}` is a family of {len(family.values())}; say which member",
+                reference.location,
+                "EARL-R024",
+                f"write `{reference.name}[1]/{reference.kind.value}`, or `{reference.name}[*]/{reference.kind.value}` for every member"
+                if star
+                else f"write `{reference.name}[1]/{reference.kind.value}`, or `any(K in {family.first}..{family.last}: {reference.name}[K]/{reference.kind.value})`",
+            )
+            return
+        if len(reference.indices) > 1:
+            self.error(
+                f"`{text}` has {len(reference.indices)} indices; a family has one", reference.location, "EARL-R025"
+            )
+            return
+        index = reference.indices[0]
+        if isinstance(index, Star):
+            if not star:
+                self.error(
+                    f"`{text}`: `[*]` stands for every member and cannot be a value in an expression",
+                    reference.location,
+                    "EARL-R026",
+                    f"use `any(K in {family.first}..{family.last}: {reference.name}[K]/{reference.kind.value})` or `all(…)`",
+                )
+            return
+        values = self.index_values(index, scope)
+        if values is None:
+            return
+        outside = sorted({v for v in values if v < family.first or v > family.last})
+        if outside:
+            self.error(
+                f"`{text}` reaches index {outside[0]}, outside the family's {family.first}..{family.last}",
+                index.location or reference.location,
+                "EARL-R027",
+            )
+
+    def expression(
+        self,
+        expression: Expression,
+        table: _SubsystemTable | None,
+        scope: Scope,
+        owner: str,
+        reads_allowed: bool = True,
+    ) -> None:
+        stack: list[tuple[Expression, Scope]] = [(expression, scope)]
+        while stack:
+            node, node_scope = stack.pop()
+            if isinstance(node, Name):
+                if node.name not in node_scope:
+                    self.unknown_name(node, node_scope)
+                continue
+            if isinstance(node, Quantifier):
+                for bound in (node.first, node.last):
+                    stack.append((bound, node_scope))
+                first = self.constant_integer(node.first, node_scope, "the first index of `any`/`all`")
+                last = self.constant_integer(node.last, node_scope, "the last index of `any`/`all`")
+                inner = dict(node_scope)
+                inner[node.index] = (
+                    IndexRange(first, last) if first is not None and last is not None else IndexRange(1, 0)
+                )
+                stack.append((node.body, inner))
+                continue
+            if isinstance(node, Read):
+                if not reads_allowed or table is None:
+                    self.error(
+                        f"`{reference_text(node.target)}` cannot be read here: an initial value is a constant",
+                        node.location,
+                        "EARL-R028",
+                    )
+                    continue
+                declared = self.reference(
+                    node.target,
+                    table,
+                    node_scope,
+                    owner,
+                    (Kind.INPUT_BUFFER, Kind.MEMORY_INPUT, Kind.PRIMITIVE_PREDICATE),
+                    "read by a predicate",
+                )
+                if declared is not None:
+                    self._path(node, declared, node_scope)
+                for accessor in node.path:
+                    index = getattr(accessor, "index", None)
+                    if index is not None:
+                        stack.append((index, node_scope))
+                continue
+            if isinstance(node, Call):
+                arity = BUILTIN_FUNCTIONS.get(node.function)
+                if arity is None:
+                    self.error(
+                        f"unknown function `{node.function}`",
+                        node.location,
+                        "EARL-R040",
+                        did_you_mean(node.function, BUILTIN_FUNCTIONS)
+                        or f"functions: {', '.join(BUILTIN_FUNCTIONS)}, any, all",
+                    )
+                    continue
+                if len(node.arguments) != arity:
+                    self.error(
+                        f"`{node.function}` takes {arity} argument, not {len(node.arguments)}",
+                        node.location,
+                        "EARL-R041",
+                    )
+                    continue
+                argument = node.arguments[0]
+                if not isinstance(argument, Read) or argument.target.kind is not Kind.INPUT_BUFFER:
+                    self.error(
+                        f"`{node.function}(…)` applies to an Input Buffer, e.g. `{node.function}(manipulatorCommand/ib)`",
+                        argument.location or node.location,
+                        "EARL-R042",
+                    )
+                    continue
+            stack.extend((child, node_scope) for child in children(node))
+
+    def _path(self, read: Read, declared: _Declared, scope: Scope) -> None:
+        if not read.path:
+            return
+        element = declared.element
+        if read.target.kind is Kind.PRIMITIVE_PREDICATE:
+            self.error(f"`{reference_text(read.target)}` is a Boolean and has no fields", read.location, "EARL-R043")
+            return
+        current: Any = self.structural_type(element.data_type)
+        described = reference_text(read.target)
+        for accessor in read.path:
+            if current is None:
+                return
+            if isinstance(accessor, FieldAccess):
+                if not isinstance(current, StructType):
+                    self.error(
+                        f"`{described}` is not a struct, so it has no field `{accessor.name}`",
+                        accessor.location,
+                        "EARL-R044",
+                    )
+                    return
+                member = current.field_named(accessor.name)
+                if member is None:
+                    self.error(
+                        f"`{current.name}` has no field `{accessor.name}`",
+                        accessor.location,
+                        "EARL-R045",
+                        did_you_mean(accessor.name, [f.name for f in current.fields])
+                        or f"its fields: {', '.join(f.name for f in current.fields) or 'none'}",
+                    )
+                    return
+                described += f".{accessor.name}"
+                current = self.structural_type(member.data_type)
+            else:
+                if not isinstance(current, ArrayType):
+                    self.error(f"`{described}` is not an array and cannot be indexed", accessor.location, "EARL-R046")
+                    return
+                described += "[…]"
+                current = self.structural_type(current.element)
+
+    # ------------------------------------------------------------------ links and robots
+    def _links(self, links: Sequence[Link], scope: Scope, agent: _AgentTable | None) -> None:
+        names: dict[str, Link] = {}
+        for link in links:
+            name = link.name_text
+            if name in names:
+                self.duplicate(
+                    f"link `{name}`",
+                    link.location,
+                    names[name].location,
+                )
+                continue
+            names[name] = link
+            link_scope = dict(scope)
+            family = self.family_range(link.family, scope)
+            if link.family is not None and family is not None:
+                link_scope[link.family.index] = family
+            for part in link.name:
+                if part.index is not None:
+                    self.index_values(part.index, link_scope)
+            self._link_end(link, link.source, link_scope, agent, Kind.OUTPUT_BUFFER)
+            self._link_end(link, link.destination, link_scope, agent, Kind.INPUT_BUFFER)
+
+    def _link_end(self, link: Link, end: LinkEnd, scope: Scope, agent: _AgentTable | None, kind: Kind) -> None:
+        role = "source" if kind is Kind.OUTPUT_BUFFER else "destination"
+        if agent is None:
+            if end.agent is None:
+                self.error(
+                    f"the {role} of link `{link.name_text}` must name its agent, e.g. `task/a.cs.{end.buffer.name}`",
+                    end.location,
+                    "EARL-R050",
+                    "links between subsystems of one agent are declared inside that agent",
+                )
+                return
+            table = self.agents.get(end.agent.name)
+            if table is None:
+                self.error(
+                    f"link `{link.name_text}` names the agent `{end.agent.name}/a`, which is not declared",
+                    end.agent.location,
+                    "EARL-R051",
+                    did_you_mean(end.agent.name, self.agents),
+                )
+                return
+            self._indices(end.agent, table.family, scope, star=False)
+        else:
+            if end.agent is not None:
+                self.error(
+                    f"a link inside `{agent.agent.name}/a` connects its own subsystems; drop `{reference_text(end.agent)}.`",
+                    end.agent.location,
+                    "EARL-R052",
+                    "links between agents are declared at the top level of the system",
+                )
+                return
+            table = agent
+        key = (end.subsystem.name, end.subsystem.kind)
+        found = table.subsystems.get(key)
+        if found is None:
+            names = [n for (n, k) in table.subsystems if k is end.subsystem.kind]
+            self.error(
+                f"`{table.agent.name}/a` has no subsystem `{reference_text(end.subsystem)}`",
+                end.subsystem.location,
+                "EARL-R053",
+                did_you_mean(end.subsystem.name, names),
+            )
+            return
+        sub_table, sub_family = found
+        self._indices(end.subsystem, sub_family, scope, star=False)
+        buffers = sub_table.lookup(kind)
+        declared = buffers.get(end.buffer.name)
+        if declared is None:
+            other = Kind.INPUT_BUFFER if kind is Kind.OUTPUT_BUFFER else Kind.OUTPUT_BUFFER
+            hint = did_you_mean(end.buffer.name, buffers)
+            if hint is None and end.buffer.name in sub_table.lookup(other):
+                hint = f"`{end.buffer.name}` is an {KIND_TITLES[other]} there; a link runs from an Output Buffer to an Input Buffer"
+            where = f"{table.agent.name}/a.{reference_text(end.subsystem)}"
+            self.error(
+                f"`{where}` has no {KIND_TITLES[kind]} `{end.buffer.name}`", end.buffer.location, "EARL-R054", hint
+            )
+            return
+        self._indices(end.buffer, declared.family, scope, star=False)
+
+    def _robots(self) -> None:
+        seen: dict[str, Any] = {}
+        links = {link.name_text for link in self.system.links}
+        for robot in self.system.robots:
+            if robot.name in seen:
+                self.duplicate(f"robot `{robot.name}/r`", robot.location, seen[robot.name].location)
+                continue
+            seen[robot.name] = robot
+            if robot.name in self.agents:
+                self.error(f"`{robot.name}` names both a robot and an agent", robot.location, "EARL-R055")
+            for reference in robot.agents:
+                table = self.agents.get(reference.name)
+                if table is None:
+                    self.error(
+                        f"robot `{robot.name}/r` refers to the agent `{reference.name}/a`, which is not declared",
+                        reference.location,
+                        "EARL-R056",
+                        did_you_mean(reference.name, self.agents),
+                    )
+                    continue
+                self._indices(reference, table.family, {}, star=True)
+            for reference in robot.links:
+                if reference.name not in links:
+                    self.error(
+                        f"robot `{robot.name}/r` refers to the link `{reference.name}`, which is not declared",
+                        reference.location,
+                        "EARL-R057",
+                        did_you_mean(reference.name, links),
+                    )
+
+
+def _names(expression: Expression) -> list[Name]:
+    from earl.model.expressions import walk
+
+    return [node for node in walk(expression) if isinstance(node, Name)]
+
+
+def _values(scope: Scope) -> dict[str, Value]:
+    return {name: value for name, value in scope.items() if not isinstance(value, IndexRange)}
+
+
+def _product_size(ranges: Sequence[range]) -> int:
+    size = 1
+    for values in ranges:
+        size *= len(values)
+    return size
+
+
+def resolve(system: System, overrides: Mapping[str, Value] | None = None) -> list[Diagnostic]:
+    """Every name-resolution problem of a declared system, in the order found."""
+    return Resolver(system, overrides or {}).run()
+
+
+__all__ = ["MAX_FAMILY_MEMBERS", "IndexRange", "Resolver", "resolve"]

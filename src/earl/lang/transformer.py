@@ -1,0 +1,633 @@
+"""Turns Lark's parse tree of one `.earl` file into declared model elements.
+
+The transformer is non-recursive (`Transformer_NonRecursive`) because a spec may
+nest expressions deeply; depth is measured here and refused above a bound so
+that nothing later in the pipeline can run out of stack.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+from lark import Token, Tree
+from lark.tree import Meta
+from lark.visitors import Transformer_NonRecursive, v_args
+
+from earl.diagnostics import Diagnostic, Severity
+from earl.model.elements import (
+    FSM,
+    SUBSYSTEM_CLASSES,
+    Agent,
+    Assumption,
+    BasicBehaviour,
+    ControlSubsystem,
+    Duration,
+    Family,
+    Import,
+    InputBuffer,
+    Link,
+    LinkEnd,
+    LinkNamePart,
+    Memory,
+    OutputBuffer,
+    Parameter,
+    PartialTransitionFunction,
+    Predicate,
+    PrimitivePredicate,
+    PythonImplementation,
+    Queue,
+    Robot,
+    StageSet,
+    State,
+    Subsystem,
+    Transition,
+    TransitionFunction,
+)
+from earl.model.expressions import (
+    Arithmetic,
+    BooleanOperation,
+    Call,
+    Comparison,
+    ElementReference,
+    Expression,
+    FieldAccess,
+    IndexAccess,
+    ListLiteral,
+    Literal,
+    Name,
+    Negate,
+    Not,
+    Quantifier,
+    Read,
+    Star,
+)
+from earl.model.kinds import Kind
+from earl.model.location import SourceLocation
+from earl.model.types import (
+    PRIMITIVE_TYPES,
+    ArrayType,
+    DataType,
+    Field,
+    PrimitiveType,
+    StructType,
+    TypeAlias,
+    TypeReference,
+)
+
+#: Deeper expressions are refused: no person writes them, and they would exhaust the stack.
+MAX_EXPRESSION_DEPTH = 100
+
+
+class SpecificationSyntaxError(Exception):
+    """A problem found while building the tree into elements (e.g. an expression nested too deep)."""
+
+    def __init__(self, diagnostic: Diagnostic) -> None:
+        super().__init__(diagnostic.message)
+        self.diagnostic = diagnostic
+
+
+@dataclass
+class ParsedFile:
+    """The declarations of one file, in the order written."""
+
+    path: str
+    system_name: str | None
+    system_location: SourceLocation | None
+    declarations: list[Any] = field(default_factory=list)
+    closing_comments: list[str] = field(default_factory=list)
+    header_comments: list[str] = field(default_factory=list)
+
+
+@dataclass
+class _DeclaredName:
+    name: str
+    family: Family | None
+    location: SourceLocation
+
+
+@dataclass
+class _BodyItem:
+    """A `period` or buffer-group line, before it is placed in its subsystem or state."""
+
+    what: str
+    value: Any
+
+
+def _location(path: str, meta: Meta | Token) -> SourceLocation:
+    if isinstance(meta, Token):
+        line = meta.line or 1
+        column = meta.column or 1
+        return SourceLocation(path, line, column, meta.end_line or line, meta.end_column or column + 1)
+    if getattr(meta, "empty", True):
+        return SourceLocation(path, 1, 1, 1, 1)
+    return SourceLocation(path, meta.line, meta.column, meta.end_line, meta.end_column)
+
+
+@v_args(meta=True)
+class ElementBuilder(Transformer_NonRecursive[Token, Any]):
+    """One callback per grammar rule; each returns a model element or a piece of one."""
+
+    def __init__(self, path: str) -> None:
+        super().__init__()
+        self.path = path
+        self._depth: dict[int, int] = {}
+
+    def _loc(self, meta: Meta | Token) -> SourceLocation:
+        return _location(self.path, meta)
+
+    # ------------------------------------------------------------------ file
+    def start(self, meta: Meta, children: list[Any]) -> ParsedFile:
+        name: str | None = None
+        location: SourceLocation | None = None
+        declarations = list(children)
+        if declarations and isinstance(declarations[0], tuple) and declarations[0][0] == "system":
+            _, name, location = declarations.pop(0)
+        return ParsedFile(self.path, name, location, declarations)
+
+    def system_header(self, meta: Meta, children: list[Token]) -> tuple[str, str, SourceLocation]:
+        return ("system", str(children[0]), self._loc(children[0]))
+
+    def import_decl(self, meta: Meta, children: list[Token]) -> Import:
+        return Import(_string_value(children[0]), self._loc(meta))
+
+    def parameter(self, meta: Meta, children: list[Any]) -> Parameter:
+        name, data_type, value = children
+        return Parameter(str(name), data_type, value, self._loc(meta))
+
+    # ------------------------------------------------------------------ types
+    def type_alias(self, meta: Meta, children: list[Any]) -> TypeAlias:
+        return TypeAlias(str(children[0]), children[1], self._loc(meta))
+
+    def struct_decl(self, meta: Meta, children: list[Any]) -> StructType:
+        return StructType(str(children[0]), list(children[1:]), self._loc(meta))
+
+    def struct_field(self, meta: Meta, children: list[Any]) -> Field:
+        return Field(str(children[0]), children[1], len(children) > 2, self._loc(meta))
+
+    def named_type(self, meta: Meta, children: list[Token]) -> DataType:
+        name = str(children[0])
+        if name in PRIMITIVE_TYPES:
+            return PrimitiveType(name, self._loc(meta))
+        return TypeReference(name, self._loc(meta))
+
+    def fixed_array(self, meta: Meta, children: list[Any]) -> ArrayType:
+        return ArrayType(children[0], children[1], self._loc(meta))
+
+    def variable_array(self, meta: Meta, children: list[Any]) -> ArrayType:
+        return ArrayType(children[0], None, self._loc(meta))
+
+    # ------------------------------------------------------------------ system
+    def robot(self, meta: Meta, children: list[Any]) -> Robot:
+        name, _kind, *members = children
+        robot = Robot(self._single(name, "Robot"), location=self._loc(meta))
+        for member in members:
+            (robot.links if member.kind is Kind.INTER_AGENT_LINK else robot.agents).append(member)
+        return robot
+
+    def robot_agent(self, meta: Meta, children: list[Any]) -> ElementReference:
+        return ElementReference(str(children[0]), Kind.AGENT, tuple(children[1:-1]), self._loc(meta))
+
+    def robot_link(self, meta: Meta, children: list[Any]) -> ElementReference:
+        parts, _family = children[0]
+        text = ",".join(p.name if p.index is None else f"{p.name}[{_index_source(p.index)}]" for p in parts)
+        return ElementReference(text, Kind.INTER_AGENT_LINK, (), self._loc(meta))
+
+    def agent(self, meta: Meta, children: list[Any]) -> Agent:
+        declared: _DeclaredName = children[0]
+        agent = Agent(declared.name, declared.family, location=self._loc(meta))
+        for member in children[2:]:
+            if isinstance(member, Parameter):
+                agent.parameters.append(member)
+            elif isinstance(member, Subsystem):
+                agent.subsystems.append(member)
+            else:
+                agent.links.append(member)
+        return agent
+
+    def declared_name(self, meta: Meta, children: list[Any]) -> _DeclaredName:
+        family = children[1] if len(children) > 1 else None
+        return _DeclaredName(str(children[0]), family, self._loc(children[0]))
+
+    def family(self, meta: Meta, children: list[Any]) -> Family:
+        return Family(str(children[0]), children[1], children[2], self._loc(meta))
+
+    def link(self, meta: Meta, children: list[Any]) -> Link:
+        if len(children) == 3:
+            (parts, family), source, destination = children
+        else:
+            source, destination = children
+            parts, family = _derived_link_name(source, destination), None
+        source_end = _link_end(source, Kind.OUTPUT_BUFFER)
+        destination_end = _link_end(destination, Kind.INPUT_BUFFER)
+        return Link(tuple(parts), source_end, destination_end, family, self._loc(meta))
+
+    def link_name(self, meta: Meta, children: list[Any]) -> tuple[list[LinkNamePart], Family | None]:
+        parts: list[LinkNamePart] = []
+        family: Family | None = None
+        for name, index in children:
+            if isinstance(index, Family):
+                if family is not None:
+                    raise SpecificationSyntaxError(
+                        Diagnostic(
+                            Severity.ERROR,
+                            "a link family declares one index; the other part of its name uses it",
+                            index.location,
+                            code="EARL-S010",
+                            hint=f"write `[{family.index}]` instead of a second `[... in ...]`",
+                        )
+                    )
+                family = index
+                parts.append(LinkNamePart(name, Name(index.index)))
+            else:
+                parts.append(LinkNamePart(name, index))
+        return parts, family
+
+    def link_name_part(self, meta: Meta, children: list[Any]) -> tuple[str, Any]:
+        return str(children[0]), children[1] if len(children) > 1 else None
+
+    def link_end(self, meta: Meta, children: list[Any]) -> dict[str, Any]:
+        agent = children[0] if isinstance(children[0], ElementReference) and children[0].kind is Kind.AGENT else None
+        rest = children[1:] if agent is not None else children
+        subsystem, buffer_name, *indices = rest
+        return {
+            "agent": agent,
+            "subsystem": subsystem,
+            "buffer": (str(buffer_name), tuple(indices), self._loc(buffer_name)),
+            "location": self._loc(meta),
+        }
+
+    def agent_ref(self, meta: Meta, children: list[Any]) -> ElementReference:
+        return ElementReference(str(children[0]), Kind.AGENT, tuple(children[1:-1]), self._loc(meta))
+
+    def control_subsystem_ref(self, meta: Meta, children: list[Any]) -> ElementReference:
+        return ElementReference("cs", Kind.CONTROL_SUBSYSTEM, (), self._loc(meta))
+
+    def subsystem_ref(self, meta: Meta, children: list[Any]) -> ElementReference:
+        return ElementReference(str(children[0]), Kind(str(children[-1])), tuple(children[1:-1]), self._loc(meta))
+
+    # ------------------------------------------------------------------ subsystems
+    def control_subsystem(self, meta: Meta, children: list[Any]) -> Subsystem:
+        return self._fill(ControlSubsystem(location=self._loc(meta)), children[1:])
+
+    def other_subsystem(self, meta: Meta, children: list[Any]) -> Subsystem:
+        declared: _DeclaredName = children[0]
+        cls = SUBSYSTEM_CLASSES[Kind(str(children[1]))]
+        subsystem = cls(declared.name, declared.family, location=self._loc(meta))
+        return self._fill(subsystem, children[2:])
+
+    def _fill(self, subsystem: Subsystem, items: list[Any]) -> Subsystem:
+        for item in items:
+            if isinstance(item, _BodyItem):
+                subsystem.period = item.value
+            elif isinstance(item, Parameter):
+                subsystem.parameters.append(item)
+            elif isinstance(item, InputBuffer):
+                subsystem.input_buffers.append(item)
+            elif isinstance(item, OutputBuffer):
+                subsystem.output_buffers.append(item)
+            elif isinstance(item, Memory):
+                subsystem.memories.append(item)
+            elif isinstance(item, PrimitivePredicate):
+                subsystem.primitive_predicates.append(item)
+            elif isinstance(item, PartialTransitionFunction):
+                subsystem.partial_transition_functions.append(item)
+            elif isinstance(item, StageSet):
+                subsystem.stage_sets.append(item)
+            elif isinstance(item, BasicBehaviour):
+                subsystem.basic_behaviours.append(item)
+            elif isinstance(item, FSM):
+                if subsystem.fsm is not None:
+                    raise SpecificationSyntaxError(
+                        Diagnostic(
+                            Severity.ERROR,
+                            f"`{subsystem.name}` declares a second `fsm`; a Subsystem has exactly one FSM",
+                            item.location,
+                            code="EARL-S011",
+                            hint="put all states and transitions in one `fsm { … }` block",
+                        )
+                    )
+                subsystem.fsm = item
+        return subsystem
+
+    def period(self, meta: Meta, children: list[Any]) -> _BodyItem:
+        return _BodyItem("period", children[0])
+
+    def duration(self, meta: Meta, children: list[Token]) -> Duration:
+        number = _number(children[0])
+        if number <= 0:
+            raise SpecificationSyntaxError(
+                Diagnostic(
+                    Severity.ERROR,
+                    f"a duration must be positive, not {children[0]}",
+                    self._loc(children[0]),
+                    code="EARL-S012",
+                )
+            )
+        return Duration(number, str(children[1]))
+
+    def input_buffer(self, meta: Meta, children: list[Any]) -> InputBuffer:
+        declared: _DeclaredName = children[0]
+        queue = children[3] if len(children) > 3 else None
+        return InputBuffer(declared.name, children[2], declared.family, queue, self._loc(meta))
+
+    def queue(self, meta: Meta, children: list[Any]) -> Queue:
+        if len(children) > 1:
+            policy = str(children[1])
+            if policy not in Queue.OVERFLOW_POLICIES:
+                choices = ", ".join(f"`{p}`" for p in Queue.OVERFLOW_POLICIES)
+                raise SpecificationSyntaxError(
+                    Diagnostic(
+                        Severity.ERROR,
+                        f"unknown overflow policy `{policy}`",
+                        self._loc(children[1]),
+                        code="EARL-S013",
+                        hint=f"choose one of {choices}",
+                    )
+                )
+            return Queue(children[0], policy)
+        return Queue(children[0])
+
+    def output_buffer(self, meta: Meta, children: list[Any]) -> OutputBuffer:
+        declared: _DeclaredName = children[0]
+        return OutputBuffer(declared.name, children[2], declared.family, self._loc(meta))
+
+    def memory(self, meta: Meta, children: list[Any]) -> Memory:
+        declared: _DeclaredName = children[0]
+        initial = children[3] if len(children) > 3 else None
+        return Memory(declared.name, children[2], declared.family, initial, self._loc(meta))
+
+    def _single(self, declared: _DeclaredName | Token, what: str) -> str:
+        """The name of an element that cannot be an indexed family."""
+        if isinstance(declared, Token):
+            return str(declared)
+        if declared.family is not None:
+            raise SpecificationSyntaxError(
+                Diagnostic(
+                    Severity.ERROR,
+                    f"a {what} cannot be an indexed family",
+                    declared.family.location,
+                    code="EARL-S016",
+                    hint=f"declare one `{declared.name}` and use `any(...)`/`all(...)` or `[*]` inside it",
+                )
+            )
+        return declared.name
+
+    def primitive_predicate(self, meta: Meta, children: list[Any]) -> PrimitivePredicate:
+        return PrimitivePredicate(self._single(children[0], "Primitive Predicate"), children[2], self._loc(meta))
+
+    def ref_name(self, meta: Meta, children: list[Token]) -> Token:
+        return children[0]
+
+    def partial_transition_function(self, meta: Meta, children: list[Any]) -> PartialTransitionFunction:
+        name, _kind, reads, writes, *implementation = children
+        return PartialTransitionFunction(
+            self._single(name, "Partial Transition Function"),
+            reads,
+            writes,
+            implementation[0] if implementation else None,
+            self._loc(meta),
+        )
+
+    def pf_reads(self, meta: Meta, children: list[ElementReference]) -> list[ElementReference]:
+        return list(children)
+
+    def pf_writes(self, meta: Meta, children: list[ElementReference]) -> list[ElementReference]:
+        return list(children)
+
+    def reference_list(self, meta: Meta, children: list[ElementReference]) -> list[ElementReference]:
+        return list(children)
+
+    def implementation(self, meta: Meta, children: list[Token]) -> PythonImplementation:
+        return PythonImplementation(_string_value(children[0]))
+
+    def stage_set(self, meta: Meta, children: list[Any]) -> StageSet:
+        return StageSet(str(children[0]), children[1], self._loc(meta))
+
+    def pf_set(self, meta: Meta, children: list[ElementReference]) -> list[ElementReference]:
+        return list(children)
+
+    def basic_behaviour(self, meta: Meta, children: list[Any]) -> BasicBehaviour:
+        name, _kind, transition_function, terminal, *error = children
+        return BasicBehaviour(
+            self._single(name, "Basic Behaviour"),
+            transition_function,
+            terminal,
+            error[0] if error else None,
+            self._loc(meta),
+        )
+
+    def transition_function(self, meta: Meta, children: list[Any]) -> TransitionFunction:
+        return TransitionFunction(list(children), self._loc(meta))
+
+    def terminal_condition(self, meta: Meta, children: list[Any]) -> Predicate:
+        return Predicate(children[0], self._loc(meta))
+
+    def error_condition(self, meta: Meta, children: list[Any]) -> Predicate:
+        return Predicate(children[0], self._loc(meta))
+
+    # ------------------------------------------------------------------ FSM
+    def fsm(self, meta: Meta, children: list[Any]) -> FSM:
+        initial, *items = children
+        fsm = FSM(initial, location=self._loc(meta))
+        for item in items:
+            if isinstance(item, State):
+                fsm.states.append(item)
+            elif isinstance(item, Transition):
+                fsm.transitions.append(item)
+            else:
+                fsm.assumptions.append(item)
+        return fsm
+
+    def initial_state(self, meta: Meta, children: list[Token]) -> str:
+        return str(children[0])
+
+    def state(self, meta: Meta, children: list[Any]) -> State:
+        name, behaviour, *group = children
+        state = State(str(name), behaviour.name, location=self._loc(meta), behaviour_location=behaviour.location)
+        if behaviour.kind is not Kind.BASIC_BEHAVIOUR:
+            raise SpecificationSyntaxError(
+                Diagnostic(
+                    Severity.ERROR,
+                    f"state `{name}` must name a Basic Behaviour (`/bb`), not `/{behaviour.kind.value}`",
+                    behaviour.location,
+                    code="EARL-S014",
+                    hint=f"write `state {name}: {behaviour.name}/bb`",
+                )
+            )
+        for item in group[0] if group else []:
+            if item.what == "obligatory":
+                state.obligatory.extend(item.value)
+            elif item.what == "optional":
+                state.optional.extend(item.value)
+            else:
+                state.timeout = item.value
+        return state
+
+    def buffer_group(self, meta: Meta, children: list[_BodyItem]) -> list[_BodyItem]:
+        return list(children)
+
+    def obligatory(self, meta: Meta, children: list[Any]) -> _BodyItem:
+        return _BodyItem("obligatory", children[0])
+
+    def optional(self, meta: Meta, children: list[Any]) -> _BodyItem:
+        return _BodyItem("optional", children[0])
+
+    def state_timeout(self, meta: Meta, children: list[Any]) -> _BodyItem:
+        return _BodyItem("timeout", children[0])
+
+    def transition(self, meta: Meta, children: list[Any]) -> Transition:
+        source, destination, condition, *priority = children
+        return Transition(
+            source,
+            str(destination),
+            Predicate(condition, condition.location),
+            int(priority[0]) if priority else None,
+            self._loc(meta),
+        )
+
+    def transition_source(self, meta: Meta, children: list[Token]) -> str:
+        return str(children[0])
+
+    def any_state(self, meta: Meta, children: list[Token]) -> None:
+        return None
+
+    def assumption(self, meta: Meta, children: list[Any]) -> Assumption:
+        return Assumption(children[0], self._loc(meta))
+
+    # ------------------------------------------------------------------ expressions
+    def element_ref(self, meta: Meta, children: list[Any]) -> ElementReference:
+        name, *indices, kind = children
+        converted = tuple(Star(self._loc(i)) if isinstance(i, Token) and i.type == "STAR" else i for i in indices)
+        return ElementReference(str(name), Kind(str(kind)), converted, self._loc(meta))
+
+    def _expression(self, node: Expression, children: list[Any]) -> Expression:
+        depth = 1 + max((self._depth.get(id(c), 0) for c in children), default=0)
+        if depth > MAX_EXPRESSION_DEPTH:
+            raise SpecificationSyntaxError(
+                Diagnostic(
+                    Severity.ERROR,
+                    f"this expression is nested more than {MAX_EXPRESSION_DEPTH} levels deep",
+                    node.location,
+                    code="EARL-S015",
+                    hint="split it into several primitive predicates",
+                )
+            )
+        self._depth[id(node)] = depth
+        return node
+
+    def or_expression(self, meta: Meta, children: list[Any]) -> Expression:
+        return self._expression(BooleanOperation("or", tuple(children), self._loc(meta)), children)
+
+    def and_expression(self, meta: Meta, children: list[Any]) -> Expression:
+        return self._expression(BooleanOperation("and", tuple(children), self._loc(meta)), children)
+
+    def not_(self, meta: Meta, children: list[Any]) -> Expression:
+        return self._expression(Not(children[0], self._loc(meta)), children)
+
+    def comparison(self, meta: Meta, children: list[Any]) -> Expression:
+        left, operator, right = children
+        return self._expression(Comparison(str(operator), left, right, self._loc(meta)), [left, right])
+
+    def sum(self, meta: Meta, children: list[Any]) -> Expression:
+        return self._fold(meta, children)
+
+    def product(self, meta: Meta, children: list[Any]) -> Expression:
+        return self._fold(meta, children)
+
+    def _fold(self, meta: Meta, children: list[Any]) -> Expression:
+        result: Expression = children[0]
+        for operator, operand in zip(children[1::2], children[2::2], strict=False):
+            location = _span(result.location, operand.location) or self._loc(meta)
+            result = self._expression(Arithmetic(str(operator), result, operand, location), [result, operand])
+        return result
+
+    def negate(self, meta: Meta, children: list[Any]) -> Expression:
+        return self._expression(Negate(children[1], self._loc(meta)), children[1:])
+
+    def read(self, meta: Meta, children: list[Any]) -> Expression:
+        target, *path = children
+        return self._expression(
+            Read(target, tuple(path), self._loc(meta)), [a.index for a in path if isinstance(a, IndexAccess)]
+        )
+
+    def field_access(self, meta: Meta, children: list[Token]) -> FieldAccess:
+        return FieldAccess(str(children[0]), self._loc(children[0]))
+
+    def index_access(self, meta: Meta, children: list[Any]) -> IndexAccess:
+        return IndexAccess(children[0], self._loc(meta))
+
+    def number(self, meta: Meta, children: list[Token]) -> Expression:
+        return Literal(_number(children[0]), self._loc(meta))
+
+    def string(self, meta: Meta, children: list[Token]) -> Expression:
+        return Literal(_string_value(children[0]), self._loc(meta))
+
+    def true(self, meta: Meta, children: list[Token]) -> Expression:
+        return Literal(True, self._loc(meta))
+
+    def false(self, meta: Meta, children: list[Token]) -> Expression:
+        return Literal(False, self._loc(meta))
+
+    def name(self, meta: Meta, children: list[Token]) -> Expression:
+        return Name(str(children[0]), self._loc(meta))
+
+    def call(self, meta: Meta, children: list[Any]) -> Expression:
+        function, *arguments = children
+        return self._expression(Call(str(function), tuple(arguments), self._loc(meta)), arguments)
+
+    def quantifier(self, meta: Meta, children: list[Any]) -> Expression:
+        kind, index, first, last, body = children
+        node = Quantifier(str(kind), str(index), first, last, body, self._loc(meta))
+        return self._expression(node, [first, last, body])
+
+    def list_literal(self, meta: Meta, children: list[Any]) -> Expression:
+        return self._expression(ListLiteral(tuple(children), self._loc(meta)), children)
+
+
+def _span(first: SourceLocation | None, last: SourceLocation | None) -> SourceLocation | None:
+    if first is None or last is None:
+        return None
+    return SourceLocation(first.file, first.line, first.column, last.end_line, last.end_column)
+
+
+def _number(token: Token) -> int | float:
+    text = str(token)
+    if any(c in text for c in ".eE"):
+        return float(text)
+    return int(text)
+
+
+def _string_value(token: Token) -> str:
+    import json
+
+    return str(json.loads(str(token)))
+
+
+def _index_source(index: Expression) -> str:
+    from earl.model.text import expression_text
+
+    return expression_text(index)
+
+
+def _link_end(end: dict[str, Any], buffer_kind: Kind) -> LinkEnd:
+    name, indices, location = end["buffer"]
+    buffer = ElementReference(name, buffer_kind, indices, location)
+    return LinkEnd(end["agent"], end["subsystem"], buffer, end["location"])
+
+
+def _derived_link_name(source: dict[str, Any], destination: dict[str, Any]) -> list[LinkNamePart]:
+    """`source,destination` (§2.5): agent names between agents, subsystem names inside one."""
+    parts = []
+    for end in (source, destination):
+        reference: ElementReference = end["agent"] or end["subsystem"]
+        index = reference.indices[0] if len(reference.indices) == 1 else None
+        parts.append(LinkNamePart(reference.name, index if not isinstance(index, Star) else None))
+    return parts
+
+
+def with_location(element: Any, location: SourceLocation) -> Any:
+    return replace(element, location=location)
+
+
+__all__ = ["MAX_EXPRESSION_DEPTH", "ElementBuilder", "ParsedFile", "SpecificationSyntaxError", "Tree"]
