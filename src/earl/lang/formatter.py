@@ -50,7 +50,7 @@ class _Printer:
     def line(self, depth: int, text: str, comments: Comments | None = None) -> None:
         if comments is not None:
             for comment in comments.leading:
-                self.lines.append(f"{INDENT * depth}{comment}")
+                self.lines.append(f"{INDENT * depth}{comment}" if comment else "")
             if comments.trailing:
                 text = f"{text}  {comments.trailing}"
         self.lines.append(f"{INDENT * depth}{text}")
@@ -97,8 +97,17 @@ def format_system(system: System) -> str:
     for import_ in system.imports:
         printer.blank()
         _import(printer, import_)
+    previous: object | None = None
     for declaration in declared:
-        printer.blank()
+        # One-line declarations of one kind (links, parameters, aliases) stay together as written.
+        grouped = (
+            type(declaration) is type(previous)
+            and isinstance(declaration, Parameter | TypeAlias | Link)
+            and not declaration.comments.leading
+        )
+        if not grouped:
+            printer.blank()
+        previous = declaration
         if isinstance(declaration, Parameter):
             _parameter(printer, 0, declaration)
         elif isinstance(declaration, StructType):

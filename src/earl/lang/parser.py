@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from bisect import bisect_left
 from functools import lru_cache
 from importlib import resources
 from typing import Any
@@ -162,7 +163,11 @@ def _statements(declarations: list[Any]) -> list[Any]:
 
 
 def attach_comments(declarations: list[Any], comments: list[Token], path: str) -> list[str]:
-    """Give each comment to the element it sits above, or ends the line of; return those after the last."""
+    """Give each comment to the element it sits above, or ends the line of; return those after the last.
+
+    A blank line that parts a comment from the comment or element below it is kept as an
+    empty entry in `leading`, so section headers stay apart from what they introduce.
+    """
     closing: list[str] = []
     if not comments:
         return closing
@@ -171,8 +176,8 @@ def attach_comments(declarations: list[Any], comments: list[Token], path: str) -
     for element in elements:
         by_line.setdefault(element.location.line, element)
     starts = [e.location.line for e in elements]
-    from bisect import bisect_left
-
+    last_line: dict[int, int] = {}  # id(element) -> line of its last leading comment
+    last_closing = 0
     for comment in comments:
         text = str(comment)
         line = comment.line or 1
@@ -182,7 +187,18 @@ def attach_comments(declarations: list[Any], comments: list[Token], path: str) -
             continue
         position = bisect_left(starts, line)
         if position < len(elements):
-            elements[position].comments.leading.append(text)
+            element = elements[position]
+            leading = element.comments.leading
+            if leading and line > last_line[id(element)] + 1:
+                leading.append("")
+            leading.append(text)
+            last_line[id(element)] = line
         else:
+            if closing and line > last_closing + 1:
+                closing.append("")
             closing.append(text)
+            last_closing = line
+    for element in elements:
+        if id(element) in last_line and element.location.line > last_line[id(element)] + 1:
+            element.comments.leading.append("")
     return closing

@@ -67,6 +67,9 @@ PARAMETER_TYPES: dict[str, tuple[type, ...]] = {
 }
 
 
+_INTEGER_TYPES = {name for name, accepted in PARAMETER_TYPES.items() if accepted == (int,)}
+
+
 @dataclass(frozen=True)
 class IndexRange:
     """An index variable while a family body is resolved: every value from first to last."""
@@ -164,6 +167,12 @@ class Resolver:
                 continue
             if parameter.name in overrides:
                 value: Value = overrides[parameter.name]
+            elif any(isinstance(scope.get(n.name), IndexRange) for n in _names(parameter.value)):
+                # `param joint: int = K` differs per family member: check every member's value.
+                values = self.index_values(parameter.value, scope) if type_name in _INTEGER_TYPES else None
+                if values is not None and values:
+                    scope[parameter.name] = IndexRange(min(values), max(values))
+                continue
             else:
                 try:
                     value = evaluate_constant(parameter.value, _values(scope))
