@@ -12,10 +12,35 @@ and writes `.earl` text.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from pathlib import Path
+
 from earl.diagnostics import Diagnostic, EarlError, Severity
-from earl.lang.loader import load, loads
 from earl.model import *  # noqa: F403  (the model's names are the API)
 from earl.model import __all__ as _model_names
+from earl.model.elements import System
+
+ParameterValue = bool | int | float | str
+
+
+def load(path: str | Path, parameters: Mapping[str, ParameterValue] | None = None) -> System:
+    """Read a `.earl` file (or a directory holding `system.earl`) into a resolved System.
+
+    `parameters` override system parameters (`{"N": 3}`).  Raises `EarlError` with
+    every problem found, each located at its file, line and column.
+    """
+    # Imported here so that `import earl.model` never loads the parser.
+    from earl.lang.loader import load as load_file
+
+    return load_file(path, parameters)
+
+
+def loads(text: str, path: str = "<text>", parameters: Mapping[str, ParameterValue] | None = None) -> System:
+    """Like `load`, for `.earl` text in memory; `path` names it in messages."""
+    from earl.lang.loader import loads as load_text
+
+    return load_text(text, path, parameters)
+
 
 __version__ = "0.1.0"
 

@@ -265,7 +265,7 @@ def _body_item(printer: _Printer, depth: int, item: object) -> None:
 
 def _basic_behaviour(printer: _Printer, depth: int, behaviour: BasicBehaviour) -> None:
     printer.line(depth, f"{behaviour.name}/bb {{", behaviour.comments)
-    stages = " then ".join(_pf_set(stage) for stage in behaviour.transition_function.stages)
+    stages = " then ".join(_pf_set(stage) for stage in behaviour.transition_function.stages) or "{}"
     printer.line(depth + 1, f"tf = {stages}")
     printer.line(depth + 1, f"tc = {expression_text(behaviour.terminal_condition.expression)}")
     if behaviour.error_condition is not None:

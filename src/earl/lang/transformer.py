@@ -238,7 +238,7 @@ class ElementBuilder(Transformer_NonRecursive[Token, Any]):
                         )
                     )
                 family = index
-                parts.append(LinkNamePart(name, Name(index.index)))
+                parts.append(LinkNamePart(name, Name(index.index, index.location), declares_family=True))
             else:
                 parts.append(LinkNamePart(name, index))
         return parts, family
@@ -418,7 +418,10 @@ class ElementBuilder(Transformer_NonRecursive[Token, Any]):
         )
 
     def transition_function(self, meta: Meta, children: list[Any]) -> TransitionFunction:
-        return TransitionFunction(list(children), self._loc(meta))
+        stages = list(children)
+        if stages == [[]]:
+            stages = []  # `tf = {}`: a behaviour that computes nothing
+        return TransitionFunction(stages, self._loc(meta))
 
     def terminal_condition(self, meta: Meta, children: list[Any]) -> Predicate:
         return Predicate(children[0], self._loc(meta))

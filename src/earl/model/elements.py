@@ -72,6 +72,8 @@ class InputBuffer:
     queue: Queue | None = None
     location: SourceLocation | None = location_field()
     comments: Comments = comments_field()
+    #: In an expanded system, which member of `family` this element is (see earl.model.expand).
+    index: int | None = None
     kind: ClassVar[Kind] = Kind.INPUT_BUFFER
 
 
@@ -84,6 +86,8 @@ class OutputBuffer:
     family: Family | None = None
     location: SourceLocation | None = location_field()
     comments: Comments = comments_field()
+    #: In an expanded system, which member of `family` this element is (see earl.model.expand).
+    index: int | None = None
     kind: ClassVar[Kind] = Kind.OUTPUT_BUFFER
 
 
@@ -97,6 +101,8 @@ class Memory:
     initial_value: Expression | None = None
     location: SourceLocation | None = location_field()
     comments: Comments = comments_field()
+    #: In an expanded system, which member of `family` this element is (see earl.model.expand).
+    index: int | None = None
     kind: ClassVar[Kind] = Kind.MEMORY
 
 
@@ -289,6 +295,8 @@ class Subsystem:
     fsm: FSM | None = None
     location: SourceLocation | None = location_field()
     comments: Comments = comments_field()
+    #: In an expanded system, which member of `family` this element is (see earl.model.expand).
+    index: int | None = None
     kind: ClassVar[Kind]
 
     def input_buffer(self, name: str) -> InputBuffer | None:
@@ -371,8 +379,11 @@ class LinkEnd:
 
 @dataclass(frozen=True, slots=True)
 class LinkNamePart:
+    """One side of a link's name; in `cs,motorController[K in 1..N]` the second part declares the family."""
+
     name: str
     index: Expression | None = None
+    declares_family: bool = False
 
 
 @dataclass
@@ -390,6 +401,8 @@ class Link:
     family: Family | None = None
     location: SourceLocation | None = location_field()
     comments: Comments = comments_field()
+    #: In an expanded system, which member of `family` this element is (see earl.model.expand).
+    index: int | None = None
 
     @property
     def name_text(self) -> str:
@@ -409,6 +422,8 @@ class Agent:
     links: list[Link] = field(default_factory=list)
     location: SourceLocation | None = location_field()
     comments: Comments = comments_field()
+    #: In an expanded system, which member of `family` this element is (see earl.model.expand).
+    index: int | None = None
     kind: ClassVar[Kind] = Kind.AGENT
 
     @property

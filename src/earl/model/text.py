@@ -86,7 +86,7 @@ def link_name_text(link: Link) -> str:
     for part in link.name:
         if part.index is None:
             parts.append(part.name)
-        elif link.family is not None and part.index == Name(link.family.index):
+        elif link.family is not None and part.declares_family:
             parts.append(family_text(part.name, link.family))
         else:
             parts.append(f"{part.name}[{expression_text(part.index)}]")

@@ -1,0 +1,230 @@
+"""The model: built in Python, read from text, expanded into instances; independent of every reader."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import earl
+from earl.model import (
+    FSM,
+    Agent,
+    BasicBehaviour,
+    BooleanOperation,
+    ControlSubsystem,
+    ElementReference,
+    Family,
+    Field,
+    InputBuffer,
+    Kind,
+    Link,
+    LinkEnd,
+    LinkNamePart,
+    Literal,
+    Name,
+    Not,
+    OutputBuffer,
+    Parameter,
+    PrimitivePredicate,
+    PrimitiveType,
+    Read,
+    RealEffector,
+    Robot,
+    State,
+    StructType,
+    System,
+    Transition,
+    TransitionFunction,
+    TypeReference,
+    VirtualEffector,
+)
+from earl.model.elements import Predicate
+from earl.model.expand import expand
+from earl.model.text import expression_text
+
+EXAMPLE = Path(__file__).parent.parent / "examples" / "pick_and_place" / "system.earl"
+
+
+def test_the_model_imports_no_parser_renderer_or_runtime() -> None:
+    code = (
+        "import sys, earl.model, earl.model.expand;"
+        "bad = [m for m in sys.modules if m == 'lark' or m.startswith(('lark.', 'earl.lang', 'earl.cli'))];"
+        "print(bad); sys.exit(1 if bad else 0)"
+    )
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=False)
+    assert result.returncode == 0, result.stdout + result.stderr
+
+
+def _built_in_python() -> System:
+    def pp(name: str) -> Read:
+        return Read(ElementReference(name, Kind.PRIMITIVE_PREDICATE))
+
+    command = ElementReference("command", Kind.INPUT_BUFFER)
+    cs = ControlSubsystem(
+        input_buffers=[InputBuffer("command", TypeReference("Command"))],
+        output_buffers=[OutputBuffer("drive", PrimitiveType("double"), Family("K", Literal(1), Name("N")))],
+        primitive_predicates=[
+            PrimitivePredicate("stop", Read(command, (earl.model.FieldAccess("stop"),))),
+            PrimitivePredicate("false", Literal(False)),
+        ],
+        basic_behaviours=[
+            BasicBehaviour("run", TransitionFunction([]), Predicate(pp("stop"))),
+            BasicBehaviour("halt", TransitionFunction([]), Predicate(pp("false"))),
+        ],
+        fsm=FSM(
+            "run",
+            states=[State("run", "run"), State("halt", "halt")],
+            transitions=[Transition("run", "halt", Predicate(pp("stop")), priority=1)],
+        ),
+    )
+    drive = VirtualEffector(
+        "drive",
+        Family("K", Literal(1), Name("N")),
+        input_buffers=[InputBuffer("setpoint", PrimitiveType("double"))],
+        output_buffers=[OutputBuffer("current", PrimitiveType("double"))],
+    )
+    motor = RealEffector(
+        "motor", Family("K", Literal(1), Name("N")), input_buffers=[InputBuffer("current", PrimitiveType("double"))]
+    )
+    link = Link(
+        (LinkNamePart("cs"), LinkNamePart("drive", Name("K"), declares_family=True)),
+        LinkEnd(
+            None,
+            ElementReference("cs", Kind.CONTROL_SUBSYSTEM),
+            ElementReference("drive", Kind.OUTPUT_BUFFER, (Name("K"),)),
+        ),
+        LinkEnd(
+            None,
+            ElementReference("drive", Kind.VIRTUAL_EFFECTOR, (Name("K"),)),
+            ElementReference("setpoint", Kind.INPUT_BUFFER),
+        ),
+        Family("K", Literal(1), Name("N")),
+    )
+    agent = Agent("arm", subsystems=[cs, drive, motor], links=[link])
+    return System(
+        "built",
+        parameters=[Parameter("N", PrimitiveType("int"), Literal(2))],
+        types=[StructType("Command", [Field("stop", PrimitiveType("boolean"))])],
+        agents=[agent],
+        robots=[Robot("robot", agents=[ElementReference("arm", Kind.AGENT)])],
+    )
+
+
+def test_a_model_built_in_python_prints_as_text_that_reads_back_equal() -> None:
+    system = _built_in_python()
+    text = system.to_earl()
+    assert "drive[K in 1..N]/ve {" in text
+    assert "link cs,drive[K in 1..N]: cs.drive[K] -> drive[K]/ve.setpoint" in text
+    again = earl.loads(text)
+    assert again == system
+    assert again.to_earl() == text
+
+
+def test_equality_ignores_locations_but_not_content() -> None:
+    first = earl.loads("system a\nparam N: int = 1\n")
+    second = earl.loads("system a\n\n\n   param N: int = 1\n")
+    third = earl.loads("system a\nparam N: int = 2\n")
+    assert first == second
+    assert first != third
+    assert first.parameters[0].location is not None
+    assert first.parameters[0].location.line == 2
+    assert second.parameters[0].location.line == 4
+
+
+def test_every_element_of_the_flagship_keeps_its_source_location() -> None:
+    system = earl.load(EXAMPLE)
+    missing = []
+    for agent in system.agents:
+        elements: list[object] = [agent, *agent.subsystems, *agent.links]
+        for subsystem in agent.subsystems:
+            elements += [
+                *subsystem.input_buffers,
+                *subsystem.output_buffers,
+                *subsystem.memories,
+                *subsystem.primitive_predicates,
+                *subsystem.partial_transition_functions,
+                *subsystem.basic_behaviours,
+            ]
+            if subsystem.fsm is not None:
+                elements += [subsystem.fsm, *subsystem.fsm.states, *subsystem.fsm.transitions]
+        missing += [e for e in elements if getattr(e, "location", None) is None]
+    assert missing == []
+    idle = system.agent("manip").control_subsystem.fsm.state_named("idle")  # type: ignore[union-attr]
+    assert idle is not None and idle.location is not None
+    assert idle.location.file.endswith("system.earl")
+    assert "state idle: idle/bb" in EXAMPLE.read_text().splitlines()[idle.location.line - 1]
+
+
+@pytest.mark.parametrize("joints", [3, 6, 7])
+def test_families_expand_to_one_instance_per_member(joints: int) -> None:
+    system = earl.load(EXAMPLE, {"N": joints})
+    expanded = expand(system, {"N": joints})
+    manip = expanded.agent("manip")
+    assert manip is not None
+    controllers = manip.subsystems_of(Kind.VIRTUAL_EFFECTOR)
+    assert [c.index for c in controllers] == list(range(1, joints + 1))
+    assert all(c.family is not None for c in controllers)  # the family is kept for rendering
+    assert len(manip.subsystems_of(Kind.REAL_EFFECTOR)) == joints
+    assert len(manip.links) == 4 * joints
+    cs = manip.control_subsystem
+    assert cs is not None
+    assert [b.index for b in cs.input_buffers if b.name == "motorControllerState"] == list(range(1, joints + 1))
+    # any(K in 1..N: …) is unrolled into an `or` over every member
+    emergency = cs.primitive_predicate("emergencyStop")
+    assert emergency is not None
+    text = expression_text(emergency.expression)
+    assert text.count("motorControllerState[") == joints
+    assert f"motorControllerState[{joints}]/ib.emergencyStop" in text
+    # [*] in a function's declared writes names every member
+    output = cs.partial_transition_function("outputMotorCon")
+    assert output is not None
+    assert len([w for w in output.writes if w.kind is Kind.OUTPUT_BUFFER]) == joints
+    # `* -> emergencyStop` becomes one transition from every other state
+    assert cs.fsm is not None
+    sources = sorted(t.source or "" for t in cs.fsm.transitions if t.destination == "emergencyStop")
+    assert sources == ["idle", "jointMove", "operationalMove"]
+    # the declared model is untouched: still one family declaration
+    declared = system.agent("manip")
+    assert declared is not None
+    assert len(declared.subsystems_of(Kind.VIRTUAL_EFFECTOR)) == 1
+
+
+def test_parameters_become_values_in_expanded_types_and_params() -> None:
+    system = earl.load(EXAMPLE, {"N": 4})
+    expanded = expand(system, {"N": 4})
+    joint_position = expanded.type_named("JointPosition")
+    assert joint_position is not None
+    assert expression_text(joint_position.data_type.size) == "4"  # type: ignore[union-attr, arg-type]
+    manip = expanded.agent("manip")
+    assert manip is not None
+    joints = [s.parameters[0].value for s in manip.subsystems_of(Kind.VIRTUAL_EFFECTOR)]
+    assert joints == [Literal(1), Literal(2), Literal(3), Literal(4)]
+
+
+def test_an_empty_any_is_false_and_a_single_member_any_is_its_body() -> None:
+    text = """system s
+param N: int = 1
+a/a {
+    cs {
+        x[K in 1..N]/ib: boolean
+        one/pp = any(K in 1..N: x[K]/ib)
+        none/pp = any(K in 1..0: x[K]/ib)
+        every/pp = all(K in 2..1: x[K]/ib)
+    }
+}
+"""
+    expanded = expand(earl.loads(text))
+    cs = expanded.agents[0].control_subsystem
+    assert cs is not None
+    values = {p.name: p.expression for p in cs.primitive_predicates}
+    assert expression_text(values["one"]) == "x[1]/ib"
+    assert values["none"] == Literal(False)
+    assert values["every"] == Literal(True)
+
+
+def test_boolean_operations_keep_their_operands_in_order() -> None:
+    expression = BooleanOperation("and", (Not(Name("a")), Name("b")))
+    assert expression_text(expression) == "not a and b"
