@@ -35,6 +35,13 @@ def load(path: str | Path, parameters: Mapping[str, ParameterValue] | None = Non
     return load_file(path, parameters)
 
 
+def save(system: System, path: str | Path) -> None:
+    """Write `system` to `path` as canonical `.earl` text (the file is replaced atomically)."""
+    from earl.lang.loader import save as save_file
+
+    save_file(system, path)
+
+
 def loads(text: str, path: str = "<text>", parameters: Mapping[str, ParameterValue] | None = None) -> System:
     """Like `load`, for `.earl` text in memory; `path` names it in messages."""
     from earl.lang.loader import loads as load_text
@@ -44,4 +51,4 @@ def loads(text: str, path: str = "<text>", parameters: Mapping[str, ParameterVal
 
 __version__ = "0.1.0"
 
-__all__ = ["Diagnostic", "EarlError", "Severity", "load", "loads", "__version__", *_model_names]
+__all__ = ["Diagnostic", "EarlError", "Severity", "__version__", "load", "loads", "save", *_model_names]

@@ -5,13 +5,12 @@ from __future__ import annotations
 import argparse
 import difflib
 import sys
-from pathlib import Path
 from typing import Any
 
 from earl.cli.common import UsageError, spec_path, usage_error
 from earl.cli.output import print_diagnostics
 from earl.diagnostics import EarlError
-from earl.lang.loader import load
+from earl.lang.loader import parse_file, save
 
 
 def register(commands: Any) -> None:
@@ -38,7 +37,7 @@ def run(arguments: argparse.Namespace) -> int:
     status = 0
     for path in paths:
         try:
-            system = load(path)
+            system = parse_file(path)  # formatting needs the syntax only, so a library file works too
         except EarlError as error:
             print_diagnostics(error.diagnostics, error.sources)
             status = 1
@@ -51,7 +50,7 @@ def run(arguments: argparse.Namespace) -> int:
                 status = 1
         elif arguments.write:
             if original != canonical:
-                _write(path, canonical)
+                save(system, path)
                 sys.stderr.write(f"{path}: reformatted\n")
         elif arguments.diff:
             diff = difflib.unified_diff(
@@ -64,10 +63,3 @@ def run(arguments: argparse.Namespace) -> int:
         else:
             sys.stdout.write(canonical)
     return status
-
-
-def _write(path: Path, text: str) -> None:
-    """Replace the file atomically so an interrupted write never loses the spec."""
-    temporary = path.with_name(f".{path.name}.earl-fmt")
-    temporary.write_text(text, encoding="utf-8")
-    temporary.replace(path)

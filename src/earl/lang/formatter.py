@@ -92,7 +92,8 @@ def format_system(system: System) -> str:
     printer = _Printer()
     for comment in system.comments.leading:
         printer.line(0, comment)
-    printer.line(0, f"system {system.name}")
+    if system.name:
+        printer.line(0, f"system {system.name}")
     declared = system.order if _order_is_complete(system) else _default_order(system)
     for import_ in system.imports:
         printer.blank()

@@ -114,9 +114,13 @@ def load_files(path: Path, sources: SourceMap) -> tuple[ParsedFile, list[ParsedF
     return root, imported
 
 
-def merge(root: ParsedFile, imported: list[ParsedFile], sources: SourceMap) -> System:
-    """One System holding the declarations of all files; only the root's keep their order for printing."""
-    if root.system_name is None:
+def merge(root: ParsedFile, imported: list[ParsedFile], sources: SourceMap, library: bool = False) -> System:
+    """One System holding the declarations of all files; only the root's keep their order for printing.
+
+    With `library`, a file without a `system` line is accepted (an imported file); its
+    System has the empty name and prints without a header.
+    """
+    if root.system_name is None and not library:
         raise EarlError(
             [
                 Diagnostic(
@@ -129,7 +133,7 @@ def merge(root: ParsedFile, imported: list[ParsedFile], sources: SourceMap) -> S
             ],
             sources,
         )
-    system = System(root.system_name, location=root.system_location)
+    system = System(root.system_name or "", location=root.system_location)
     system.comments.leading = list(root.header_comments)
     system.comments.closing = list(root.closing_comments)
     for parsed in [*imported, root]:
@@ -168,6 +172,24 @@ def load(path: str | Path, parameters: Mapping[str, ParameterValue] | None = Non
         raise EarlError(errors, sources)
     system.sources = sources
     return system
+
+
+def parse_file(path: str | Path) -> System:
+    """One file read for its syntax only: no imports followed, no names resolved (what `earl fmt` needs)."""
+    sources = SourceMap()
+    root = read_file(Path(path), sources)
+    system = merge(root, [], sources, library=True)
+    system.source_file = root.path
+    system.sources = sources
+    return system
+
+
+def save(system: System, path: str | Path) -> None:
+    """Write the system as canonical `.earl` text, replacing the file atomically."""
+    target = Path(path)
+    temporary = target.with_name(f".{target.name}.tmp")
+    temporary.write_text(system.to_earl(), encoding="utf-8")
+    temporary.replace(target)
 
 
 def loads(text: str, path: str = "<text>", parameters: Mapping[str, ParameterValue] | None = None) -> System:

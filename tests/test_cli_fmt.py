@@ -1,0 +1,81 @@
+"""`earl fmt`: print, check and rewrite in canonical form; library files without `system` too."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+import earl
+from earl.cli.main import main
+
+MESSY = "system  demo\nparam N:int=2   // joints\nstruct S{a:int,b:double[N]?}\n"
+CANONICAL = "system demo\n\nparam N: int = 2  // joints\n\nstruct S {\n    a: int\n    b: double[N]?\n}\n"
+
+
+def test_fmt_prints_canonical_text(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    spec = tmp_path / "s.earl"
+    spec.write_text(MESSY)
+    assert main(["fmt", str(spec)]) == 0
+    assert capsys.readouterr().out == CANONICAL
+    assert spec.read_text() == MESSY  # printing never touches the file
+
+
+def test_fmt_check_fails_on_non_canonical_and_passes_on_canonical(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    messy = tmp_path / "messy.earl"
+    messy.write_text(MESSY)
+    tidy = tmp_path / "tidy.earl"
+    tidy.write_text(CANONICAL)
+    assert main(["fmt", "--check", str(messy)]) == 1
+    assert "not canonical" in capsys.readouterr().err
+    assert main(["fmt", "--check", str(tidy)]) == 0
+
+
+def test_fmt_write_rewrites_in_place_and_keeps_comments(tmp_path: Path) -> None:
+    spec = tmp_path / "s.earl"
+    spec.write_text(MESSY)
+    assert main(["fmt", "--write", str(spec)]) == 0
+    assert spec.read_text() == CANONICAL
+    assert main(["fmt", "--check", str(spec)]) == 0
+
+
+def test_fmt_diff_shows_the_change(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    spec = tmp_path / "s.earl"
+    spec.write_text(MESSY)
+    assert main(["fmt", "--diff", str(spec)]) == 0
+    out = capsys.readouterr().out
+    assert "-param N:int=2   // joints" in out
+    assert "+param N: int = 2  // joints" in out
+
+
+def test_fmt_formats_an_imported_library_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    library = tmp_path / "types.earl"
+    library.write_text("// shared types\nstruct A { x: int }\n")
+    assert main(["fmt", str(library)]) == 0
+    assert capsys.readouterr().out == "// shared types\nstruct A {\n    x: int\n}\n"
+
+
+def test_fmt_reports_a_syntax_error_with_exit_1_and_leaves_the_file(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    spec = tmp_path / "bad.earl"
+    spec.write_text("system demo\nparam N int = 2\n")
+    assert main(["fmt", "--write", str(spec)]) == 1
+    err = capsys.readouterr().err
+    assert "bad.earl:2:9" in err
+    assert spec.read_text() == "system demo\nparam N int = 2\n"
+
+
+def test_fmt_on_a_missing_file_is_a_usage_error(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["fmt", str(tmp_path / "nope.earl")]) == 2
+    assert "no such file" in capsys.readouterr().err
+
+
+def test_save_writes_canonical_text_that_loads_back(tmp_path: Path) -> None:
+    system = earl.loads(MESSY)
+    target = tmp_path / "saved.earl"
+    earl.save(system, target)
+    assert target.read_text() == CANONICAL
+    assert earl.load(target) == system
