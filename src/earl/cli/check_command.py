@@ -1,24 +1,32 @@
-"""`earl check SPEC`: read a specification and report every problem, pointing at the line."""
+"""`earl check SPEC`: every way a specification breaks the manual, pointing at the line."""
 
 from __future__ import annotations
 
 import argparse
-import json
 from typing import Any
 
+from rich.console import Console
+from rich.table import Table
+
+from earl.check import check, context_for
+from earl.check.report import as_json, as_sarif
 from earl.cli.common import UsageError, parse_parameter, spec_path, usage_error
 from earl.cli.output import print_diagnostics
-from earl.diagnostics import Diagnostic, EarlError
+from earl.diagnostics import Diagnostic, EarlError, Severity
 from earl.lang.loader import load
+from earl.model.elements import System
 
 
 def register(commands: Any) -> None:
     parser = commands.add_parser(
         "check",
         help="check a specification against the rules of the EARL manual",
-        description="Read SPEC (a .earl file, or a directory holding system.earl), resolve every name and "
-        "report each problem with its file, line and column. Reading a spec never runs code it names.",
-        epilog="exit codes: 0 valid, 1 invalid specification, 2 usage error",
+        description="Read SPEC (a .earl file, or a directory holding system.earl), resolve every name, apply "
+        "every rule of the EARL manual (docs/rules.md) and analyse each FSM for overlapping, dead and missing "
+        "transition conditions. Each problem is reported with its file, line and column. Reading a spec never "
+        "runs code it names.",
+        epilog="exit codes: 0 valid (warnings and notes allowed; see --strict), 1 errors found, 2 usage error",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("spec", metavar="SPEC", help="the .earl file, or a directory with a system.earl")
     parser.add_argument(
@@ -29,30 +37,42 @@ def register(commands: Any) -> None:
         help="set a system parameter, e.g. --param N=3 (repeatable)",
     )
     parser.add_argument(
-        "--format", choices=["human", "json"], default="human", help="how to print problems (default: human)"
+        "--format",
+        choices=["human", "json", "sarif"],
+        default="human",
+        help="human (default): grouped by file with the source line; json: a list of objects; sarif: SARIF 2.1.0",
     )
-    parser.add_argument("--verbose", "-v", action="store_true", help="also summarise what the spec contains")
+    parser.add_argument("--strict", action="store_true", help="fail (exit 1) on warnings too")
+    parser.add_argument(
+        "--verbose", "-v", action="store_true", help="also list every agent with its Table 1 type and subsystems"
+    )
     parser.set_defaults(run=run)
 
 
-def _json(diagnostics: list[Diagnostic]) -> str:
-    return json.dumps(
-        [
-            {
-                "code": d.code,
-                "severity": d.severity.value,
-                "message": d.message,
-                "hint": d.hint,
-                "file": d.location.file if d.location else None,
-                "line": d.location.line if d.location else None,
-                "column": d.location.column if d.location else None,
-                "end_line": d.location.end_line if d.location else None,
-                "end_column": d.location.end_column if d.location else None,
-            }
-            for d in diagnostics
-        ],
-        indent=2,
-    )
+def _print(diagnostics: list[Diagnostic], arguments: argparse.Namespace, sources: Any) -> None:
+    if arguments.format == "json":
+        print(as_json(diagnostics))
+    elif arguments.format == "sarif":
+        print(as_sarif(diagnostics))
+    else:
+        shown = diagnostics if arguments.verbose else [d for d in diagnostics if d.severity is not Severity.NOTE]
+        print_diagnostics(shown, sources)
+
+
+def _summary(system: System, parameters: dict[str, Any]) -> None:
+    context = context_for(system, parameters)
+    table = Table(title=f"system {system.name}", title_justify="left")
+    table.add_column("agent")
+    table.add_column("type (Table 1)")
+    table.add_column("subsystems")
+    for agent in context.system.agents:
+        row = context.agent_type(agent)
+        counts: dict[str, int] = {}
+        for subsystem in agent.subsystems:
+            counts[subsystem.kind.value] = counts.get(subsystem.kind.value, 0) + 1
+        name = agent.name if agent.index is None else f"{agent.name}[{agent.index}]"
+        table.add_row(f"{name}/a", f"{row.name} — {row.description}", ", ".join(f"{n} {k}" for k, n in counts.items()))
+    Console(highlight=False).print(table)
 
 
 def run(arguments: argparse.Namespace) -> int:
@@ -64,19 +84,23 @@ def run(arguments: argparse.Namespace) -> int:
     try:
         system = load(path, parameters)
     except EarlError as error:
-        if arguments.format == "json":
-            print(_json(error.diagnostics))
-        else:
-            print_diagnostics(error.diagnostics, error.sources)
+        _print(error.diagnostics, arguments, error.sources)
         return 1
-    if arguments.format == "json":
-        print(_json([]))
-        return 0
-    agents = len(system.agents)
-    subsystems = sum(len(a.subsystems) for a in system.agents)
-    print(f"{path}: ok — system `{system.name}`, {agents} agent(s), {subsystems} subsystem declaration(s)")
-    if arguments.verbose:
-        for agent in system.agents:
-            kinds = ", ".join(("cs" if s.kind.value == "cs" else f"{s.name}/{s.kind.value}") for s in agent.subsystems)
-            print(f"  {agent.name}/a: {kinds}")
-    return 0
+    diagnostics = check(system, parameters)
+    errors = sum(1 for d in diagnostics if d.severity is Severity.ERROR)
+    warnings = sum(1 for d in diagnostics if d.severity is Severity.WARNING)
+    _print(diagnostics, arguments, system.sources)
+    failed = errors > 0 or (arguments.strict and warnings > 0)
+    if arguments.format == "human":
+        if arguments.verbose:
+            _summary(system, parameters)
+        if not failed:
+            notes = len(diagnostics) - errors - warnings
+            parts = [f"{warnings} warning{'s' if warnings != 1 else ''}"] if warnings else []
+            if notes:
+                parts.append(
+                    f"{notes} note{'s' if notes != 1 else ''}{'' if arguments.verbose else ', shown with --verbose'}"
+                )
+            extra = f" ({'; '.join(parts)})" if parts else ""
+            print(f"{path}: ok — system `{system.name}` follows the rules of the EARL manual{extra}")
+    return 1 if failed else 0

@@ -1,0 +1,159 @@
+"""The type of an expression, to tell whether a predicate really is Boolean (manual §2.2)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from earl.check.context import CheckContext
+from earl.model.elements import InputBuffer, Memory, Subsystem
+from earl.model.expressions import (
+    Arithmetic,
+    BooleanOperation,
+    Call,
+    Comparison,
+    Expression,
+    FieldAccess,
+    ListLiteral,
+    Literal,
+    Name,
+    Negate,
+    Not,
+    Quantifier,
+    Read,
+)
+from earl.model.kinds import Kind
+from earl.model.location import SourceLocation
+from earl.model.text import expression_text
+from earl.model.types import ArrayType, PrimitiveType, StructType
+
+BOOLEAN = "boolean"
+NUMBER = "number"
+STRING = "string"
+OTHER = "other"  # a struct, an array or bytes: only comparable for equality
+UNKNOWN = "unknown"  # the resolver reported the problem already
+
+_NUMERIC = {
+    "int8",
+    "int16",
+    "int32",
+    "int64",
+    "uint8",
+    "uint16",
+    "uint32",
+    "uint64",
+    "int",
+    "float32",
+    "float64",
+    "double",
+}
+
+
+@dataclass
+class TypeProblem:
+    message: str
+    location: SourceLocation | None
+
+
+class ExpressionTyper:
+    """Infers `boolean`, `number`, `string` or `other` bottom-up and records misuse."""
+
+    def __init__(self, context: CheckContext, subsystem: Subsystem) -> None:
+        self.context = context
+        self.subsystem = subsystem
+        self.problems: list[TypeProblem] = []
+
+    def type_of(self, expression: Expression) -> str:
+        if isinstance(expression, Literal):
+            value = expression.value
+            if isinstance(value, bool):
+                return BOOLEAN
+            return STRING if isinstance(value, str) else NUMBER
+        if isinstance(expression, ListLiteral):
+            return OTHER
+        if isinstance(expression, Name):
+            return UNKNOWN
+        if isinstance(expression, Read):
+            return self._read(expression)
+        if isinstance(expression, Call):
+            return BOOLEAN
+        if isinstance(expression, Quantifier):
+            self._expect(expression.body, BOOLEAN, f"the body of `{expression.quantifier}(…)`")
+            return BOOLEAN
+        if isinstance(expression, Not):
+            self._expect(expression.operand, BOOLEAN, "the operand of `not`")
+            return BOOLEAN
+        if isinstance(expression, BooleanOperation):
+            for operand in expression.operands:
+                self._expect(operand, BOOLEAN, f"an operand of `{expression.operator}`")
+            return BOOLEAN
+        if isinstance(expression, Negate):
+            self._expect(expression.operand, NUMBER, "the operand of `-`")
+            return NUMBER
+        if isinstance(expression, Arithmetic):
+            self._expect(expression.left, NUMBER, f"the left operand of `{expression.operator}`")
+            self._expect(expression.right, NUMBER, f"the right operand of `{expression.operator}`")
+            return NUMBER
+        if isinstance(expression, Comparison):
+            left, right = self.type_of(expression.left), self.type_of(expression.right)
+            if UNKNOWN not in (left, right):
+                if expression.operator in ("==", "!="):
+                    if left != right:
+                        self.problems.append(
+                            TypeProblem(
+                                f"`{expression_text(expression)}` compares a {left} with a {right}",
+                                expression.location,
+                            )
+                        )
+                elif left != NUMBER or right != NUMBER:
+                    self.problems.append(
+                        TypeProblem(
+                            f"`{expression.operator}` orders numbers, but `{expression_text(expression)}` compares a {left} with a {right}",
+                            expression.location,
+                        )
+                    )
+            return BOOLEAN
+        return UNKNOWN
+
+    def _expect(self, expression: Expression, expected: str, role: str) -> None:
+        actual = self.type_of(expression)
+        if actual not in (expected, UNKNOWN):
+            self.problems.append(
+                TypeProblem(
+                    f"{role} must be a {expected}, but `{expression_text(expression)}` is a {actual}",
+                    expression.location,
+                )
+            )
+
+    def _read(self, read: Read) -> str:
+        target = read.target
+        if target.kind is Kind.PRIMITIVE_PREDICATE:
+            return BOOLEAN
+        element: InputBuffer | Memory | None
+        if target.kind is Kind.INPUT_BUFFER:
+            element = self.context.input_buffer(self.subsystem, target)
+        else:
+            element = self.context.memory(self.subsystem, target)
+        if element is None:
+            return UNKNOWN
+        current = self.context.structural(element.data_type)
+        for accessor in read.path:
+            if isinstance(accessor, FieldAccess) and isinstance(current, StructType):
+                field = current.field_named(accessor.name)
+                if field is None:
+                    return UNKNOWN
+                current = self.context.structural(field.data_type)
+            elif not isinstance(accessor, FieldAccess) and isinstance(current, ArrayType):
+                current = self.context.structural(current.element)
+            else:
+                return UNKNOWN
+        if isinstance(current, PrimitiveType):
+            if current.name == "boolean":
+                return BOOLEAN
+            if current.name in _NUMERIC:
+                return NUMBER
+            if current.name == "string":
+                return STRING
+        return OTHER
+
+
+__all__ = ["BOOLEAN", "ExpressionTyper", "TypeProblem"]

@@ -1,0 +1,265 @@
+"""Rules on predicates, partial transition functions and transition functions (manual §2.2, §3, Eq. 4–8)."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Iterator
+
+from earl.check.context import CheckContext, instance_name, reference_key, subsystem_name
+from earl.check.expression_types import BOOLEAN, ExpressionTyper
+from earl.check.registry import Finding, rule
+from earl.diagnostics import Severity
+from earl.model.elements import BasicBehaviour, Subsystem
+from earl.model.expressions import ElementReference, Expression, reads
+from earl.model.kinds import Kind
+from earl.model.location import SourceLocation
+from earl.model.text import expression_text, reference_text
+
+
+def _conditions(subsystem: Subsystem) -> Iterator[tuple[str, Expression, SourceLocation | None]]:
+    """Every Boolean formula of a subsystem, with what it is called in messages."""
+    for predicate in subsystem.primitive_predicates:
+        yield f"primitive predicate `{predicate.name}/pp`", predicate.expression, predicate.location
+    for behaviour in subsystem.basic_behaviours:
+        yield (
+            f"the terminal condition of `{behaviour.name}/bb`",
+            behaviour.terminal_condition.expression,
+            behaviour.terminal_condition.location,
+        )
+        if behaviour.error_condition is not None:
+            yield (
+                f"the error condition of `{behaviour.name}/bb`",
+                behaviour.error_condition.expression,
+                behaviour.error_condition.location,
+            )
+    if subsystem.fsm is not None:
+        for transition in subsystem.fsm.transitions:
+            yield (
+                f"the initial condition of `{transition.name}/t`",
+                transition.condition.expression,
+                transition.condition.location,
+            )
+        for assumption in subsystem.fsm.assumptions:
+            yield "an assumption", assumption.expression, assumption.location
+
+
+def _once(findings: Iterable[Finding]) -> Iterator[Finding]:
+    """Family members share declarations: report each problem once."""
+    seen: set[tuple[str, SourceLocation | None]] = set()
+    for finding in findings:
+        if (finding.message, finding.location) not in seen:
+            seen.add((finding.message, finding.location))
+            yield finding
+
+
+@rule("EARL-E030", Severity.ERROR, "predicates are Boolean", "§2.2, Table 4, Table 5")
+def predicates_are_boolean(context: CheckContext) -> Iterator[Finding]:
+    """Primitive predicates, terminal, error and initial conditions, and assumptions produce a Boolean
+    (`fun` returns true or false), and their operators are applied to operands of the right type."""
+
+    def findings() -> Iterator[Finding]:
+        for _agent, subsystem in context.subsystems():
+            typer = ExpressionTyper(context, subsystem)
+            for role, expression, location in _conditions(subsystem):
+                kind = typer.type_of(expression)
+                if kind not in (BOOLEAN, "unknown"):
+                    yield Finding(
+                        f"{role} is a {kind}, not a Boolean: `{expression_text(expression)}`",
+                        expression.location or location,
+                        "compare it, e.g. `x > 0.5`, or test it with `newData(…)`",
+                    )
+            for problem in typer.problems:
+                yield Finding(problem.message, problem.location)
+
+    yield from _once(findings())
+
+
+@rule("EARL-W030", Severity.WARNING, "every primitive predicate is used", "§2.2, Table 4")
+def unused_primitive_predicates(context: CheckContext) -> Iterator[Finding]:
+    """A primitive predicate no condition uses is dead specification: remove it, or use it."""
+    for agent in context.declared.agents:
+        for subsystem in agent.subsystems:
+            used: set[str] = set()
+            for _role, expression, _location in _conditions(subsystem):
+                used.update(r.target.name for r in reads(expression) if r.target.kind is Kind.PRIMITIVE_PREDICATE)
+            for predicate in subsystem.primitive_predicates:
+                if predicate.name not in used:
+                    yield Finding(
+                        f"primitive predicate `{predicate.name}/pp` is never used",
+                        predicate.location,
+                        "use it in a terminal, error or initial condition, or remove it",
+                    )
+
+
+def _writes(
+    subsystem: Subsystem, behaviour: BasicBehaviour
+) -> list[list[tuple[str, ElementReference, ElementReference]]]:
+    """Per stage: (function name, function reference, written element) for every declared write."""
+    stages = []
+    for stage in behaviour.transition_function.stages:
+        entries = []
+        for function_reference in stage:
+            function = subsystem.partial_transition_function(function_reference.name)
+            if function is None:
+                continue
+            entries += [(function.name, function_reference, written) for written in function.writes]
+        stages.append(entries)
+    return stages
+
+
+@rule("EARL-E040", Severity.ERROR, "only the last stage writes output buffers", "Eq. (4), Eq. (6)")
+def output_buffers_in_last_stage(context: CheckContext) -> Iterator[Finding]:
+    """The first-stage functions (`pf`, Eq. 4) write only Internal Memory (`mo`, Eq. 5); the Output Buffers
+    are produced by the second stage (`pfo`, Eq. 6), after all memory is computed."""
+
+    def findings() -> Iterator[Finding]:
+        for agent, subsystem in context.subsystems():
+            for behaviour in subsystem.basic_behaviours:
+                stages = behaviour.transition_function.stages
+                for number, stage in enumerate(stages, start=1):
+                    last = number == len(stages) and len(stages) > 1
+                    for function_reference in stage:
+                        function = subsystem.partial_transition_function(function_reference.name)
+                        if function is None:
+                            continue
+                        if not last:
+                            for written in function.writes:
+                                if written.kind is Kind.OUTPUT_BUFFER:
+                                    yield Finding(
+                                        f"`{function.name}/pf` writes `{written.name}/ob` in stage {number} of `{behaviour.name}/bb` in `{subsystem_name(agent, subsystem)}`",
+                                        function_reference.location,
+                                        "Eq. (4)–(6): a first-stage function writes memory (`/mo`); move the output to a second stage (`then { … }`)",
+                                    )
+                        else:
+                            for element in [*function.reads, *function.writes]:
+                                if element.kind in (Kind.INPUT_BUFFER, Kind.MEMORY_OUTPUT):
+                                    what = "reads" if element.kind is Kind.INPUT_BUFFER else "writes"
+                                    yield Finding(
+                                        f"`{function.name}/pf` {what} `{reference_text(element)}` in the last stage of `{behaviour.name}/bb`",
+                                        function_reference.location,
+                                        "Eq. (6): a second-stage function reads memory (`/mi`) and writes output buffers (`/ob`) only",
+                                    )
+
+    yield from _once(findings())
+
+
+@rule("EARL-E041", Severity.ERROR, "transition-function stages follow the declared stage sets", "Eq. (4), Eq. (6)")
+def stages_follow_stage_sets(context: CheckContext) -> Iterator[Finding]:
+    """When a subsystem declares its stage sets (`stage pf = {…}` for Eq. 4, `stage pfo = {…}` for Eq. 6),
+    the i-th stage of every transition function takes its functions from the i-th set."""
+    for agent in context.declared.agents:
+        for subsystem in agent.subsystems:
+            if not subsystem.stage_sets:
+                continue
+            for behaviour in subsystem.basic_behaviours:
+                stages = behaviour.transition_function.stages
+                if len(stages) > len(subsystem.stage_sets):
+                    yield Finding(
+                        f"`{behaviour.name}/bb` has {len(stages)} stages but `{subsystem.name}` declares {len(subsystem.stage_sets)} stage sets",
+                        behaviour.transition_function.location,
+                    )
+                    continue
+                for stage, stage_set in zip(stages, subsystem.stage_sets, strict=False):
+                    members = {f.name for f in stage_set.functions}
+                    for function in stage:
+                        if function.name not in members:
+                            yield Finding(
+                                f"`{function.name}/pf` is in a stage of `{behaviour.name}/bb` that takes its functions from `{stage_set.name}`, which does not contain it",
+                                function.location,
+                                f"add it to `stage {stage_set.name}`, or move it to the stage it belongs to",
+                            )
+
+
+@rule("EARL-E042", Severity.ERROR, "no two functions of one stage write the same element", "Eq. (7), Eq. (8)")
+def one_writer_per_stage(context: CheckContext) -> Iterator[Finding]:
+    """Within one stage of one behaviour's transition function the functions run as if in parallel, so no
+    two of them may produce the same Internal Memory (Eq. 7) or Output Buffer (Eq. 8)."""
+
+    def findings() -> Iterator[Finding]:
+        for agent, subsystem in context.subsystems():
+            for behaviour in subsystem.basic_behaviours:
+                for number, stage in enumerate(_writes(subsystem, behaviour), start=1):
+                    writer: dict[str, str] = {}
+                    for function, function_reference, written in stage:
+                        key = f"{reference_key(written)}/{'m' if written.kind is Kind.MEMORY_OUTPUT else written.kind.value}"
+                        if key in writer and writer[key] != function:
+                            yield Finding(
+                                f"`{writer[key]}/pf` and `{function}/pf` both write `{key}` in stage {number} of `{behaviour.name}/bb` ({subsystem_name(agent, subsystem)})",
+                                function_reference.location,
+                                "functions of one stage run in parallel: let one of them write it, or put them in different stages",
+                            )
+                        writer.setdefault(key, function)
+
+    yield from _once(findings())
+
+
+@rule("EARL-W040", Severity.WARNING, "every output buffer is written by some behaviour", "§2.2, Figure 5b")
+def output_buffers_written(context: CheckContext) -> Iterator[Finding]:
+    """`tf.pf.ob.send()` sends the Output Buffers the transition function computed; one that no function of
+    any behaviour writes is never sent, and whatever it is linked to never receives data."""
+    for agent in context.declared.agents:
+        for subsystem in agent.subsystems:
+            used = {f.name for b in subsystem.basic_behaviours for stage in b.transition_function.stages for f in stage}
+            written = {
+                w.name
+                for f in subsystem.partial_transition_functions
+                if f.name in used
+                for w in f.writes
+                if w.kind is Kind.OUTPUT_BUFFER
+            }
+            for buffer in subsystem.output_buffers:
+                if buffer.name not in written:
+                    yield Finding(
+                        f"output buffer `{buffer.name}/ob` is never written by a function of any behaviour, so it is never sent",
+                        buffer.location,
+                        f"add `{buffer.name}/ob` to the writes of a second-stage function",
+                    )
+
+
+@rule("EARL-W041", Severity.WARNING, "memory is written or initialised before it is read", "§2.2, Table 3")
+def memory_read_before_written(context: CheckContext) -> Iterator[Finding]:
+    """In the first iteration of the initial state's behaviour, memory without an initial value that a
+    function reads before an earlier stage wrote it holds only its type's zero value."""
+
+    def findings() -> Iterator[Finding]:
+        for agent, subsystem in context.subsystems():
+            if subsystem.fsm is None:
+                continue
+            state = subsystem.fsm.state_named(subsystem.fsm.initial)
+            behaviour = subsystem.basic_behaviour(state.behaviour) if state else None
+            if behaviour is None:
+                continue
+            initialised = {instance_name(m.name, m.index) for m in subsystem.memories if m.initial_value is not None}
+            written: set[str] = set()
+            for stage in behaviour.transition_function.stages:
+                stage_writes: set[str] = set()
+                for function_reference in stage:
+                    function = subsystem.partial_transition_function(function_reference.name)
+                    if function is None:
+                        continue
+                    for element in function.reads:
+                        key = reference_key(element)
+                        if element.kind is Kind.MEMORY_INPUT and key not in initialised and key not in written:
+                            yield Finding(
+                                f"`{function.name}/pf` reads `{key}/mi` in the first iteration of `{behaviour.name}/bb` (the initial state of {subsystem_name(agent, subsystem)}) before anything wrote it",
+                                function_reference.location,
+                                f"give `{element.name}/m` an initial value, or write it in an earlier stage",
+                            )
+                    stage_writes.update(reference_key(w) for w in function.writes if w.kind is Kind.MEMORY_OUTPUT)
+                written |= stage_writes
+
+    yield from _once(findings())
+
+
+@rule("EARL-W042", Severity.WARNING, "every partial transition function is used", "§2.2, Table 6")
+def unused_functions(context: CheckContext) -> Iterator[Finding]:
+    """A partial transition function that no behaviour's transition function composes never runs."""
+    for agent in context.declared.agents:
+        for subsystem in agent.subsystems:
+            used = {f.name for b in subsystem.basic_behaviours for stage in b.transition_function.stages for f in stage}
+            for function in subsystem.partial_transition_functions:
+                if function.name not in used:
+                    yield Finding(
+                        f"partial transition function `{function.name}/pf` is not used by any behaviour",
+                        function.location,
+                        "compose it into a `tf`, or remove it",
+                    )

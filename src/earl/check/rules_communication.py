@@ -1,0 +1,168 @@
+"""Rules on links (manual §2.3, Figure 7; the permitted-link table is `earl.model.tables`)."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+from earl.check.context import CheckContext, ResolvedLink, instance_name, subsystem_name
+from earl.check.registry import Finding, rule
+from earl.diagnostics import Severity
+from earl.model.kinds import KIND_TITLES, Kind
+from earl.model.tables import PERMITTED_LINKS, permitted_link
+from earl.model.types import type_text
+
+
+@rule("EARL-E010", Severity.ERROR, "a link connects buffers of the same data type", "§2.2, §2.3")
+def link_types_match(context: CheckContext) -> Iterator[Finding]:
+    """A link carries the message of its Output Buffer into its Input Buffer, so both hold the same dataType."""
+    for link in context.links:
+        if not context.same_type(link.source_buffer.data_type, link.destination_buffer.data_type):
+            yield Finding(
+                f"link `{link.link.name_text}` sends `{type_text(link.source_buffer.data_type)}` into an Input Buffer of type `{type_text(link.destination_buffer.data_type)}`",
+                link.link.location,
+                "give both buffers the same data type",
+            )
+
+
+@rule("EARL-E011", Severity.ERROR, "an Input Buffer is fed by at most one link", "§2.3")
+def one_link_per_input(context: CheckContext) -> Iterator[Finding]:
+    """Each Input Buffer receives from at most one Output Buffer; two links into one buffer would overwrite
+    each other's messages unpredictably."""
+    for links in context.links_into.values():
+        if len(links) > 1:
+            first, second = links[0], links[1]
+            buffer = instance_name(first.destination_buffer.name, first.destination_buffer.index)
+            yield Finding(
+                f"`{subsystem_name(first.destination_agent, first.destination_subsystem)}.{buffer}/ib` is fed by link `{first.link.name_text}` and by link `{second.link.name_text}`",
+                second.link.location,
+                "give the destination one Input Buffer per incoming link",
+            )
+
+
+@rule("EARL-E012", Severity.ERROR, "only permitted pairs of subsystems are linked", "§2.3, Figure 7")
+def permitted_pairs(context: CheckContext) -> Iterator[Finding]:
+    """Links follow the permitted-link table (Figure 7): the compulsory chains cs → ve → re and rr → vr → cs,
+    the optional ve → cs, re → ve, cs → vr, vr → rr inside one agent, and cs → cs between two agents."""
+    for link in context.links:
+        source, destination = link.source_subsystem.kind, link.destination_subsystem.kind
+        if link.between_agents and link.source_agent is link.destination_agent:
+            continue  # reported by EARL-E013
+        if permitted_link(source, destination, link.between_agents) is None:
+            allowed = ", ".join(
+                f"{row.source.value} → {row.destination.value}"
+                for row in PERMITTED_LINKS
+                if row.between_agents == link.between_agents
+            )
+            where = "between agents" if link.between_agents else "inside an agent"
+            yield Finding(
+                f"a link from a {KIND_TITLES[source]} to a {KIND_TITLES[destination]} is not permitted {where} (link `{link.link.name_text}`)",
+                link.link.location,
+                f"permitted {where}: {allowed}",
+            )
+
+
+@rule("EARL-E013", Severity.ERROR, "agents communicate only through their Control Subsystems", "§2.3, Figure 7")
+def inter_agent_links_between_control_subsystems(context: CheckContext) -> Iterator[Finding]:
+    """Inter-agent communication happens only between the Control Subsystems of two different agents."""
+    for link in context.links:
+        if not link.between_agents:
+            continue
+        if link.source_agent is link.destination_agent:
+            yield Finding(
+                f"link `{link.link.name_text}` starts and ends in `{instance_name(link.source_agent.name, link.source_agent.index)}/a`",
+                link.link.location,
+                "declare links between the subsystems of one agent inside that agent",
+            )
+            continue
+        for subsystem, agent in (
+            (link.source_subsystem, link.source_agent),
+            (link.destination_subsystem, link.destination_agent),
+        ):
+            if subsystem.kind is not Kind.CONTROL_SUBSYSTEM:
+                yield Finding(
+                    f"inter-agent link `{link.link.name_text}` ends at `{subsystem_name(agent, subsystem)}`, not at a Control Subsystem",
+                    link.link.location,
+                    "agents exchange messages only through their `cs`",
+                )
+
+
+def _chain(context: CheckContext, middle: Kind, real: Kind, towards_real: bool) -> Iterator[Finding]:
+    """Real subsystems of kind `real` not on cs → middle → real (or real → middle → cs)."""
+    inside: dict[int, list[ResolvedLink]] = {}
+    for link in context.links:
+        if not link.between_agents:
+            inside.setdefault(id(link.source_agent), []).append(link)
+    chain = f"cs → {middle.value} → {real.value}" if towards_real else f"{real.value} → {middle.value} → cs"
+    for agent, subsystem in context.subsystems():
+        if subsystem.kind is not real:
+            continue
+        links = inside.get(id(agent), [])
+        if towards_real:
+            commanded = {
+                id(link.destination_subsystem) for link in links if link.source_subsystem.kind is Kind.CONTROL_SUBSYSTEM
+            }
+            complete = any(
+                link.destination_subsystem is subsystem
+                and link.source_subsystem.kind is middle
+                and id(link.source_subsystem) in commanded
+                for link in links
+            )
+        else:
+            reporting = {
+                id(link.source_subsystem) for link in links if link.destination_subsystem.kind is Kind.CONTROL_SUBSYSTEM
+            }
+            complete = any(
+                link.source_subsystem is subsystem
+                and link.destination_subsystem.kind is middle
+                and id(link.destination_subsystem) in reporting
+                for link in links
+            )
+        if not complete:
+            yield Finding(
+                f"`{subsystem_name(agent, subsystem)}` is not on a chain {chain}",
+                subsystem.location,
+                f"§2.3: every {KIND_TITLES[real]} needs the chain {chain}; link the missing step",
+            )
+
+
+@rule("EARL-E014", Severity.ERROR, "every Real Effector is commanded through cs → ve → re", "§2.3, Figure 7")
+def effector_chain(context: CheckContext) -> Iterator[Finding]:
+    """The commands produced by the Control Subsystem, transformed by a Virtual Effector, must reach every
+    Real Effector."""
+    yield from _dedupe(_chain(context, Kind.VIRTUAL_EFFECTOR, Kind.REAL_EFFECTOR, towards_real=True))
+
+
+@rule("EARL-E015", Severity.ERROR, "every Real Receptor reports through rr → vr → cs", "§2.3, Figure 7")
+def receptor_chain(context: CheckContext) -> Iterator[Finding]:
+    """The data of every Real Receptor passes through a Virtual Receptor to the Control Subsystem."""
+    yield from _dedupe(_chain(context, Kind.VIRTUAL_RECEPTOR, Kind.REAL_RECEPTOR, towards_real=False))
+
+
+def _dedupe(findings: Iterator[Finding]) -> Iterator[Finding]:
+    """Members of one family share a declaration: report each declaration once."""
+    seen: set[tuple[str, object]] = set()
+    for finding in findings:
+        key = (finding.message.split("`")[0], finding.location)
+        if key not in seen:
+            seen.add(key)
+            yield finding
+
+
+@rule("EARL-W010", Severity.WARNING, "link names join source and destination", "§2.1, §2.5")
+def link_names(context: CheckContext) -> Iterator[Finding]:
+    """Good practice (§2.5): a link is named by its source, a comma, and its destination — agent names for
+    inter-agent links (`task,manip`), subsystem names inside an agent."""
+    reported: set[int] = set()
+    for link in context.links:
+        parts = [part.name for part in link.link.name]
+        if link.between_agents:
+            expected = [link.source_agent.name, link.destination_agent.name]
+        else:
+            expected = [link.source_subsystem.name, link.destination_subsystem.name]
+        if parts != expected and id(link.link.location) not in reported:
+            reported.add(id(link.link.location))
+            yield Finding(
+                f"link `{link.link.name_text}` is not named after its ends; §2.5 suggests `{expected[0]},{expected[1]}`",
+                link.link.location,
+                None,
+            )

@@ -1,0 +1,150 @@
+"""Rules on the parts of a system (manual §2.1, §2.2 Figure 4b, §2.4 Table 1)."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+from earl.check.context import CheckContext, instance_name
+from earl.check.registry import Finding, rule
+from earl.diagnostics import Severity
+from earl.model.kinds import KIND_TITLES, Kind
+
+
+@rule("EARL-E001", Severity.ERROR, "a System contains at least one Robot", "§2.1, Figure 2")
+def system_has_a_robot(context: CheckContext) -> Iterator[Finding]:
+    """A System must contain at least one Robot; agents outside any robot (a coordinator) are
+    allowed in addition."""
+    if not context.declared.robots:
+        yield Finding(
+            f"system `{context.declared.name}` has no Robot",
+            context.declared.location,
+            "group the agents of a robot with `myRobot/r { someAgent/a … }`",
+        )
+
+
+@rule("EARL-E002", Severity.ERROR, "a Robot contains at least one Agent", "§2.1, Figure 2")
+def robot_has_an_agent(context: CheckContext) -> Iterator[Finding]:
+    """A Robot is composed of at least one Agent."""
+    for robot in context.declared.robots:
+        if not robot.agents:
+            yield Finding(f"robot `{robot.name}/r` contains no Agent", robot.location, "list its agents: `manip/a`")
+
+
+@rule("EARL-E003", Severity.ERROR, "an Agent belongs to at most one Robot", "§2.1, Figure 2")
+def agent_in_one_robot(context: CheckContext) -> Iterator[Finding]:
+    """An Agent is a part of at most one Robot (it may belong to none, e.g. a coordinator of several robots)."""
+    owner: dict[str, str] = {}
+    for robot in context.system.robots:
+        for reference in robot.agents:
+            agent = context.agent(reference)
+            if agent is None:
+                continue
+            name = instance_name(agent.name, agent.index)
+            if name in owner and owner[name] != robot.name:
+                yield Finding(
+                    f"agent `{name}/a` belongs to robot `{owner[name]}/r` and to robot `{robot.name}/r`",
+                    reference.location,
+                    "an agent is a part of at most one robot",
+                )
+            owner.setdefault(name, robot.name)
+
+
+@rule("EARL-E004", Severity.ERROR, "a Robot refers only to links between its own Agents", "§2.1, Figure 2")
+def robot_links_connect_its_agents(context: CheckContext) -> Iterator[Finding]:
+    """Each inter-agent link a Robot refers to connects two of that Robot's own Agents."""
+    links = {link.link.name_text: link for link in context.links if link.between_agents}
+    for robot in context.system.robots:
+        members = {id(context.agent(reference)) for reference in robot.agents}
+        for reference in robot.links:
+            link = links.get(reference.name)
+            if link is None:
+                continue
+            outside = [a for a in (link.source_agent, link.destination_agent) if id(a) not in members]
+            if outside:
+                yield Finding(
+                    f"robot `{robot.name}/r` refers to link `{reference.name}`, but `{instance_name(outside[0].name, outside[0].index)}/a` is not one of its agents",
+                    reference.location,
+                    "add the agent to the robot, or drop the link from it",
+                )
+
+
+@rule("EARL-E005", Severity.ERROR, "an Agent has exactly one Control Subsystem", "§2.1, Table 1")
+def one_control_subsystem(context: CheckContext) -> Iterator[Finding]:
+    """The Control Subsystem `cs` is indispensable: it coordinates the agent's subsystems and is the only
+    one that talks to other agents."""
+    for agent in context.declared.agents:
+        if not agent.control_subsystems:
+            yield Finding(f"agent `{agent.name}/a` has no Control Subsystem", agent.location, "add `cs { … }`")
+
+
+def _pairs(context: CheckContext, virtual: Kind, real: Kind) -> Iterator[Finding]:
+    for agent in context.declared.agents:
+        has_virtual = bool(agent.subsystems_of(virtual))
+        has_real = bool(agent.subsystems_of(real))
+        if has_virtual != has_real:
+            present, missing = (virtual, real) if has_virtual else (real, virtual)
+            yield Finding(
+                f"agent `{agent.name}/a` has a {KIND_TITLES[present]} but no {KIND_TITLES[missing]}",
+                agent.location,
+                f"Equation (1): |{virtual.value}| ≥ 1 ⇔ |{real.value}| ≥ 1; add a `/{missing.value}` or remove the `/{present.value}`",
+            )
+
+
+@rule("EARL-E006", Severity.ERROR, "Virtual and Real Effectors come together", "Equation (1)")
+def effectors_in_pairs(context: CheckContext) -> Iterator[Finding]:
+    """|ve| ≥ 1 ⇔ |re| ≥ 1: a real effector cannot exist without a virtual one supervising it, and vice versa."""
+    yield from _pairs(context, Kind.VIRTUAL_EFFECTOR, Kind.REAL_EFFECTOR)
+
+
+@rule("EARL-E007", Severity.ERROR, "Virtual and Real Receptors come together", "Equation (1)")
+def receptors_in_pairs(context: CheckContext) -> Iterator[Finding]:
+    """|vr| ≥ 1 ⇔ |rr| ≥ 1: a real receptor cannot exist without a virtual one aggregating its data, and vice versa."""
+    yield from _pairs(context, Kind.VIRTUAL_RECEPTOR, Kind.REAL_RECEPTOR)
+
+
+#: Figure 4b: the buffers each kind of subsystem needs at the least.
+_REQUIRED_BUFFERS: dict[Kind, tuple[bool, bool]] = {
+    Kind.VIRTUAL_EFFECTOR: (True, True),
+    Kind.VIRTUAL_RECEPTOR: (True, True),
+    Kind.REAL_EFFECTOR: (True, False),
+    Kind.REAL_RECEPTOR: (False, True),
+}
+
+
+@rule("EARL-E008", Severity.ERROR, "subsystems have the buffers their role needs", "§2.2, Figure 4b")
+def required_buffers(context: CheckContext) -> Iterator[Finding]:
+    """Every Virtual Effector and Virtual Receptor has at least one Input and one Output Buffer; a Real
+    Effector at least one Input Buffer to receive commands; a Real Receptor at least one Output Buffer
+    to send sensory data."""
+    for agent in context.declared.agents:
+        for subsystem in agent.subsystems:
+            needs_input, needs_output = _REQUIRED_BUFFERS.get(subsystem.kind, (False, False))
+            name = f"{agent.name}/a.{subsystem.name}/{subsystem.kind.value}"
+            if needs_input and not subsystem.input_buffers:
+                yield Finding(
+                    f"{KIND_TITLES[subsystem.kind]} `{name}` has no Input Buffer",
+                    subsystem.location,
+                    "Figure 4b: it receives commands or data through at least one `/ib`",
+                )
+            if needs_output and not subsystem.output_buffers:
+                yield Finding(
+                    f"{KIND_TITLES[subsystem.kind]} `{name}` has no Output Buffer",
+                    subsystem.location,
+                    "Figure 4b: it sends data through at least one `/ob`",
+                )
+
+
+@rule("EARL-W001", Severity.WARNING, "an agent of type C (zombie) is useless", "§2.4, Table 1")
+def zombie_agent(context: CheckContext) -> Iterator[Finding]:
+    """An agent with neither effectors, receptors nor inter-agent links has type C: it can neither act,
+    perceive nor communicate (Table 1 calls it a zombie)."""
+    seen: set[int] = set()
+    for agent in context.system.agents:
+        declared = agent.location
+        if context.agent_type(agent).name == "C" and id(declared) not in seen:
+            seen.add(id(declared))
+            yield Finding(
+                f"agent `{instance_name(agent.name, agent.index)}/a` is of type C (zombie): no effectors, receptors or inter-agent links",
+                agent.location,
+                "link it to another agent's control subsystem, or give it effectors or receptors",
+            )
