@@ -13,7 +13,7 @@ import sys
 from collections.abc import Sequence
 
 from earl import __version__
-from earl.cli import check_command, fmt_command
+from earl.cli import check_command, fmt_command, rules_command
 
 EXIT_OK = 0
 EXIT_INVALID = 1
@@ -56,6 +56,7 @@ def build_parser() -> argparse.ArgumentParser:
     commands = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     check_command.register(commands)
     fmt_command.register(commands)
+    rules_command.register(commands)
     return parser
 
 

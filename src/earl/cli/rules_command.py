@@ -1,0 +1,42 @@
+"""`earl rules [CODE]`: what each rule of `earl check` enforces, and why (like `rustc --explain`)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from typing import Any
+
+from earl.check.registry import RULES, rules_by_code
+from earl.cli.common import usage_error
+from earl.diagnostics import did_you_mean
+from earl.lang.codes import READING_CODES
+
+
+def register(commands: Any) -> None:
+    parser = commands.add_parser(
+        "rules",
+        help="list the rules of `earl check`, or explain one",
+        description="Without CODE, list every rule with its manual reference; with CODE, explain that rule.",
+    )
+    parser.add_argument("code", metavar="CODE", nargs="?", help="a code such as EARL-E060 (or just E060)")
+    parser.set_defaults(run=run)
+
+
+def run(arguments: argparse.Namespace) -> int:
+    if arguments.code is None:
+        for rule in rules_by_code():
+            sys.stdout.write(f"{rule.code}  {rule.severity.value:<7}  {rule.title}  ({rule.reference})\n")
+        return 0
+    code = arguments.code.upper()
+    if not code.startswith("EARL-"):
+        code = f"EARL-{code}"
+    if code in RULES:
+        rule = RULES[code]
+        sys.stdout.write(f"{rule.code}: {rule.title}\n{rule.severity.value}; manual {rule.reference}\n\n")
+        sys.stdout.write(f"{rule.explanation}\n")
+        return 0
+    if code in READING_CODES:
+        sys.stdout.write(f"{code}: {READING_CODES[code]} (found while reading the spec; see docs/rules.md)\n")
+        return 0
+    hint = did_you_mean(code, [*RULES, *READING_CODES])
+    return usage_error(f"no rule {arguments.code}" + (f"; {hint}" if hint else "; `earl rules` lists them"))
