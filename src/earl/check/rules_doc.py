@@ -76,8 +76,8 @@ def render() -> str:
     lines.append(
         "Some rules of the manual cannot be broken in `.earl` text, or are checked while names are resolved:\n"
     )
-    for rule, how in ENFORCED_BY_THE_LANGUAGE:
-        lines.append(f"- {rule} — {how}")
+    for statement, how in ENFORCED_BY_THE_LANGUAGE:
+        lines.append(f"- {statement} — {how}")
     lines.append("")
     lines.append("## Table 1: agent types\n")
     lines.append("`earl check --verbose` computes the type of every agent from its subsystems and inter-agent links.\n")

@@ -78,6 +78,9 @@ from earl.model.types import (
 #: Deeper expressions are refused: no person writes them, and they would exhaust the stack.
 MAX_EXPRESSION_DEPTH = 100
 
+#: Deeper array types are refused for the same reason.
+MAX_ARRAY_DIMENSIONS = 32
+
 
 class SpecificationSyntaxError(Exception):
     """A problem found while building the tree into elements (e.g. an expression nested too deep)."""
@@ -172,10 +175,26 @@ class ElementBuilder(Transformer_NonRecursive[Token, Any]):
         return TypeReference(name, self._loc(meta))
 
     def fixed_array(self, meta: Meta, children: list[Any]) -> ArrayType:
-        return ArrayType(children[0], children[1], self._loc(meta))
+        return self._array(ArrayType(children[0], children[1], self._loc(meta)))
 
     def variable_array(self, meta: Meta, children: list[Any]) -> ArrayType:
-        return ArrayType(children[0], None, self._loc(meta))
+        return self._array(ArrayType(children[0], None, self._loc(meta)))
+
+    def _array(self, array: ArrayType) -> ArrayType:
+        # `int[1][1]…` thousands deep would exhaust the stack of every recursive walk over types.
+        depth = 1 + self._depth.get(id(array.element), 0)
+        if depth > MAX_ARRAY_DIMENSIONS:
+            raise SpecificationSyntaxError(
+                Diagnostic(
+                    Severity.ERROR,
+                    f"this array type has more than {MAX_ARRAY_DIMENSIONS} dimensions",
+                    array.location,
+                    code="EARL-S017",
+                    hint="name the inner array with `type` and build on it, or flatten the dimensions",
+                )
+            )
+        self._depth[id(array)] = depth
+        return array
 
     # ------------------------------------------------------------------ system
     def robot(self, meta: Meta, children: list[Any]) -> Robot:
