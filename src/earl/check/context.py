@@ -149,10 +149,23 @@ class CheckContext:
         ]
 
     # ------------------------------------------------------------------ Table 1
+    def instances(self, agent: Agent) -> list[Agent]:
+        """The expanded agents `agent` stands for: itself, or, for an agent of the declared system, its
+        counterpart (every member of a family).  Links are resolved between expanded agents only."""
+        if any(candidate is agent for candidate in self.system.agents):
+            return [agent]
+        return [
+            candidate
+            for candidate in self.system.agents
+            if candidate.name == agent.name and (agent.index is None or candidate.index == agent.index)
+        ]
+
     def agent_type(self, agent: Agent) -> AgentType:
+        """The row of Table 1 of an agent of the declared or of the expanded system."""
         effectors = bool(agent.subsystems_of(Kind.VIRTUAL_EFFECTOR) or agent.subsystems_of(Kind.REAL_EFFECTOR))
         receptors = bool(agent.subsystems_of(Kind.VIRTUAL_RECEPTOR) or agent.subsystems_of(Kind.REAL_RECEPTOR))
-        return agent_type(effectors, receptors, bool(self.inter_agent_links(agent)))
+        transmission = any(self.inter_agent_links(instance) for instance in self.instances(agent))
+        return agent_type(effectors, receptors, transmission)
 
     # ------------------------------------------------------------------ data types
     def structural(self, data_type: DataType) -> DataType | StructType:

@@ -251,7 +251,8 @@ def _from_analysis(code: str) -> Any:
 def _register(code: str, severity: Severity, title: str, reference: str, doc: str) -> None:
     function = _from_analysis(code)
     function.__doc__ = doc
-    function.__name__ = title
+    # SARIF names a rule by an identifier, as the other rules' function names are.
+    function.__name__ = "_".join(title.split())
     rule(code, severity, title, reference)(function)
 
 

@@ -50,10 +50,15 @@ class _Printer:
     def line(self, depth: int, text: str, comments: Comments | None = None) -> None:
         if comments is not None:
             for comment in comments.leading:
-                self.lines.append(f"{INDENT * depth}{comment}" if comment else "")
+                self.comment(depth, comment)
             if comments.trailing:
-                text = f"{text}  {comments.trailing}"
+                text = f"{text}  {comments.trailing.rstrip()}"
         self.lines.append(f"{INDENT * depth}{text}")
+
+    def comment(self, depth: int, comment: str) -> None:
+        """A whole-line comment; "" is the blank line that kept it apart from what follows."""
+        comment = comment.rstrip()  # trailing space, and the `\r` a CRLF file leaves in a comment
+        self.lines.append(f"{INDENT * depth}{comment}" if comment else "")
 
     def text(self) -> str:
         while self.lines and self.lines[-1] == "":
@@ -91,7 +96,7 @@ def format_system(system: System) -> str:
     """The whole system as canonical text, imports kept as `import` lines."""
     printer = _Printer()
     for comment in system.comments.leading:
-        printer.line(0, comment)
+        printer.comment(0, comment)
     if system.name:
         printer.line(0, f"system {system.name}")
     declared = system.order if _order_is_complete(system) else _default_order(system)
@@ -124,7 +129,7 @@ def format_system(system: System) -> str:
     if system.comments.closing:
         printer.blank()
         for comment in system.comments.closing:
-            printer.line(0, comment)
+            printer.comment(0, comment)
     return printer.text()
 
 

@@ -15,8 +15,9 @@ from earl.lang.syntax_errors import translate
 from earl.lang.transformer import ElementBuilder, ParsedFile, SpecificationSyntaxError
 from earl.model.location import SourceLocation
 
-#: Larger files are refused before parsing: a spec of a thousand agents is far smaller.
-MAX_FILE_BYTES = 32 * 1024 * 1024
+#: Larger files are refused before parsing: a spec of a thousand agents is far smaller, and the
+#: parser reads some 100-200 KB a second, so a bigger file would look like a hang.
+MAX_FILE_BYTES = 2 * 1024 * 1024
 
 
 class _CommentCollector:

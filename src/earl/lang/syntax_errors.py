@@ -1,71 +1,121 @@
-"""Lark's parse errors, told as one plain sentence with a hint (Lark's LALR error-reporting idea)."""
+"""Lark's parse errors, told as one plain sentence with a hint (Lark's LALR error-reporting idea).
+
+The parser stops at the first token it cannot use.  What it had read until then
+(its value stack) and what it would have accepted (its parse table) are enough to
+name the usual slips: a misspelt keyword, a transition without `->`, a duration
+without its unit, an element without its kind, a `{` never closed.
+"""
 
 from __future__ import annotations
 
-from lark import Token
+from functools import lru_cache
+from typing import Any
+
+from lark import Token, Tree
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
 from earl.diagnostics import Diagnostic, Severity, did_you_mean
+from earl.model.kinds import KIND_TITLES, Kind
 from earl.model.location import SourceLocation
 
-#: How each terminal of the grammar is named to a person.
+#: How each terminal of the grammar is named to a person (keywords and punctuation are quoted).
 TERMINAL_TEXT: dict[str, str] = {
     "NAME": "a name",
     "NUMBER": "a number",
     "INT": "a whole number",
     "STRING": "a string in double quotes",
-    "LBRACE": "`{`",
-    "RBRACE": "`}`",
-    "LPAR": "`(`",
-    "RPAR": "`)`",
-    "LSQB": "`[`",
-    "RSQB": "`]`",
-    "COLON": "`:`",
-    "COMMA": "`,`",
-    "DOT": "`.`",
-    "EQUAL": "`=`",
-    "SLASH": "`/`",
-    "STAR": "`*`",
-    "PLUS": "`+`",
-    "MINUS": "`-`",
-    "QMARK": "`?`",
     "OPTIONAL": "`?`",
-    "__ANON_0": "`->`",
-    "ROBOT_KIND": "`r`",
-    "AGENT_KIND": "`a`",
+    "ROBOT_KIND": "`r` (Robot)",
+    "AGENT_KIND": "`a` (Agent)",
     "SUBSYSTEM_KIND": "a subsystem kind (`ve`, `re`, `vr`, `rr`)",
-    "IB": "`ib`",
-    "OB": "`ob`",
-    "M": "`m`",
-    "MI": "`mi`",
-    "MO": "`mo`",
-    "PP": "`pp`",
-    "PF": "`pf`",
-    "BB": "`bb`",
+    "CS": "`cs`",
+    "IB": "`ib` (Input Buffer)",
+    "OB": "`ob` (Output Buffer)",
+    "M": "`m` (Internal Memory)",
+    "MI": "`mi` (memory read)",
+    "MO": "`mo` (memory written)",
+    "PP": "`pp` (Primitive Predicate)",
+    "PF": "`pf` (Partial Transition Function)",
+    "BB": "`bb` (Basic Behaviour)",
     "TIME_UNIT": "a time unit (`s`, `ms`, `us`)",
-    "COMPARISON_OPERATOR": "a comparison",
-    "TRUE": "`true`",
-    "FALSE": "`false`",
-    "ANY": "`any`",
-    "ALL": "`all`",
+    "COMPARISON_OPERATOR": "a comparison (`==`, `<`, …)",
+    "ANY_STATE": "`*`",
     "$END": "the end of the file",
 }
+
+#: The terminals an expression may start with; when all are expected they are named as one.
+_EXPRESSION_START = {"NAME", "NUMBER", "LPAR"}
+_EXPRESSION_TERMINALS = {"NAME", "NUMBER", "STRING", "LPAR", "LSQB", "MINUS", "NOT", "TRUE", "FALSE", "ANY", "ALL"}
 
 #: Hints for what was expected, keyed by a terminal that identifies the construct.
 HINTS: dict[str, str] = {
     "TIME_UNIT": "write a duration with its unit, e.g. `period 2 ms`",
     "AGENT_KIND": "an Agent is named with `/a`, e.g. `manip/a`",
     "ROBOT_KIND": "a Robot is named with `/r`, e.g. `manipulationRobot/r`",
+    "INITIAL": "an `fsm` starts with its initial state: `fsm { initial idle  state idle: idle/bb … }`",
+    "TC": "a Basic Behaviour is written `name/bb { tf = {move/pf} then {send/pf} tc = CONDITION }`",
+    "WHEN": "a transition is written `source -> destination when CONDITION`",
+    "TF": "a Basic Behaviour is written `name/bb { tf = {move/pf} then {send/pf} tc = CONDITION }`",
+    "IN": "a family is declared `name[K in 1..N]/kind`",
+    "PYTHON": 'an implementation is written `= python "module:function"`',
 }
 
-_PAIRS = {"RBRACE": "{", "RPAR": "(", "RSQB": "["}
+#: How a declaration of each kind is written, for a slip right after its kind suffix.
+DECLARATION_FORMS: dict[str, str] = {
+    "PP": "a Primitive Predicate is written `name/pp = CONDITION`",
+    "M": "an Internal Memory is written `name/m: Type` or `name/m: Type = INITIAL`",
+    "IB": "an Input Buffer is written `name/ib: Type`, optionally followed by `fifo N`",
+    "OB": "an Output Buffer is written `name/ob: Type`",
+    "PF": 'a Partial Transition Function is written `name/pf(reads -> writes)`, optionally `= python "module:function"`',
+    "BB": "a Basic Behaviour is written `name/bb { tf = {move/pf} tc = CONDITION }`",
+    "AGENT_KIND": "an Agent is written `name/a { cs { … } … }`",
+    "ROBOT_KIND": "a Robot is written `name/r { agent/a  link a,b }`",
+    "SUBSYSTEM_KIND": "a subsystem is written `name/ve { … }` (or `re`, `vr`, `rr`)",
+}
+
+#: What may be declared where: the keyword that identifies each kind of block, and the forms.
+_BLOCK_FORMS: list[tuple[str, str]] = [
+    (
+        "PERIOD",
+        "elements are named with their kind: `cmd/ib: T`, `out/ob: T`, `x/m: T`, `ready/pp = …`, "
+        "`move/pf(…)`, `idle/bb { … }`",
+    ),
+    ("CS", "subsystems are `cs { … }` or `name/ve { … }` (also `re`, `vr`, `rr`)"),
+    ("STRUCT", "declarations are named with their kind: `manip/a { … }` for an Agent, `r1/r { … }` for a Robot"),
+]
+
+_CLOSING = {"LBRACE": "}", "LPAR": ")", "LSQB": "]"}
+_OPENING = {"RBRACE": "LBRACE", "RPAR": "LPAR", "RSQB": "LSQB"}
+
+#: Keywords that only the top level of a file holds: meeting one inside a block hints at a missing `}`.
+_TOP_LEVEL_ONLY = {"system", "import", "struct", "type"}
+
+#: Characters people type from other languages, and what EARL writes instead.
+_CHARACTER_HINTS: dict[str, str] = {
+    ";": "EARL needs no `;` between statements; remove it",
+    "'": 'strings are written in double quotes, e.g. "module:function"',
+    "#": "comments start with `//`",
+    "\u2192": "write the arrow as `->`",
+    "&": "write `and`",
+    "|": "write `or`",
+    "!": "write `not`, or `!=` for “not equal”",
+}
+
+
+@lru_cache(maxsize=1)
+def _literal_terminals() -> dict[str, str]:
+    """Terminal name → its literal text, for every terminal that is a fixed string (`->`, `{`, `period`)."""
+    from earl.lang.parser import _parser  # the parser imports this module; resolve the cycle lazily
+
+    return {t.name: t.pattern.value for t in _parser().terminals if t.pattern.type == "str"}
 
 
 def _describe(terminal: str, keywords: dict[str, str]) -> str:
     if terminal in TERMINAL_TEXT:
         return TERMINAL_TEXT[terminal]
-    if terminal in keywords:
-        return f"`{keywords[terminal]}`"
+    literal = keywords.get(terminal) or _literal_terminals().get(terminal)
+    if literal is not None:
+        return f"`{literal}`"
     return terminal.lower()
 
 
@@ -78,64 +128,184 @@ def _found(token: Token) -> str:
 def translate(error: UnexpectedInput, path: str, text: str, keywords: dict[str, str]) -> Diagnostic:
     """One diagnostic for a Lark error: where, what was expected, and a hint."""
     if isinstance(error, UnexpectedCharacters):
-        line, column = error.line, error.column
-        character = text.splitlines()[line - 1][column - 1] if line - 1 < len(text.splitlines()) else "?"
-        location = SourceLocation(path, line, column, line, column + 1)
-        if character == '"':
-            return Diagnostic(
-                Severity.ERROR,
-                "this string is not closed on its line",
-                location,
-                code="EARL-S002",
-                hint='strings are written in double quotes on one line, e.g. "pick_and_place.manip:joint_move"',
-            )
-        return Diagnostic(
-            Severity.ERROR,
-            f"unexpected character `{character}`",
-            location,
-            code="EARL-S001",
-            hint="names are letters, digits and `_`; comments start with `//`",
-        )
+        return _unexpected_character(error, path, text)
     if isinstance(error, (UnexpectedToken, UnexpectedEOF)):
-        token: Token = error.token if isinstance(error, UnexpectedToken) else Token("$END", "")
-        expected = sorted(error.expected) if error.expected else []
-        expected = [t for t in expected if t not in ("COMMENT", "WS")]
-        previous = _previous_token(error)
-        if token.type == "$END" or not token.line:
-            lines = text.splitlines() or [""]
-            line = len(lines)
-            column = len(lines[-1]) + 1
-            location = SourceLocation(path, line, column, line, column + 1)
-        else:
-            column = token.column or 1
-            location = SourceLocation(
-                path, token.line, column, token.end_line or token.line, token.end_column or column + 1
-            )
-        return _expected_message(token, expected, previous, location, keywords)
+        return _unexpected_token(error, path, text, keywords)
     return Diagnostic(Severity.ERROR, str(error).splitlines()[0], None, code="EARL-S000")
 
 
-def _previous_token(error: UnexpectedInput) -> Token | None:
-    parser = getattr(error, "interactive_parser", None)
-    if parser is None:
+def _unexpected_character(error: UnexpectedCharacters, path: str, text: str) -> Diagnostic:
+    position = error.pos_in_stream
+    character = text[position] if position is not None and 0 <= position < len(text) else str(error.char)
+    line, column = error.line, error.column
+    location = SourceLocation(path, line, column, line, column + 1)
+    if character == '"':
+        return Diagnostic(
+            Severity.ERROR,
+            "this string is not closed on its line",
+            location,
+            code="EARL-S002",
+            hint='strings are written in double quotes on one line, e.g. "pick_and_place.manip:joint_move"',
+        )
+    shown = f"`{character}`" if character.isprintable() and not character.isspace() else f"U+{ord(character):04X}"
+    hint = _CHARACTER_HINTS.get(character)
+    if hint is None and character.isalpha():
+        hint = "names are ASCII letters, digits and `_`"
+    return Diagnostic(
+        Severity.ERROR,
+        f"unexpected character {shown}",
+        location,
+        code="EARL-S001",
+        hint=hint or "names are letters, digits and `_`; comments start with `//`",
+    )
+
+
+class _Context:
+    """What the parser had read when it stopped, and what it would have accepted."""
+
+    def __init__(self, error: UnexpectedToken | UnexpectedEOF, keywords: dict[str, str]) -> None:
+        self.keywords = keywords
+        parser = getattr(error, "interactive_parser", None)
+        state = getattr(parser, "parser_state", None)
+        self.values: list[Any] = list(getattr(state, "value_stack", None) or [])
+        self.expected = self._expected(error, parser)
+        self.before: set[str] = set()
+        states = getattr(state, "state_stack", None) or []
+        if state is not None and len(states) >= 2:
+            table = state.parse_conf.states.get(states[-2], {})
+            self.before = {t for t in table if t == t.upper()}
+
+    @staticmethod
+    def _expected(error: UnexpectedToken | UnexpectedEOF, parser: Any) -> list[str]:
+        found: set[str] = set()
+        if parser is not None:
+            try:
+                # The lexer's own list leaves out keywords (they are lexed as names); the parser knows them.
+                found = set(parser.accepts())
+            except Exception:
+                found = set()
+        if not found:
+            found = set(error.expected or ())
+        return sorted(t for t in found if t not in ("COMMENT", "WS"))
+
+    @property
+    def previous(self) -> Token | None:
+        """The token read just before the error, when the parser had not yet folded it into a rule."""
+        if self.values and isinstance(self.values[-1], Token):
+            return self.values[-1]
         return None
-    stack = parser.parser_state.value_stack
-    for value in reversed(stack):
-        if isinstance(value, Token):
-            return value
-        break
-    return None
+
+    def value(self, back: int) -> Any:
+        return self.values[-back] if len(self.values) >= back else None
+
+    def last_end(self) -> tuple[int, int] | None:
+        """Line and column just after the last thing read."""
+        for value in reversed(self.values):
+            if isinstance(value, Token) and value.end_line is not None:
+                return value.end_line, value.end_column or 1
+            if isinstance(value, Tree) and not value.meta.empty:
+                return value.meta.end_line, value.meta.end_column
+        return None
+
+    def open_brackets(self) -> list[Token]:
+        """The `{`, `(` and `[` read but not closed, outermost first."""
+        opened: list[Token] = []
+        for value in self.values:
+            if not isinstance(value, Token):
+                continue
+            if value.type in _CLOSING:
+                opened.append(value)
+            elif value.type in _OPENING and opened and opened[-1].type == _OPENING[value.type]:
+                opened.pop()
+        return opened
+
+    def describe(self, terminals: list[str]) -> list[str]:
+        """What the terminals are called, keywords and punctuation first, then kinds of token."""
+        terminals = list(terminals)
+        described: list[str] = []
+        if set(terminals) >= _EXPRESSION_START:
+            described.append("an expression")
+            terminals = [t for t in terminals if t not in _EXPRESSION_TERMINALS]
+        texts = sorted({_describe(t, self.keywords) for t in terminals}, key=lambda d: (not d.startswith("`"), d))
+        return described + texts
+
+    def keyword(self, terminal: str) -> str | None:
+        return self.keywords.get(terminal) or _literal_terminals().get(terminal)
 
 
-def _expected_message(
-    token: Token, expected: list[str], previous: Token | None, location: SourceLocation, keywords: dict[str, str]
+def _unexpected_token(
+    error: UnexpectedToken | UnexpectedEOF, path: str, text: str, keywords: dict[str, str]
 ) -> Diagnostic:
-    described = [_describe(t, keywords) for t in expected]
-    after = f" after `{previous}`" if previous is not None and str(previous).strip() else ""
-    hint: str | None = None
+    token: Token = error.token if isinstance(error, UnexpectedToken) else Token("$END", "")
+    context = _Context(error, keywords)
+    end = context.last_end()
 
-    # A source state followed by anything but an arrow: the commonest slip in an FSM.
-    if "__ANON_0" in expected and previous is not None and previous.type in ("NAME", "STAR") and len(expected) <= 3:
+    def after_previous() -> SourceLocation:
+        if end is None:
+            return SourceLocation(path, 1, 1, 1, 2)
+        return SourceLocation(path, end[0], end[1], end[0], end[1] + 1)
+
+    if token.type == "$END" or not token.line:
+        location = after_previous()
+    elif end is not None and token.line > end[0] and token.type not in ("NUMBER", "INT", "STRING"):
+        # What is missing belongs at the end of the line before, not before the next statement.
+        location = after_previous()
+    else:
+        column = token.column or 1
+        location = SourceLocation(
+            path, token.line, column, token.end_line or token.line, token.end_column or column + 1
+        )
+
+    for special in (_misplaced_keyword, _missing_arrow, _end_of_file, _bad_kind, _duration):
+        diagnostic = special(token, context, location, path)
+        if diagnostic is not None:
+            return diagnostic
+    return _expected_message(token, context, location)
+
+
+def _token_location(path: str, token: Token) -> SourceLocation:
+    line = token.line or 1
+    column = token.column or 1
+    return SourceLocation(path, line, column, token.end_line or line, token.end_column or column + 1)
+
+
+def _misplaced_keyword(token: Token, context: _Context, location: SourceLocation, path: str) -> Diagnostic | None:
+    """`peroid 2 ms`, `strcut S {…}`, a second `system`: a name where a keyword was meant."""
+    previous = context.previous
+    if previous is None or previous.type != "NAME" or not context.before:
+        return None
+    name = str(previous)
+    acceptable = {context.keyword(t): t for t in context.before if t in context.keywords}
+    acceptable.pop(None, None)
+    if name in context.keywords.values() and name not in acceptable:
+        if name == "system":
+            hint = "`system NAME` is written once, as the first line of the root file"
+        elif name in _TOP_LEVEL_ONLY and context.open_brackets():
+            hint = _unclosed_hint(context.open_brackets()) or f"`{name}` is written at the top level of a file"
+        else:
+            hint = None
+        return Diagnostic(
+            Severity.ERROR, f"`{name}` cannot be written here", _token_location(path, previous), "EARL-S007", hint
+        )
+    # A name followed by `/` or `[` is an element; anything else after it suggests a keyword was meant.
+    if token.type in ("SLASH", "LSQB"):
+        return None
+    suggestion = did_you_mean(name, [k for k in acceptable if k is not None])
+    if suggestion is None:
+        return None
+    return Diagnostic(
+        Severity.ERROR, f"unknown keyword `{name}`", _token_location(path, previous), "EARL-S007", suggestion
+    )
+
+
+def _missing_arrow(token: Token, context: _Context, location: SourceLocation, path: str) -> Diagnostic | None:
+    arrow = next((t for t in context.expected if context.keyword(t) == "->"), None)
+    if arrow is None:
+        return None
+    previous = context.previous
+    in_fsm = "ANY_STATE" in context.before or "STATE" in context.before or not context.before
+    if previous is not None and previous.type == "NAME" and in_fsm and len(context.expected) <= 3:
+        # A source state followed by anything but an arrow: the commonest slip in an FSM.
         return Diagnostic(
             Severity.ERROR,
             f"expected `->` after the source state `{previous}`",
@@ -143,29 +313,149 @@ def _expected_message(
             code="EARL-S003",
             hint="a transition is written `source -> destination when CONDITION`",
         )
-    if token.type == "$END":
-        closing = [t for t in expected if t in _PAIRS]
-        message = f"the file ends{after} but {' or '.join(described[:4])} was expected"
-        if closing:
-            hint = f"a `{_PAIRS[closing[0]]}` is not closed"
-        return Diagnostic(Severity.ERROR, message, location, code="EARL-S004", hint=hint)
-
-    for terminal in expected:
-        if terminal in HINTS:
-            hint = HINTS[terminal]
-            break
-    if token.type == "NAME" and hint is None:
-        candidates = [keywords[t] for t in expected if t in keywords]
-        hint = did_you_mean(str(token), candidates)
-    if token.type == "NAME" and previous is not None and previous.type == "SLASH":
-        kinds = [d for d in described]
+    top = context.value(1)
+    if isinstance(top, Tree) and top.data == "link_end":
         return Diagnostic(
             Severity.ERROR,
-            f"`{token}` is not a kind of element that can stand here; expected {_join(kinds)}",
+            f"expected `->` between the two ends of the link, found {_found(token)}",
             location,
-            code="EARL-S005",
-            hint=hint or "the kind after `/` says what an element is: `a`, `cs`, `ve`, `ib`, `pp`, …",
+            code="EARL-S003",
+            hint="a link runs from an Output Buffer to an Input Buffer: `link a,b: a/a.cs.out -> b/a.cs.in`",
         )
+    if any(isinstance(v, Token) and v.type == "PF" for v in context.values):
+        return Diagnostic(
+            Severity.ERROR,
+            f"expected `->` between what `/pf` reads and what it writes, found {_found(token)}",
+            location,
+            code="EARL-S003",
+            hint="write `name/pf(reads -> writes)`, e.g. `move/pf(cmd/ib -> pos/mo)`; either side may be empty",
+        )
+    return None
+
+
+def _unclosed_hint(opened: list[Token]) -> str | None:
+    if not opened:
+        return None
+    innermost = opened[-1]
+    return (
+        f"is a `{_CLOSING[innermost.type]}` missing? "
+        f"the `{innermost}` on line {innermost.line}, column {innermost.column} is still open"
+    )
+
+
+def _end_of_file(token: Token, context: _Context, location: SourceLocation, path: str) -> Diagnostic | None:
+    if token.type != "$END":
+        return None
+    opened = context.open_brackets()
+    if opened:
+        innermost = opened[-1]
+        closing = _CLOSING[innermost.type]
+        return Diagnostic(
+            Severity.ERROR,
+            f"the file ends before the `{innermost}` on line {innermost.line} is closed",
+            location,
+            code="EARL-S004",
+            hint=f"add the missing `{closing}`" + ("" if len(opened) == 1 else f" ({len(opened)} brackets are open)"),
+        )
+    previous = context.previous
+    after = f" after `{previous}`" if previous is not None and str(previous).strip() else ""
+    described = context.describe(context.expected)
+    hint = next((HINTS[t] for t in context.expected if t in HINTS), None)
+    return Diagnostic(
+        Severity.ERROR,
+        f"the file ends{after} but {_join(described[:6], 'or')} was expected",
+        location,
+        code="EARL-S004",
+        hint=hint,
+    )
+
+
+def _bad_kind(token: Token, context: _Context, location: SourceLocation, path: str) -> Diagnostic | None:
+    """`manip/x`: the word after `/` is not a kind that can stand here."""
+    previous = context.previous
+    if previous is None or previous.type != "SLASH" or token.type not in ("NAME", "NUMBER", "INT"):
+        return None
+    kinds = context.describe(context.expected)
+    hint = next((HINTS[t] for t in context.expected if t in HINTS), None)
+    if str(token) in (Kind.AGENT.value, Kind.ROBOT.value) and context.open_brackets():
+        title = KIND_TITLES[Kind(str(token))]
+        hint = f"an {title} is declared at the top level; " + (_unclosed_hint(context.open_brackets()) or "")
+    return Diagnostic(
+        Severity.ERROR,
+        f"`{token}` is not a kind of element that can stand here; expected {_join(kinds, 'or')}",
+        location,
+        code="EARL-S005",
+        hint=hint or "the kind after `/` says what an element is: `a`, `ve`, `ib`, `ob`, `m`, `pp`, `pf`, `bb`, …",
+    )
+
+
+def _duration(token: Token, context: _Context, location: SourceLocation, path: str) -> Diagnostic | None:
+    """`period 2` or `period 2 min`: a number without one of the three units."""
+    previous = context.previous
+    if "TIME_UNIT" not in context.expected or previous is None or previous.type != "NUMBER":
+        return None
+    if token.type == "NAME" and token.line == previous.line:
+        return Diagnostic(
+            Severity.ERROR,
+            f"`{token}` is not a time unit; write `s`, `ms` or `us`",
+            location,
+            code="EARL-S008",
+            hint=f"e.g. `{previous} ms`",
+        )
+    return Diagnostic(
+        Severity.ERROR,
+        f"the duration `{previous}` has no unit",
+        _token_location(path, previous),
+        code="EARL-S008",
+        hint=f"write it with its unit: `{previous} s`, `{previous} ms` or `{previous} us`",
+    )
+
+
+def _expected_message(token: Token, context: _Context, location: SourceLocation) -> Diagnostic:
+    expected = context.expected
+    previous = context.previous
+    described = context.describe(expected)
+    after = f" after `{previous}`" if previous is not None and str(previous).strip() else ""
+    hint: str | None = None
+
+    if token.type == "NAME":
+        hint = did_you_mean(str(token), [k for t in expected if (k := context.keyword(t)) and k.isidentifier()])
+    if hint is None and previous is not None and previous.type in DECLARATION_FORMS:
+        before_slash = context.value(3)
+        if (isinstance(before_slash, Tree) and before_slash.data == "declared_name") or (
+            isinstance(before_slash, Token) and before_slash.type in ("TRUE", "FALSE")
+        ):
+            hint = DECLARATION_FORMS[previous.type]
+    if hint is None:
+        hint = next((HINTS[t] for t in expected if t in HINTS), None)
+    if hint is None and previous is not None and previous.type == "NAME" and "SLASH" in expected:
+        # `cmd: T` or `manip { … }`: an element written without its kind.
+        hint = next((form for marker, form in _BLOCK_FORMS if marker in context.before), None)
+        if hint is not None:
+            return Diagnostic(
+                Severity.ERROR,
+                f"expected `/` and a kind after `{previous}`, found {_found(token)}",
+                location,
+                code="EARL-S006",
+                hint=hint,
+            )
+    if hint is None:
+        hint = _after_keyword_hint(context)
+    if hint is None and token.type in ("NUMBER", "INT") and "NAME" in expected and "NUMBER" not in expected:
+        hint = "names start with a letter or `_`"
+    if hint is None and token.type == "NAME" and str(token) in _TOP_LEVEL_ONLY:
+        hint = _unclosed_hint(context.open_brackets())
+    if hint is None and any(t in _OPENING for t in expected) and token.type in _OPENING:
+        hint = _unclosed_hint(context.open_brackets())
+    if hint is None and previous is not None and previous.type == "CS" and token.type == "SLASH":
+        hint = "the Control Subsystem is written `cs { … }`, without a kind"
+    top = context.value(1)
+    second = context.value(2)
+    if token.type == "COMPARISON_OPERATOR" and (
+        (isinstance(top, Tree) and top.data == "comparison")
+        or (isinstance(second, Token) and second.type == "COMPARISON_OPERATOR")
+    ):
+        hint = "comparisons do not chain: write `a < b and b < c`"
     if len(described) > 8:
         return Diagnostic(
             Severity.ERROR,
@@ -176,16 +466,43 @@ def _expected_message(
         )
     return Diagnostic(
         Severity.ERROR,
-        f"expected {_join(described)}{after}, found {_found(token)}",
+        f"expected {_join(described, 'or')}{after}, found {_found(token)}",
         location,
         code="EARL-S006",
         hint=hint,
     )
 
 
-def _join(items: list[str]) -> str:
+def _after_keyword_hint(context: _Context) -> str | None:
+    """How the innermost statement still open is written, when a keyword began it."""
+    values = context.values
+    for index in range(len(values) - 1, -1, -1):
+        value = values[index]
+        if not isinstance(value, Token):
+            continue
+        if value.type in _KEYWORD_FORMS:
+            return _KEYWORD_FORMS[value.type]
+        if value.type == "LBRACE":
+            opener = values[index - 2] if index >= 2 else None
+            if not (isinstance(opener, Token) and opener.type == "STRUCT"):
+                return None
+    return None
+
+
+_KEYWORD_FORMS: dict[str, str] = {
+    "PARAM": "a parameter is written `param N: int = 6`",
+    "SYSTEM": "the system is named on the first line: `system pickAndPlace`",
+    "IMPORT": 'the file to import is written in double quotes: `import "types.earl"`',
+    "STRUCT": "a struct is written `struct Name { field: Type  other: Type? }`",
+    "TYPE": "a type alias is written `type Name = double[6]`",
+    "LINK": "a link is written `link NAME: FROM -> TO`, e.g. `link task,manip: task/a.cs.cmd -> manip/a.cs.cmd`",
+    "PRIORITY": "a priority is a whole number, e.g. `priority 1`",
+}
+
+
+def _join(items: list[str], conjunction: str) -> str:
     if not items:
         return "something else"
     if len(items) == 1:
         return items[0]
-    return ", ".join(items[:-1]) + " or " + items[-1]
+    return ", ".join(items[:-1]) + f" {conjunction} " + items[-1]

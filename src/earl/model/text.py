@@ -7,6 +7,7 @@ same everywhere: `motorControllerState[K]/ib.emergencyStop`, `idle,jointMove/t`.
 from __future__ import annotations
 
 import json
+import math
 from typing import TYPE_CHECKING
 
 from earl.model.expressions import (
@@ -61,6 +62,11 @@ def literal_text(value: bool | int | float | str) -> str:
         return "true" if value else "false"
     if isinstance(value, str):
         return json.dumps(value, ensure_ascii=False)
+    if isinstance(value, float) and not math.isfinite(value):
+        if math.isnan(value):
+            raise ValueError("nan has no EARL literal: no number in the language reads as nan")
+        # The reader turns a number too large for a float into infinity, so this reads back as it.
+        return "1e999" if value > 0 else "-1e999"
     return repr(value)
 
 

@@ -1,0 +1,401 @@
+"""`earl check` and `earl rules` on the command line: output formats, exit codes, and safety."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from earl.check.registry import RULES
+from earl.cli.main import main
+
+EXAMPLE = Path(__file__).parent.parent / "examples" / "pick_and_place" / "system.earl"
+
+# Two purely computational agents joined by one link: every rule holds.
+CLEAN = """\
+system demo
+
+a1/a {
+    cs {
+        out/ob: double
+        x/m: double = 0.0
+        go/pp = x/mi > 1.0
+        compute/pf(x/mi -> x/mo)
+        emit/pf(x/mi -> out/ob)
+        run/bb {
+            tf = {compute/pf} then {emit/pf}
+            tc = go/pp
+        }
+        fsm {
+            initial run
+            state run: run/bb
+            run -> run when go/pp
+        }
+    }
+}
+
+a2/a {
+    cs {
+        inp/ib: double
+        y/m: double = 0.0
+        got/pp = newData(inp/ib)
+        take/pf(inp/ib -> y/mo)
+        run/bb {
+            tf = {take/pf}
+            tc = got/pp
+        }
+        fsm {
+            initial run
+            state run: run/bb
+            run -> run when got/pp
+        }
+    }
+}
+
+link a1,a2: a1/a.cs.out -> a2/a.cs.inp
+
+r/r {
+    a1/a
+    a2/a
+    link a1,a2
+}
+"""
+
+# An unwritten output buffer (EARL-W040 at 6:9) only.
+WARNING = CLEAN.replace("        out/ob: double\n", "        out/ob: double\n        spare/ob: double\n")
+
+# The warning, and two overlapping transitions out of `run` (EARL-E060 at 20:13).
+ERROR = WARNING.replace(
+    "            state run: run/bb\n            run -> run when go/pp\n",
+    "            state run: run/bb\n            state other: run/bb\n"
+    "            run -> run when go/pp\n            run -> other when go/pp\n            other -> run when go/pp\n",
+)
+
+# A behaviour that never ends (EARL-I063 at 28:9), nothing else.
+NOTE = CLEAN.replace("tc = got/pp", "tc = false")
+
+
+def write(tmp_path: Path, text: str, name: str = "spec.earl") -> Path:
+    path = tmp_path / name
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def run(capsys: pytest.CaptureFixture[str], *arguments: str) -> tuple[int, str, str]:
+    status = main(list(arguments))
+    captured = capsys.readouterr()
+    return status, captured.out, captured.err
+
+
+def test_the_specs_above_are_what_they_claim(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    for text, codes in (
+        (CLEAN, []),
+        (WARNING, ["EARL-W040"]),
+        (ERROR, ["EARL-W040", "EARL-E060"]),
+        (NOTE, ["EARL-I063"]),
+    ):
+        status, out, _ = run(capsys, "check", str(write(tmp_path, text)), "--format", "json")
+        assert [d["code"] for d in json.loads(out)] == codes
+        assert status == (1 if text is ERROR else 0)
+
+
+# ---------------------------------------------------------------- human output
+
+
+def test_human_output_quotes_the_line_with_a_caret_and_a_hint(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    spec = write(tmp_path, ERROR)
+    status, out, err = run(capsys, "check", str(spec))
+    assert status == 1
+    assert out == ""  # findings go to stderr, so stdout stays clean for pipes
+    lines = err.splitlines()
+    head = lines.index(
+        "error[EARL-E060]: transitions `run,run/t` and `run,other/t` of a1/a.cs can both hold, e.g. when go/pp = true"
+    )
+    assert lines[head + 1].strip() == f"--> {spec}:20:13"
+    source = next(line for line in lines[head + 1 :] if line.endswith("run -> other when go/pp"))
+    caret = lines[lines.index(source) + 1]
+    # the caret line underlines the transition, starting under its first character
+    assert caret.index("^") == source.index("run -> other")
+    assert caret.rstrip().endswith("^" * len("run -> other when go/pp"))
+    assert "= hint: give them distinct priorities (`priority 1` is evaluated first)" in err
+    assert f"--> {spec}:6:9" in err and "warning[EARL-W040]" in err
+    assert lines[-1] == "1 error, 1 warning"
+    # errors and warnings in the order of the file
+    assert err.index("EARL-W040") < err.index("EARL-E060")
+
+
+def test_human_output_of_a_clean_spec_says_ok(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    spec = write(tmp_path, CLEAN)
+    status, out, err = run(capsys, "check", str(spec))
+    assert status == 0
+    assert out == f"{spec}: ok — system `demo` follows the rules of the EARL manual\n"
+    assert err == ""
+
+
+def test_notes_are_shown_with_verbose_only(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    spec = write(tmp_path, NOTE)
+    status, out, err = run(capsys, "check", str(spec))
+    assert status == 0
+    assert "EARL-I063" not in err
+    assert "(1 note, shown with --verbose)" in out
+    status, out, err = run(capsys, "check", str(spec), "--verbose")
+    assert status == 0
+    assert "note[EARL-I063]: `run/bb` never ends" in err
+    assert f"--> {spec}:28:9" in err
+    assert "(1 note)" in out
+
+
+def test_a_syntax_error_is_reported_with_exit_1(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    spec = write(tmp_path, CLEAN.replace("run -> run when go/pp", "run run when go/pp"))
+    status, out, err = run(capsys, "check", str(spec))
+    assert status == 1
+    assert "error[EARL-S" in err and f"{spec}:17:" in err
+    assert "Traceback" not in err + out
+
+
+# ---------------------------------------------------------------- machine-readable output
+
+
+def test_json_output(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    spec = write(tmp_path, ERROR)
+    status, out, err = run(capsys, "check", str(spec), "--format", "json")
+    assert status == 1
+    assert err == ""
+    findings = json.loads(out)
+    assert isinstance(findings, list) and len(findings) == 2
+    keys = {"code", "severity", "message", "file", "line", "column", "end_line", "end_column"}
+    for finding in findings:
+        assert isinstance(finding, dict)
+        assert keys <= finding.keys()
+        assert finding["file"] == str(spec)
+    warning, error = findings
+    assert (warning["code"], warning["severity"], warning["line"], warning["column"]) == ("EARL-W040", "warning", 6, 9)
+    assert (warning["end_line"], warning["end_column"]) == (6, 9 + len("spare/ob: double"))
+    assert (error["code"], error["severity"], error["line"], error["column"]) == ("EARL-E060", "error", 20, 13)
+    assert (error["end_line"], error["end_column"]) == (20, 13 + len("run -> other when go/pp"))
+    assert "can both hold" in error["message"]
+
+
+def test_json_output_of_notes_and_of_a_clean_spec(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    _, out, _ = run(capsys, "check", str(write(tmp_path, NOTE)), "--format", "json")
+    assert [(d["code"], d["severity"]) for d in json.loads(out)] == [("EARL-I063", "note")]  # notes without --verbose
+    status, out, _ = run(capsys, "check", str(write(tmp_path, CLEAN)), "--format", "json")
+    assert status == 0 and json.loads(out) == []
+
+
+def test_json_output_of_a_spec_that_cannot_be_read(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    spec = write(
+        tmp_path,
+        CLEAN.replace(
+            "state run: run/bb\n            run -> run when go/pp",
+            "state run: walk/bb\n            run -> run when go/pp",
+        ),
+    )
+    status, out, _ = run(capsys, "check", str(spec), "--format", "json")
+    assert status == 1
+    (finding,) = json.loads(out)
+    assert finding["code"] == "EARL-R030" and finding["severity"] == "error"
+    assert (finding["file"], finding["line"]) == (str(spec), 16)
+
+
+def sarif(capsys: pytest.CaptureFixture[str], spec: Path) -> tuple[int, dict[str, Any]]:
+    status, out, _ = run(capsys, "check", str(spec), "--format", "sarif")
+    log = json.loads(out)
+    assert isinstance(log, dict)
+    return status, log
+
+
+def test_sarif_output(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    spec = write(tmp_path, ERROR)
+    status, log = sarif(capsys, spec)
+    assert status == 1
+    assert log["version"] == "2.1.0"
+    assert "sarif" in log["$schema"]
+    (only_run,) = log["runs"]
+    driver = only_run["tool"]["driver"]
+    assert driver["name"] == "earl"
+    rules = driver["rules"]
+    assert [rule["id"] for rule in rules] == sorted(RULES)
+    for rule in rules:
+        assert rule["name"].isidentifier()
+        assert rule["shortDescription"]["text"] == RULES[rule["id"]].title
+        assert rule["defaultConfiguration"]["level"] in ("error", "warning", "note")
+    assert len({rule["name"] for rule in rules}) == len(rules)
+    results = only_run["results"]
+    assert [(r["ruleId"], r["level"]) for r in results] == [("EARL-W040", "warning"), ("EARL-E060", "error")]
+    for result in results:
+        assert rules[result["ruleIndex"]]["id"] == result["ruleId"]
+        assert result["message"]["text"]
+        physical = result["locations"][0]["physicalLocation"]
+        assert physical["artifactLocation"]["uri"] == str(spec)
+    region = results[1]["locations"][0]["physicalLocation"]["region"]
+    assert (region["startLine"], region["startColumn"]) == (20, 13)
+    # SARIF's endColumn is the column after the region, as earl's end columns are
+    assert (region["endLine"], region["endColumn"]) == (20, 13 + len("run -> other when go/pp"))
+
+
+def test_sarif_output_of_a_clean_spec_still_describes_the_rules(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    status, log = sarif(capsys, write(tmp_path, CLEAN))
+    assert status == 0
+    assert log["runs"][0]["results"] == []
+    assert len(log["runs"][0]["tool"]["driver"]["rules"]) == len(RULES)
+
+
+# ---------------------------------------------------------------- exit codes
+
+
+def test_exit_codes_and_strict(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    clean, warning, error, note = (
+        str(write(tmp_path, text, name))
+        for text, name in ((CLEAN, "c.earl"), (WARNING, "w.earl"), (ERROR, "e.earl"), (NOTE, "n.earl"))
+    )
+    assert run(capsys, "check", clean)[0] == 0
+    assert run(capsys, "check", clean, "--strict")[0] == 0
+    status, out, err = run(capsys, "check", warning)
+    assert status == 0
+    assert "(1 warning)" in out and "warning[EARL-W040]" in err
+    status, out, err = run(capsys, "check", warning, "--strict")
+    assert status == 1
+    assert "ok" not in out and "warning[EARL-W040]" in err
+    assert run(capsys, "check", warning, "--strict", "--format", "json")[0] == 1
+    assert run(capsys, "check", error)[0] == 1
+    assert run(capsys, "check", note, "--strict")[0] == 0  # notes never fail
+
+
+def test_usage_errors_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    status, _, err = run(capsys, "check", str(tmp_path / "missing.earl"))
+    assert status == 2 and "no such file" in err
+    status, _, err = run(capsys, "check", str(tmp_path))  # a directory without system.earl
+    assert status == 2 and "directory" in err
+    status, _, err = run(capsys, "check", str(EXAMPLE), "--param", "N")
+    assert status == 2 and "NAME=VALUE" in err
+    with pytest.raises(SystemExit) as exit_:
+        main(["check", str(EXAMPLE), "--format", "xml"])
+    assert exit_.value.code == 2
+    with pytest.raises(SystemExit) as exit_:
+        main(["check"])
+    assert exit_.value.code == 2
+
+
+def test_an_unknown_parameter_is_an_invalid_spec(capsys: pytest.CaptureFixture[str]) -> None:
+    status, _, err = run(capsys, "check", str(EXAMPLE), "--param", "M=3")
+    assert status == 1
+    assert "EARL-R001" in err
+
+
+# ---------------------------------------------------------------- --verbose and --param
+
+
+def test_verbose_lists_agent_types(capsys: pytest.CaptureFixture[str]) -> None:
+    status, out, err = run(capsys, "check", str(EXAMPLE), "--verbose")
+    assert status == 0
+    rows = {line.split()[1]: line for line in out.splitlines() if "/a " in line}
+    assert "CT — purely computational agent" in rows["task/a"]
+    assert "CET — teleoperated agent" in rows["manip/a"] and "1 cs, 6 ve, 6 re" in rows["manip/a"]
+    assert "CET — teleoperated agent" in rows["grip/a"] and "1 cs, 1 ve, 1 re" in rows["grip/a"]
+    assert err.count("note[EARL-I063]") == 8
+    assert "(8 notes)" in out
+
+
+def test_param_changes_the_expanded_system(capsys: pytest.CaptureFixture[str]) -> None:
+    status, out, _ = run(capsys, "check", str(EXAMPLE.parent), "--param", "N=3", "--verbose")
+    assert status == 0
+    assert "1 cs, 3 ve, 3 re" in out
+
+
+def test_verbose_lists_a_zombie(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    spec = write(tmp_path, CLEAN + "\nlonely/a {\n    cs {\n    }\n}\n")
+    status, out, err = run(capsys, "check", str(spec), "--verbose")
+    assert status == 0
+    assert "warning[EARL-W001]: agent `lonely/a` is of type C (zombie)" in err
+    assert any("lonely/a" in line and "C — zombie (useless)" in line for line in out.splitlines())
+
+
+# ---------------------------------------------------------------- earl rules
+
+
+def test_rules_lists_every_rule(capsys: pytest.CaptureFixture[str]) -> None:
+    status, out, _ = run(capsys, "rules")
+    assert status == 0
+    lines = out.splitlines()
+    assert [line.split()[0] for line in lines] == sorted(RULES)
+    e060 = next(line for line in lines if line.startswith("EARL-E060"))
+    assert "error" in e060 and "transitions leaving a state do not overlap" in e060 and "Figure 5a" in e060
+
+
+def test_rules_explains_one_rule(capsys: pytest.CaptureFixture[str]) -> None:
+    status, out, _ = run(capsys, "rules", "E060")
+    assert status == 0
+    assert out.startswith(
+        "EARL-E060: transitions leaving a state do not overlap\nerror; manual §2.2, Figure 5a, Table 5\n"
+    )
+    assert "`jointMove,jointMove/t` and `jointMove,idle/t`" in out
+    assert run(capsys, "rules", "earl-w061")[1].startswith("EARL-W061: ")
+
+
+def test_rules_knows_reading_codes_and_refuses_unknown_ones(capsys: pytest.CaptureFixture[str]) -> None:
+    status, out, _ = run(capsys, "rules", "R031")
+    assert status == 0 and out.startswith("EARL-R031: ")
+    status, out, err = run(capsys, "rules", "E061")
+    assert status == 2 and out == ""
+    assert "no rule E061" in err
+
+
+# ---------------------------------------------------------------- safety
+
+
+def earl_command() -> list[str]:
+    script = Path(sys.executable).with_name("earl")
+    if script.exists():
+        return [str(script)]
+    return [sys.executable, "-c", "import sys; from earl.cli.main import main; sys.exit(main(sys.argv[1:]))"]
+
+
+def test_check_never_imports_code_the_spec_names(tmp_path: Path) -> None:
+    marker = tmp_path / "imported.txt"
+    (tmp_path / "evilmod.py").write_text(
+        "from pathlib import Path\n"
+        f"Path({str(marker)!r}).write_text('evilmod was imported')\n"
+        "def f(*arguments):\n"
+        f"    Path({str(marker)!r}).write_text('evilmod.f was called')\n"
+    )
+    spec = write(tmp_path, CLEAN.replace("compute/pf(x/mi -> x/mo)", 'compute/pf(x/mi -> x/mo) = python "evilmod:f"'))
+    environment = dict(os.environ)
+    environment["PYTHONPATH"] = os.pathsep.join(filter(None, [str(tmp_path), environment.get("PYTHONPATH")]))
+
+    # The trap works: with this environment, importing the module leaves the marker.
+    subprocess.run([sys.executable, "-c", "import evilmod"], cwd=tmp_path, env=environment, check=True)
+    assert marker.exists()
+    marker.unlink()
+
+    for options in ([], ["--verbose", "--strict"], ["--format", "json"], ["--format", "sarif"]):
+        result = subprocess.run(
+            [*earl_command(), "check", spec.name, *options],
+            cwd=tmp_path,
+            env=environment,
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
+        assert result.returncode == 0, result.stdout + result.stderr
+        assert not marker.exists(), f"earl check {' '.join(options)} imported evilmod"
+    assert (
+        "ok — system `demo`"
+        in subprocess.run(
+            [*earl_command(), "check", spec.name],
+            cwd=tmp_path,
+            env=environment,
+            capture_output=True,
+            text=True,
+            timeout=120,
+        ).stdout
+    )

@@ -1,0 +1,703 @@
+"""Every rule of `earl check`: a small spec that breaks it, pointing at the spot, and one that keeps it.
+
+Each case starts from BASE, a tiny system that passes every rule (two purely computational
+agents joined by one link), and changes it by replacing text.  The expected line and column
+are those of the token the finding must point at, counted in the changed text.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+
+import earl
+from earl.check import check, context_for
+from earl.check.registry import RULES
+from earl.diagnostics import Diagnostic, Severity
+from earl.model.elements import System
+from earl.model.text import expression_text
+
+EXAMPLE = Path(__file__).parent.parent / "examples" / "pick_and_place" / "system.earl"
+
+# Line numbers matter below: BASE is 46 lines long, and text appended with `add` starts at line 48.
+BASE = """\
+system base
+
+a1/a {
+    cs {
+        out/ob: double
+        x/m: double = 0.0
+        go/pp = x/mi > 1.0
+        compute/pf(x/mi -> x/mo)
+        emit/pf(x/mi -> out/ob)
+        run/bb {
+            tf = {compute/pf} then {emit/pf}
+            tc = go/pp
+        }
+        fsm {
+            initial run
+            state run: run/bb
+            run -> run when go/pp
+        }
+    }
+}
+
+a2/a {
+    cs {
+        inp/ib: double
+        y/m: double = 0.0
+        got/pp = newData(inp/ib)
+        take/pf(inp/ib -> y/mo)
+        run/bb {
+            tf = {take/pf}
+            tc = got/pp
+        }
+        fsm {
+            initial run
+            state run: run/bb
+            run -> run when got/pp
+        }
+    }
+}
+
+link a1,a2: a1/a.cs.out -> a2/a.cs.inp
+
+r/r {
+    a1/a
+    a2/a
+    link a1,a2
+}
+"""
+
+
+def edit(*replacements: tuple[str, str], text: str = BASE) -> str:
+    """`text` with each `old` (which must occur exactly once) replaced by `new`."""
+    for old, new in replacements:
+        assert text.count(old) == 1, f"{old!r} occurs {text.count(old)} times"
+        text = text.replace(old, new)
+    return text
+
+
+def add(extra: str, text: str = BASE) -> str:
+    """`text` followed by a blank line and `extra`; after BASE, the first line of `extra` is line 48."""
+    return f"{text}\n{extra}"
+
+
+# An agent that acts: cs → ve → re (CE).  Added after BASE, `a3/a {` is line 48.
+EFFECTOR_AGENT = """\
+a3/a {
+    cs {
+        cmd/ob: double
+    }
+    m/ve {
+        cmd/ib: double
+        drive/ob: double
+    }
+    d/re {
+        drive/ib: double
+    }
+    link cs,m: cs.cmd -> m/ve.cmd
+    link m,d: m/ve.drive -> d/re.drive
+}
+"""
+
+# An agent that perceives: rr → vr → cs (CR).  Added after BASE, `a4/a {` is line 48.
+RECEPTOR_AGENT = """\
+a4/a {
+    cs {
+        data/ib: double
+    }
+    s/vr {
+        raw/ib: double
+        data/ob: double
+    }
+    cam/rr {
+        raw/ob: double
+    }
+    link cam,s: cam/rr.raw -> s/vr.raw
+    link s,cs: s/vr.data -> cs.data
+}
+"""
+
+# A second state in a1 that the first can go to, for the FSM rules.
+TWO_STATES = (
+    "            state run: run/bb\n            run -> run when go/pp\n",
+    "            state run: run/bb\n            state other: run/bb\n"
+    "            run -> run when go/pp\n            run -> other when go/pp\n            other -> run when go/pp\n",
+)
+
+
+@dataclass(frozen=True)
+class Case:
+    code: str
+    failing: str
+    line: int
+    column: int
+    fragment: str  # a part of the message that names what is wrong
+    passing: str
+
+
+CASES: list[Case] = [
+    Case(
+        "EARL-E001",
+        BASE[: BASE.index("r/r {")],
+        1,
+        8,
+        "system `base` has no Robot",
+        BASE,
+    ),
+    Case(
+        "EARL-E002",
+        edit(("r/r {\n    a1/a\n    a2/a\n    link a1,a2\n}", "r/r {\n}")),
+        42,
+        1,
+        "robot `r/r` contains no Agent",
+        BASE,
+    ),
+    Case(
+        "EARL-E003",
+        add("r2/r {\n    a1/a\n}\n"),
+        49,
+        5,
+        "agent `a1/a` belongs to robot `r/r` and to robot `r2/r`",
+        add("r2/r {\n    a3/a\n}\n" + EFFECTOR_AGENT),
+    ),
+    Case(
+        "EARL-E004",
+        edit(("    a2/a\n    link a1,a2\n}\n", "    link a1,a2\n}\n\nr2/r {\n    a2/a\n}\n")),
+        44,
+        5,
+        "robot `r/r` refers to link `a1,a2`, but `a2/a` is not one of its agents",
+        BASE,
+    ),
+    Case(
+        "EARL-E005",
+        add("a3/a {\n    m/ve {\n        cmd/ib: double\n        drive/ob: double\n    }\n}\n"),
+        48,
+        1,
+        "agent `a3/a` has no Control Subsystem",
+        add(EFFECTOR_AGENT),
+    ),
+    Case(
+        "EARL-E006",
+        add(
+            edit(
+                ("    d/re {\n        drive/ib: double\n    }\n", ""),
+                ("    link m,d: m/ve.drive -> d/re.drive\n", ""),
+                text=EFFECTOR_AGENT,
+            )
+        ),
+        48,
+        1,
+        "agent `a3/a` has a Virtual Effector but no Real Effector",
+        add(EFFECTOR_AGENT),
+    ),
+    Case(
+        "EARL-E007",
+        add(
+            edit(
+                ("    cam/rr {\n        raw/ob: double\n    }\n", ""),
+                ("    link cam,s: cam/rr.raw -> s/vr.raw\n", ""),
+                text=RECEPTOR_AGENT,
+            )
+        ),
+        48,
+        1,
+        "agent `a4/a` has a Virtual Receptor but no Real Receptor",
+        add(RECEPTOR_AGENT),
+    ),
+    Case(
+        "EARL-E008",
+        add(
+            edit(
+                ("        drive/ib: double\n", ""),
+                ("    link m,d: m/ve.drive -> d/re.drive\n", ""),
+                text=EFFECTOR_AGENT,
+            )
+        ),
+        56,
+        5,
+        "Real Effector `a3/a.d/re` has no Input Buffer",
+        add(EFFECTOR_AGENT),
+    ),
+    Case(
+        "EARL-E010",
+        edit(("inp/ib: double", "inp/ib: int")),
+        40,
+        1,
+        "link `a1,a2` sends `double` into an Input Buffer of type `int`",
+        BASE,
+    ),
+    Case(
+        "EARL-E011",
+        add("a3/a {\n    cs {\n        out/ob: double\n    }\n}\n\nlink a3,a2: a3/a.cs.out -> a2/a.cs.inp\n"),
+        54,
+        1,
+        "`a2/a.cs.inp/ib` is fed by link `a1,a2` and by link `a3,a2`",
+        add(
+            "a3/a {\n    cs {\n        out/ob: double\n    }\n}\n\nlink a3,a1: a3/a.cs.out -> a1/a.cs.inp\n",
+            text=edit(
+                ("        out/ob: double\n        x/m", "        out/ob: double\n        inp/ib: double\n        x/m")
+            ),
+        ),
+    ),
+    Case(
+        "EARL-E012",
+        add(
+            edit(
+                ("    link m,d: m/ve.drive -> d/re.drive\n", "    link cs,d: cs.cmd -> d/re.drive\n"),
+                text=EFFECTOR_AGENT,
+            )
+        ),
+        60,
+        5,
+        "a link from a Control Subsystem to a Real Effector is not permitted inside an agent (link `cs,d`)",
+        add(EFFECTOR_AGENT),
+    ),
+    Case(
+        "EARL-E013",
+        add(EFFECTOR_AGENT + "\nlink a1,a3: a1/a.cs.out -> a3/a.m/ve.cmd\n"),
+        63,
+        1,
+        "inter-agent link `a1,a3` ends at `a3/a.m/ve`, not at a Control Subsystem",
+        add(EFFECTOR_AGENT),
+    ),
+    Case(
+        "EARL-E013",
+        add(
+            "link a1,a1: a1/a.cs.out -> a1/a.cs.inp\n",
+            text=edit(
+                ("        out/ob: double\n        x/m", "        out/ob: double\n        inp/ib: double\n        x/m")
+            ),
+        ),
+        49,
+        1,
+        "link `a1,a1` starts and ends in `a1/a`",
+        BASE,
+    ),
+    Case(
+        "EARL-E014",
+        add(edit(("    link cs,m: cs.cmd -> m/ve.cmd\n", ""), text=EFFECTOR_AGENT)),
+        56,
+        5,
+        "`a3/a.d/re` is not on a chain cs → ve → re",
+        add(EFFECTOR_AGENT),
+    ),
+    Case(
+        "EARL-E015",
+        add(edit(("    link s,cs: s/vr.data -> cs.data\n", ""), text=RECEPTOR_AGENT)),
+        56,
+        5,
+        "`a4/a.cam/rr` is not on a chain rr → vr → cs",
+        add(RECEPTOR_AGENT),
+    ),
+    Case(
+        "EARL-E030",
+        edit(("go/pp = x/mi > 1.0", "go/pp = x/mi + 1.0")),
+        7,
+        17,
+        "primitive predicate `go/pp` is a number, not a Boolean",
+        BASE,
+    ),
+    Case(
+        "EARL-E030",
+        edit(("tc = go/pp\n", "tc = go/pp or x/mi\n")),
+        12,
+        27,
+        "an operand of `or` must be a boolean, but `x/mi` is a number",
+        edit(("tc = go/pp\n", "tc = go/pp or x/mi > 3.0\n")),
+    ),
+    Case(
+        "EARL-E040",
+        edit(("tf = {compute/pf} then {emit/pf}", "tf = {compute/pf, emit/pf}")),
+        11,
+        31,
+        "`emit/pf` writes `out/ob` in stage 1 of `run/bb`",
+        BASE,
+    ),
+    Case(
+        "EARL-E040",
+        edit(("tf = {take/pf}", "tf = {take/pf} then {take/pf}")),
+        29,
+        34,
+        "`take/pf` reads `inp/ib` in the last stage of `run/bb`",
+        BASE,
+    ),
+    Case(
+        "EARL-E041",
+        edit(
+            (
+                "        emit/pf(x/mi -> out/ob)\n",
+                "        emit/pf(x/mi -> out/ob)\n        stage pf = {emit/pf}\n        stage pfo = {compute/pf}\n",
+            )
+        ),
+        13,
+        19,
+        "`compute/pf` is in a stage of `run/bb` that takes its functions from `pf`, which does not contain it",
+        edit(
+            (
+                "        emit/pf(x/mi -> out/ob)\n",
+                "        emit/pf(x/mi -> out/ob)\n        stage pf = {compute/pf}\n        stage pfo = {emit/pf}\n",
+            )
+        ),
+    ),
+    Case(
+        "EARL-E041",
+        edit(
+            ("        emit/pf(x/mi -> out/ob)\n", "        emit/pf(x/mi -> out/ob)\n        stage pfo = {emit/pf}\n"),
+            ("tf = {compute/pf} then {emit/pf}", "tf = {compute/pf} then {emit/pf} then {emit/pf}"),
+        ),
+        12,
+        13,
+        "`run/bb` has 3 stages but `cs` declares 1 stage sets",
+        edit(
+            (
+                "        emit/pf(x/mi -> out/ob)\n",
+                "        emit/pf(x/mi -> out/ob)\n        stage pf = {compute/pf}\n        stage pfo = {emit/pf}\n",
+            )
+        ),
+    ),
+    Case(
+        "EARL-E042",
+        edit(
+            (
+                "        compute/pf(x/mi -> x/mo)\n",
+                "        compute/pf(x/mi -> x/mo)\n        compute2/pf(x/mi -> x/mo)\n",
+            ),
+            ("tf = {compute/pf}", "tf = {compute/pf, compute2/pf}"),
+        ),
+        12,
+        31,
+        "`compute/pf` and `compute2/pf` both write `x/m` in stage 1 of `run/bb`",
+        edit(
+            (
+                "        compute/pf(x/mi -> x/mo)\n",
+                "        compute/pf(x/mi -> x/mo)\n        compute2/pf(x/mi -> z/mo)\n",
+            ),
+            ("        x/m: double = 0.0\n", "        x/m: double = 0.0\n        z/m: double = 0.0\n"),
+            ("tf = {compute/pf}", "tf = {compute/pf, compute2/pf}"),
+        ),
+    ),
+    Case(
+        "EARL-E060",
+        edit(TWO_STATES),
+        19,
+        13,
+        "transitions `run,run/t` and `run,other/t` of a1/a.cs can both hold, e.g. when go/pp = true",
+        edit(TWO_STATES, ("run -> other when go/pp\n", "run -> other when go/pp priority 1\n")),
+    ),
+    Case(
+        "EARL-I063",
+        edit(
+            ("        got/pp = newData(inp/ib)\n", "        got/pp = newData(inp/ib)\n        false/pp = false\n"),
+            ("tc = got/pp", "tc = false/pp"),
+        ),
+        29,
+        9,
+        "`run/bb` never ends: its terminal and error conditions can never hold, so state `run` of a2/a.cs is never left",
+        BASE,
+    ),
+    Case(
+        "EARL-W001",
+        add("a3/a {\n    cs {\n    }\n}\n"),
+        48,
+        1,
+        "agent `a3/a` is of type C (zombie)",
+        add(EFFECTOR_AGENT),
+    ),
+    Case(
+        "EARL-W010",
+        edit(("link a1,a2: a1/a", "link a2,a1: a1/a"), ("    link a1,a2\n}", "    link a2,a1\n}")),
+        40,
+        1,
+        "link `a2,a1` is not named after its ends; §2.5 suggests `a1,a2`",
+        BASE,
+    ),
+    Case(
+        "EARL-W010",
+        add(edit(("link cs,m: cs.cmd", "link cs,d: cs.cmd"), text=EFFECTOR_AGENT)),
+        59,
+        5,
+        "link `cs,d` is not named after its ends; §2.5 suggests `cs,m`",
+        add(EFFECTOR_AGENT),
+    ),
+    Case(
+        "EARL-W020",
+        edit(
+            (
+                "state run: run/bb\n            run -> run when go/pp",
+                "state run: run/bb\n            state lost: run/bb\n            run -> run when go/pp",
+            )
+        ),
+        17,
+        13,
+        "state `lost` of a1/a.cs is unreachable from the initial state `run`",
+        edit(TWO_STATES),
+    ),
+    Case(
+        "EARL-W021",
+        edit(("            run -> run when go/pp\n", "")),
+        16,
+        13,
+        "state `run` of a1/a.cs has no way out: `run/bb` can stop, but no transition leaves it",
+        BASE,
+    ),
+    Case(
+        "EARL-W030",
+        edit(("        go/pp = x/mi > 1.0\n", "        go/pp = x/mi > 1.0\n        unused/pp = x/mi > 2.0\n")),
+        8,
+        9,
+        "primitive predicate `unused/pp` is never used",
+        BASE,
+    ),
+    Case(
+        "EARL-W040",
+        edit(("        out/ob: double\n", "        out/ob: double\n        spare/ob: double\n")),
+        6,
+        9,
+        "output buffer `spare/ob` is never written by a function of any behaviour",
+        BASE,
+    ),
+    Case(
+        "EARL-W041",
+        edit(("x/m: double = 0.0", "x/m: double")),
+        11,
+        19,
+        "`compute/pf` reads `x/mi` in the first iteration of `run/bb`",
+        BASE,
+    ),
+    Case(
+        "EARL-W042",
+        edit(
+            ("        emit/pf(x/mi -> out/ob)\n", "        emit/pf(x/mi -> out/ob)\n        spare/pf(x/mi -> x/mo)\n")
+        ),
+        10,
+        9,
+        "partial transition function `spare/pf` is not used by any behaviour",
+        BASE,
+    ),
+    Case(
+        "EARL-W061",
+        edit(("run -> run when go/pp", "run -> run when go/pp and x/mi > 2.0")),
+        16,
+        13,
+        "`run/bb` can stop while no transition out of `run` holds (a1/a.cs), e.g. when go/pp = true, x/mi > 2.0 = false",
+        BASE,
+    ),
+    Case(
+        "EARL-W062",
+        edit(TWO_STATES, ("run -> other when go/pp\n", "run -> other when go/pp and not go/pp\n")),
+        19,
+        13,
+        "transition `run,other/t` of a1/a.cs can never be taken: its condition never holds",
+        edit(TWO_STATES, ("run -> other when go/pp\n", "run -> other when go/pp priority 1\n")),
+    ),
+]
+
+
+def findings(text: str, code: str | None = None) -> list[Diagnostic]:
+    diagnostics = check(earl.loads(text, "spec.earl"))
+    return [d for d in diagnostics if code is None or d.code == code]
+
+
+def test_base_spec_is_clean() -> None:
+    assert BASE.count("\n") == 46  # the line numbers of the cases count on it
+    assert findings(BASE) == []
+
+
+def test_every_rule_has_a_failing_and_a_passing_case() -> None:
+    assert {case.code for case in CASES} == set(RULES)
+
+
+@pytest.mark.parametrize("case", CASES, ids=lambda case: f"{case.code}:{case.fragment[:30]}")
+def test_rule_points_at_the_finding(case: Case) -> None:
+    found = findings(case.failing, case.code)
+    assert found, f"{case.code} not reported; got {[str(d) for d in findings(case.failing)]}"
+    at_spot = [
+        d for d in found if d.location is not None and (d.location.line, d.location.column) == (case.line, case.column)
+    ]
+    assert at_spot, f"{case.code} reported at {[str(d.location) for d in found]}, not {case.line}:{case.column}"
+    assert any(case.fragment in d.message for d in at_spot), [d.message for d in at_spot]
+    rule = RULES[case.code]
+    for diagnostic in found:
+        assert diagnostic.severity is rule.severity
+        assert diagnostic.location is not None and diagnostic.location.file == "spec.earl"
+
+
+@pytest.mark.parametrize("case", CASES, ids=lambda case: f"{case.code}:{case.fragment[:30]}")
+def test_rule_keeps_quiet_on_the_passing_spec(case: Case) -> None:
+    assert [str(d) for d in findings(case.passing, case.code)] == []
+
+
+def test_findings_are_ordered_by_position() -> None:
+    text = add(EFFECTOR_AGENT.replace("    link cs,m: cs.cmd -> m/ve.cmd\n", ""), text=edit(TWO_STATES))
+    positions = [(d.location.line, d.location.column) for d in findings(text) if d.location is not None]
+    assert len(positions) >= 2
+    assert positions == sorted(positions)
+
+
+# ---------------------------------------------------------------- the manual's example
+
+
+def example_text() -> str:
+    return EXAMPLE.read_text(encoding="utf-8")
+
+
+def test_the_example_has_no_errors_or_warnings() -> None:
+    diagnostics = check(earl.load(EXAMPLE))
+    assert [str(d) for d in diagnostics if d.severity is not Severity.NOTE] == []
+
+
+def test_the_example_notes_exactly_its_false_pp_behaviours() -> None:
+    """Every behaviour whose only condition is `tc = false/pp` never ends (a sink state), and no other."""
+    system = earl.load(EXAMPLE)
+    sinks = {
+        behaviour.location.line
+        for agent in system.agents
+        for subsystem in agent.subsystems
+        for behaviour in subsystem.basic_behaviours
+        if behaviour.location is not None
+        and behaviour.error_condition is None
+        and expression_text(behaviour.terminal_condition.expression) == "false/pp"
+    }
+    notes = [d for d in check(system) if d.code == "EARL-I063"]
+    assert len(sinks) == 8
+    assert {d.location.line for d in notes if d.location is not None} == sinks
+    assert all(d.severity is Severity.NOTE for d in notes)
+    assert any("`emergencyStop/bb` never ends" in d.message and "manip/a.cs" in d.message for d in notes)
+
+
+def without_priorities_and_assumptions(text: str) -> str:
+    text = re.sub(r" priority \d+", "", text)
+    return re.sub(r"(?m)^\s*assume .*\n", "", text)
+
+
+def assignment(message: str) -> dict[str, bool]:
+    """The example assignment a finding shows: `… e.g. when a/pp = true, b/pp = false`."""
+    shown = message.split("e.g. when ", 1)[1]
+    pairs = [part.rsplit(" = ", 1) for part in shown.split(", ")]
+    assert all(value in ("true", "false") for _, value in pairs), shown
+    return {name: value == "true" for name, value in pairs}
+
+
+def test_table_5_without_priorities_and_assumption_overlaps() -> None:
+    original = example_text()
+    assert re.search(r" priority \d", original) and re.search(r"(?m)^\s*assume ", original)
+    text = without_priorities_and_assumptions(original)
+    assert not re.search(r" priority \d|^\s*assume ", text, re.MULTILINE)
+    overlaps = findings(text, "EARL-E060")
+    wanted = [d for d in overlaps if "`jointMove,jointMove/t` and `jointMove,idle/t`" in d.message]
+    assert len(wanted) == 1, [d.message for d in overlaps]
+    finding = wanted[0]
+    assert "manip/a.cs" in finding.message
+    values = assignment(finding.message)
+    assert values["newJointPos/pp"] is True
+    assert values["emergencyStop/pp"] is False
+    line = text.splitlines().index("            jointMove -> idle when not emergencyStop/pp") + 1
+    assert finding.location is not None and finding.location.line == line
+    assert finding.hint is not None and "priorit" in finding.hint
+
+
+def test_the_assumption_alone_separates_the_two_new_set_points() -> None:
+    """Without priorities but with the `assume`, idle's two moves no longer overlap; jointMove's still do."""
+    text = re.sub(r" priority \d+", "", example_text())
+    messages = [d.message for d in findings(text, "EARL-E060")]
+    assert not any("`idle,jointMove/t` and `idle,operationalMove/t`" in m for m in messages)
+    assert any("`jointMove,jointMove/t` and `jointMove,idle/t`" in m for m in messages)
+    without = [d.message for d in findings(without_priorities_and_assumptions(example_text()), "EARL-E060")]
+    assert any("`idle,jointMove/t` and `idle,operationalMove/t`" in m for m in without)
+
+
+def test_a_stuck_state_shows_an_assignment_that_sticks() -> None:
+    text = edit(
+        ("            jointMove -> idle when not emergencyStop/pp priority 3\n", ""),
+        text=example_text(),
+    )
+    stuck = findings(text, "EARL-W061")
+    assert len(stuck) == 1
+    message = stuck[0].message
+    assert "`jointMove/bb` can stop while no transition out of `jointMove` holds (manip/a.cs)" in message
+    values = assignment(message)
+    # tc = motionFinished or emergencyStop, and neither `* -> emergencyStop` nor jointMove -> jointMove holds
+    assert values["emergencyStop/pp"] is False
+    assert values["motionFinished/pp"] is True
+    assert values["newJointPos/pp"] is False
+
+
+# ---------------------------------------------------------------- Table 1
+
+
+def test_table_1_types_of_the_example() -> None:
+    system = earl.load(EXAMPLE)
+    context = context_for(system)
+    declared = {agent.name: context.agent_type(agent).name for agent in system.agents}
+    expanded = {agent.name: context.agent_type(agent).name for agent in context.system.agents}
+    assert declared == expanded == {"task": "CT", "manip": "CET", "grip": "CET"}
+
+
+def typed_agent(effectors: bool, receptors: bool, transmission: bool) -> str:
+    """A system whose agent `x/a` has exactly the activities asked for."""
+    cs = ["cmd/ob: double"] * effectors + ["data/ib: double"] * receptors + ["tx/ob: double"] * transmission
+    parts = ["    cs {", *(f"        {line}" for line in cs), "    }"]
+    if effectors:
+        parts += ["    m/ve {", "        cmd/ib: double", "        drive/ob: double", "    }"]
+        parts += ["    d/re {", "        drive/ib: double", "    }"]
+        parts += ["    link cs,m: cs.cmd -> m/ve.cmd", "    link m,d: m/ve.drive -> d/re.drive"]
+    if receptors:
+        parts += ["    s/vr {", "        raw/ib: double", "        data/ob: double", "    }"]
+        parts += ["    cam/rr {", "        raw/ob: double", "    }"]
+        parts += ["    link cam,s: cam/rr.raw -> s/vr.raw", "    link s,cs: s/vr.data -> cs.data"]
+    text = "system types\n\nx/a {\n" + "\n".join(parts) + "\n}\n"
+    members = "x/a"
+    if transmission:
+        text += "\np/a {\n    cs {\n        rx/ib: double\n    }\n}\n\nlink x,p: x/a.cs.tx -> p/a.cs.rx\n"
+        members += " p/a"
+    return text + f"\nr/r {{ {members} }}\n"
+
+
+TABLE_1 = [
+    ("C", False, False, False),
+    ("CT", False, False, True),
+    ("CE", True, False, False),
+    ("CR", False, True, False),
+    ("CET", True, False, True),
+    ("CRT", False, True, True),
+    ("CER", True, True, False),
+    ("CERT", True, True, True),
+]
+
+
+@pytest.mark.parametrize(("name", "effectors", "receptors", "transmission"), TABLE_1)
+def test_table_1_agent_type(name: str, effectors: bool, receptors: bool, transmission: bool) -> None:
+    system: System = earl.loads(typed_agent(effectors, receptors, transmission))
+    context = context_for(system)
+    agent = system.agent("x")
+    assert agent is not None
+    row = context.agent_type(agent)
+    assert (row.name, row.effectors, row.receptors, row.transmission) == (name, effectors, receptors, transmission)
+    if transmission:
+        partner = system.agent("p")
+        assert partner is not None
+        assert context.agent_type(partner).name == "CT"  # receiving counts as communicating too
+    diagnostics = check(system)
+    assert [d.code for d in diagnostics if d.severity is Severity.ERROR] == []
+    zombies = [d for d in diagnostics if d.code == "EARL-W001"]
+    assert bool(zombies) == (name == "C")
+
+
+def test_table_1_counts_every_member_of_an_agent_family() -> None:
+    text = edit(
+        ("a2/a {", "a2[K in 1..2]/a {"),
+        ("link a1,a2: a1/a.cs.out -> a2/a.cs.inp", "link a1,a2[K in 1..2]: a1/a.cs.out -> a2[K]/a.cs.inp"),
+        ("    a2/a\n    link a1,a2\n", "    a2[1]/a\n    a2[2]/a\n"),
+    )
+    system = earl.loads(text)
+    context = context_for(system)
+    assert [context.agent_type(agent).name for agent in context.system.agents] == ["CT", "CT", "CT"]
+    family = system.agent("a2")
+    assert family is not None
+    assert context.agent_type(family).name == "CT"
+    assert findings(text) == []
