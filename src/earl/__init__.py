@@ -14,11 +14,15 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from earl.diagnostics import Diagnostic, EarlError, Severity
 from earl.model import *  # noqa: F403  (the model's names are the API)
 from earl.model import __all__ as _model_names
 from earl.model.elements import System
+
+if TYPE_CHECKING:
+    from earl.runtime import Simulation
 
 ParameterValue = bool | int | float | str
 
@@ -49,6 +53,17 @@ def loads(text: str, path: str = "<text>", parameters: Mapping[str, ParameterVal
     return load_text(text, path, parameters)
 
 
+def simulate(system: System, **options: object) -> Simulation:
+    """Run `system` in virtual time: `sim = earl.simulate(model, seed=1); sim.advance_to(2.0)`.
+
+    Options are those of `earl.runtime.Simulation` (parameters, seed, environment, trace,
+    record_memory, realtime, …).  This imports the user code the spec names.
+    """
+    from earl.runtime import simulate as run
+
+    return run(system, **options)
+
+
 __version__ = "0.1.0"
 
-__all__ = ["Diagnostic", "EarlError", "Severity", "__version__", "load", "loads", "save", *_model_names]
+__all__ = ["Diagnostic", "EarlError", "Severity", "__version__", "load", "loads", "save", "simulate", *_model_names]

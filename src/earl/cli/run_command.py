@@ -1,0 +1,217 @@
+"""`earl run SPEC`: execute a specification in virtual time (default) or real time."""
+
+from __future__ import annotations
+
+import argparse
+import signal
+import statistics
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+from rich.console import Console
+from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+from rich.table import Table
+
+from earl.cli.common import UsageError, parse_parameter, spec_path, usage_error
+from earl.cli.output import print_diagnostics
+from earl.diagnostics import EarlError
+
+EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
+
+EPILOG = """\
+examples:
+  earl run examples/pick_and_place                        the manual's example, 10 s simulated
+  earl run examples/pick_and_place --param N=3 --trace run.mcap --record-memory manip/a.cs
+  earl run spec.earl --duration 30s --seed 7              another seed, another random stream
+  earl run spec.earl --realtime --duration 5s             paced by the wall clock, jitter reported
+
+Subsystems are named like manip/a.cs or manip/a.motorController[3]/ve. A `run.toml` next
+to the spec may set defaults: environment, duration, seed, record_memory, report.
+The spec is checked first; its errors stop the run. Only `earl run` imports the Python
+code a spec names (docs/runtime.md).
+
+exit codes: 0 the run completed, 1 invalid spec or the run could not start,
+            2 usage error, 130 interrupted (the trace is closed and readable)
+"""
+
+
+def register(commands: Any) -> None:
+    parser = commands.add_parser(
+        "run",
+        help="execute a specification (virtual time by default), optionally recording an MCAP trace",
+        description="Run SPEC: every subsystem iterates its basic behaviours as Figure 5 of the EARL manual "
+        "defines, links carry messages, FSMs change state. Virtual time (the default) is deterministic and "
+        "faster than real time: the same spec and seed give a byte-identical trace.",
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("spec", metavar="SPEC", help="the .earl file, or a directory with a system.earl")
+    parser.add_argument("--duration", metavar="TIME", help="run time, e.g. 10s, 500ms (default 10s or run.toml)")
+    parser.add_argument("--realtime", action="store_true", help="pace the run by the wall clock, report jitter")
+    parser.add_argument("--trace", metavar="FILE.mcap", help="record an MCAP trace (opens in Foxglove)")
+    parser.add_argument("--seed", type=int, help="seed of the subsystems' random streams (default 0)")
+    parser.add_argument(
+        "--param", action="append", default=[], metavar="NAME=VALUE", help="set a system parameter (repeatable)"
+    )
+    parser.add_argument(
+        "--environment", metavar="MODULE:FACTORY", help="the environment (physics) factory; default from run.toml"
+    )
+    parser.add_argument(
+        "--record-memory",
+        action="append",
+        default=None,
+        metavar="SUBSYSTEM",
+        help="record memory snapshots of a subsystem after each iteration (repeatable; `all` for every one)",
+    )
+    parser.add_argument(
+        "--record-links",
+        action="append",
+        default=None,
+        metavar="PATTERN",
+        help="record only messages on links matching a glob, e.g. 'task,*' (repeatable; default: all)",
+    )
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    parser.set_defaults(run=run)
+
+
+def run(arguments: argparse.Namespace) -> int:
+    from earl.lang.loader import load
+    from earl.runtime.durations import parse_duration
+    from earl.runtime.simulation import Simulation, read_run_settings
+
+    try:
+        path = spec_path(arguments.spec)
+        parameters = dict(parse_parameter(p) for p in arguments.param)
+        settings = read_run_settings(path)
+        duration = parse_duration(arguments.duration) if arguments.duration else (settings.duration or 10.0)
+    except (UsageError, ValueError) as error:
+        return usage_error(str(error))
+    seed = arguments.seed if arguments.seed is not None else (settings.seed or 0)
+    environment = arguments.environment or settings.environment
+    record_memory = arguments.record_memory if arguments.record_memory is not None else settings.record_memory
+    try:
+        system = load(path, parameters)
+        simulation = Simulation(
+            system,
+            parameters=parameters,
+            seed=seed,
+            environment=environment,
+            trace=arguments.trace,
+            record_memory=record_memory,
+            record_links=arguments.record_links,
+            realtime=arguments.realtime,
+        )
+    except EarlError as error:
+        print_diagnostics(error.diagnostics, error.sources)
+        print("earl run: the specification cannot run; nothing was executed", file=sys.stderr)
+        return EXIT_FAILED
+    except ValueError as error:
+        return usage_error(str(error))
+    except OSError as error:
+        return usage_error(f"cannot write the trace: {error}")
+    return _execute(simulation, duration, arguments, settings.report, path)
+
+
+def _execute(simulation: Any, duration: float, arguments: argparse.Namespace, report: str | None, path: Path) -> int:
+    console = Console(stderr=True, highlight=False)
+    interrupted = False
+    previous = signal.getsignal(signal.SIGTERM)
+
+    def stop(*_: object) -> None:
+        raise KeyboardInterrupt
+
+    signal.signal(signal.SIGTERM, stop)
+    started = time.perf_counter()
+    steps = 200
+    progress: Progress | None = None
+    try:
+        for step in range(1, steps + 1):
+            simulation.advance_to(duration * step / steps)
+            elapsed = time.perf_counter() - started
+            if progress is None and elapsed > 1.0 and not arguments.no_progress and console.is_terminal:
+                progress = Progress(
+                    TextColumn("[bold]earl run[/bold]"),
+                    BarColumn(),
+                    TextColumn("{task.fields[simulated]}"),
+                    TimeRemainingColumn(),
+                    console=console,
+                    transient=True,
+                )
+                progress.start()
+                progress.add_task("run", total=steps, completed=step, simulated="")
+            if progress is not None:
+                progress.update(progress.task_ids[0], completed=step, simulated=f"{simulation.time:.2f} s")
+    except KeyboardInterrupt:
+        interrupted = True
+    finally:
+        if progress is not None:
+            progress.stop()
+        wall = time.perf_counter() - started
+        simulation.close()
+        signal.signal(signal.SIGTERM, previous)
+    _summary(simulation, wall, arguments)
+    if report:
+        _report(simulation, report, path, console)
+    if interrupted:
+        console.print(f"earl run: interrupted at {simulation.time:.3f} s; the trace is closed")
+        return EXIT_INTERRUPTED
+    return EXIT_OK
+
+
+def _summary(simulation: Any, wall: float, arguments: argparse.Namespace) -> None:
+    console = Console(highlight=False)
+    table = Table(title=f"system {simulation.system.name}: {simulation.time:.3f} s", title_justify="left")
+    table.add_column("subsystem")
+    table.add_column("state at the end")
+    table.add_column("iterations", justify="right")
+    table.add_column("transitions", justify="right")
+    table.add_column("faults", justify="right")
+    if arguments.realtime:
+        table.add_column("start lateness p50 / p99", justify="right")
+        table.add_column("overruns", justify="right")
+    for name in simulation.subsystems:
+        state = simulation.state_of(name)
+        stats = simulation.statistics.subsystems.get(name)
+        transitions = sum(stats.transitions.values()) if stats else 0
+        row = [name, state.state, str(state.iterations), str(transitions), str(state.faults)]
+        if arguments.realtime:
+            lateness = simulation.scheduler.lateness.get(name)
+            if lateness and lateness.samples:
+                samples = sorted(lateness.samples)
+                p50 = statistics.median(samples) / 1e3
+                p99 = samples[min(len(samples) - 1, int(0.99 * len(samples)))] / 1e3
+                row += [f"{p50:.0f} µs / {p99:.0f} µs", str(lateness.overruns)]
+            else:
+                row += ["–", "0"]
+        table.add_row(*row)
+    console.print(table)
+    faults = simulation.faults
+    if faults:
+        console.print(f"[yellow]{len(faults)} fault(s)[/yellow]; the first:")
+        first = faults[0]
+        console.print(f"  t={first.time / 1e9:.6f} s {first.subsystem} ({first.kind}): {first.message}")
+    ratio = simulation.time / wall if wall > 0 else float("inf")
+    mode = "real time" if arguments.realtime else "virtual time"
+    console.print(f"ran {simulation.time:.3f} s of {mode} in {wall:.2f} s of wall time ({ratio:.1f}x real time)")
+    if arguments.trace:
+        console.print(f"trace: {arguments.trace} (earl trace summary {arguments.trace}; opens in Foxglove)")
+
+
+def _report(simulation: Any, report: str, path: Path, console: Console) -> None:
+    """The example's own closing lines (`report = "module:function"` in run.toml)."""
+    from earl.runtime.binding import BindingProblem, resolve_callable, user_code_path
+
+    with user_code_path([path.resolve().parent]):
+        try:
+            function = resolve_callable(report, "the run report", None, arity=1)
+            text = function(simulation)
+        except BindingProblem as problem:
+            console.print(f"earl run: {problem.diagnostic.message}")
+            return
+        except Exception as error:  # the report is the example's code: say what failed, keep the exit code
+            console.print(f"earl run: the report `{report}` failed: {type(error).__name__}: {error}")
+            return
+    if text:
+        print(text)

@@ -1,0 +1,103 @@
+"""`earl trace summary FILE` and `earl plot FILE --signal …`: reading a run's MCAP trace."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+from typing import Any
+
+from rich.console import Console
+from rich.table import Table
+
+from earl.cli.common import usage_error
+
+EXIT_OK, EXIT_FAILED = 0, 1
+
+
+def register(commands: Any) -> None:
+    trace = commands.add_parser(
+        "trace",
+        help="read an MCAP trace written by `earl run --trace`",
+        description="Read a trace written by `earl run --trace FILE.mcap`.",
+        epilog="example:\n  earl trace summary run.mcap\n\nexit codes: 0 ok, 1 not a readable earl trace",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    actions = trace.add_subparsers(dest="action", metavar="ACTION", parser_class=type(trace))
+    summary = actions.add_parser(
+        "summary",
+        help="per subsystem: time in each state, transitions taken, faults",
+        description="Per subsystem: the time spent in each FSM state, the transitions taken and the faults.",
+    )
+    summary.add_argument("file", metavar="FILE.mcap")
+    summary.set_defaults(run=run_summary)
+    trace.set_defaults(run=lambda _arguments: (trace.print_help(), 2)[1])
+
+    plot = commands.add_parser(
+        "plot",
+        help="plot signals of a trace, with the FSM states as shaded bands (PNG)",
+        description="Plot signals recorded in a trace against time; the FSM states of each signal's "
+        "subsystem are shaded behind it. A signal is memory (recorded with --record-memory), e.g. "
+        "manip/a.cs.windingCurrent[1], or a field of what an output buffer sent, e.g. "
+        "manip/a.cs.manipulatorState.currentJointPos[0].",
+        epilog="example:\n  earl plot run.mcap --signal manip/a.cs.windingCurrent[1] -o current.png\n\n"
+        "exit codes: 0 written, 1 the trace lacks a signal or is unreadable, 2 usage error",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    plot.add_argument("file", metavar="FILE.mcap")
+    plot.add_argument("--signal", action="append", required=True, metavar="SIGNAL", help="repeatable")
+    plot.add_argument("-o", "--output", default="plot.png", metavar="FILE.png", help="default plot.png")
+    plot.add_argument("--title", help="a title over the figure")
+    plot.set_defaults(run=run_plot)
+
+
+def run_summary(arguments: argparse.Namespace) -> int:
+    from earl.runtime.trace_reader import TraceError, summarise
+
+    path = Path(arguments.file)
+    if not path.is_file():
+        return usage_error(f"no such file: {arguments.file}")
+    try:
+        summary = summarise(path)
+    except TraceError as error:
+        sys.stderr.write(f"earl trace: {error}\n")
+        return EXIT_FAILED
+    console = Console(highlight=False)
+    end = summary.end_time * 1e-9
+    settings = ", ".join(f"{k}={v}" for k, v in summary.settings.items())
+    table = Table(title=f"{path.name}: {end:.3f} s ({settings})", title_justify="left")
+    table.add_column("subsystem")
+    table.add_column("time in each state")
+    table.add_column("transitions taken")
+    table.add_column("iterations", justify="right")
+    table.add_column("faults", justify="right")
+    for name, subsystem in summary.subsystems.items():
+        states = "\n".join(
+            f"{state}: {duration * 1e-9:.3f} s ({100 * duration * 1e-9 / end if end else 0:.0f}%)"
+            for state, duration in sorted(subsystem.state_time.items(), key=lambda item: -item[1])
+        )
+        transitions = "\n".join(f"{t} ×{n}" for t, n in sorted(subsystem.transitions.items())) or "–"
+        table.add_row(name, states, transitions, str(subsystem.iterations), str(subsystem.faults))
+    console.print(table)
+    console.print(f"{summary.messages} messages on links, {len(summary.faults)} faults")
+    for fault in summary.faults[:10]:
+        console.print(f"  t={fault['time'] * 1e-9:.6f} s {fault['subsystem']} ({fault['kind']}): {fault['message']}")
+    if len(summary.faults) > 10:
+        console.print(f"  … and {len(summary.faults) - 10} more")
+    return EXIT_OK
+
+
+def run_plot(arguments: argparse.Namespace) -> int:
+    from earl.runtime.plot import plot_signals
+    from earl.runtime.trace_reader import TraceError
+
+    path = Path(arguments.file)
+    if not path.is_file():
+        return usage_error(f"no such file: {arguments.file}")
+    try:
+        plot_signals(path, arguments.signal, Path(arguments.output), arguments.title)
+    except TraceError as error:
+        sys.stderr.write(f"earl plot: {error}\n")
+        return EXIT_FAILED
+    print(f"wrote {arguments.output}")
+    return EXIT_OK

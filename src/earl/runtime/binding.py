@@ -1,0 +1,156 @@
+"""Binding user code: `= python "pick_and_place.manip:joint_move"` to a Python function.
+
+Everything is bound before anything runs, so that a missing module, a misspelt
+function or a wrong signature is reported at once — located at the spec element
+that names it — and never as a traceback in the middle of a run.  This module and
+the runtime are the only parts of earl that import user code (`earl check`,
+`earl doc` and the exports never do).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import importlib
+import inspect
+import sys
+import traceback
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+from earl.diagnostics import Diagnostic, Severity
+from earl.model.elements import PartialTransitionFunction
+from earl.model.location import SourceLocation
+
+#: A partial transition function as the runtime calls it: `function(inputs, outputs, context)`.
+UserFunction = Callable[[Any, Any, Any], object]
+
+SIGNATURE = "def NAME(inputs, outputs, context) -> None"
+
+
+class BindingProblem(Exception):
+    def __init__(self, diagnostic: Diagnostic) -> None:
+        super().__init__(diagnostic.message)
+        self.diagnostic = diagnostic
+
+
+@contextlib.contextmanager
+def user_code_path(directories: list[Path]) -> Iterator[None]:
+    """Put the spec's directory first on `sys.path` while user modules are imported."""
+    added = [str(d.resolve()) for d in directories if str(d.resolve()) not in sys.path]
+    sys.path[:0] = added
+    try:
+        yield
+    finally:
+        for entry in added:
+            with contextlib.suppress(ValueError):
+                sys.path.remove(entry)
+
+
+def resolve_callable(path: str, what: str, location: SourceLocation | None, arity: int = 3) -> Callable[..., Any]:
+    """Import `module:function` (or `module.function`) and check that it can be called with `arity` arguments."""
+    module_name, function_name = _split(path)
+    if not module_name or not function_name:
+        raise BindingProblem(
+            Diagnostic(
+                Severity.ERROR,
+                f"`{path}` does not name a function: write `module:function`",
+                location,
+                code="EARL-X001",
+                hint='e.g. `= python "pick_and_place.manip:joint_move"`',
+            )
+        )
+    try:
+        module = importlib.import_module(module_name)
+    except ModuleNotFoundError as error:
+        missing = error.name or module_name
+        raise BindingProblem(
+            Diagnostic(
+                Severity.ERROR,
+                f"{what} names the module `{module_name}`, which cannot be found (no module `{missing}`)",
+                location,
+                code="EARL-X002",
+                hint="modules are looked up next to the spec file first, then on the Python path; "
+                f"create `{module_name.replace('.', '/')}.py` there",
+            )
+        ) from None
+    except Exception as error:  # the user's module failed while importing: say where, briefly
+        frame = traceback.extract_tb(error.__traceback__)[-1] if error.__traceback__ else None
+        at = f" ({frame.filename}:{frame.lineno})" if frame else ""
+        raise BindingProblem(
+            Diagnostic(
+                Severity.ERROR,
+                f"importing `{module_name}` for {what} failed: {type(error).__name__}: {error}{at}",
+                location,
+                code="EARL-X003",
+            )
+        ) from None
+    function = getattr(module, function_name, None)
+    if function is None:
+        available = sorted(n for n, v in vars(module).items() if callable(v) and not n.startswith("_"))
+        from earl.diagnostics import did_you_mean
+
+        suggestion = did_you_mean(function_name, available)
+        raise BindingProblem(
+            Diagnostic(
+                Severity.ERROR,
+                f"{what} names `{function_name}`, but the module `{module_name}` has no such function",
+                location,
+                code="EARL-X004",
+                hint=suggestion or f"define `{SIGNATURE.replace('NAME', function_name)}` in `{module.__file__}`",
+            )
+        )
+    if not callable(function):
+        raise BindingProblem(
+            Diagnostic(
+                Severity.ERROR,
+                f"{what} names `{module_name}:{function_name}`, which is a {type(function).__name__}, not a function",
+                location,
+                code="EARL-X004",
+            )
+        )
+    _check_arity(function, arity, f"{module_name}:{function_name}", what, location)
+    return function  # type: ignore[no-any-return]
+
+
+def _split(path: str) -> tuple[str, str]:
+    if ":" in path:
+        module, _, function = path.partition(":")
+    else:
+        module, _, function = path.rpartition(".")
+    return module.strip(), function.strip()
+
+
+def _check_arity(function: Any, arity: int, name: str, what: str, location: SourceLocation | None) -> None:
+    try:
+        signature = inspect.signature(function)
+    except (TypeError, ValueError):
+        return  # a builtin or C function: trust it
+    try:
+        signature.bind(*range(arity))
+    except TypeError:
+        raise BindingProblem(
+            Diagnostic(
+                Severity.ERROR,
+                f"`{name}`{signature} cannot be called as {what} needs: with {arity} arguments",
+                location,
+                code="EARL-X005",
+                hint=f"write it as `{SIGNATURE.replace('NAME', name.rpartition(':')[2])}` (see docs/runtime.md)",
+            )
+        ) from None
+
+
+def bind_function(function: PartialTransitionFunction, owner: str) -> UserFunction:
+    """The Python function implementing a partial transition function of subsystem `owner`."""
+    what = f"`{function.name}/pf` of {owner}"
+    if function.implementation is None:
+        raise BindingProblem(
+            Diagnostic(
+                Severity.ERROR,
+                f"{what} has no implementation, so it cannot run",
+                function.location,
+                code="EARL-X000",
+                hint='bind it to Python code: `... ) = python "module:function"`',
+            )
+        )
+    return resolve_callable(function.implementation.path, what, function.location)

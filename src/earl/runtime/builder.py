@@ -1,0 +1,337 @@
+"""From an expanded System to subsystem engines wired by their links.
+
+Everything that can be wrong before the first iteration is found here and reported
+together, each problem located at the spec element it concerns: code that cannot
+be imported, a subsystem that could never wait (no period and nothing obligatory).
+"""
+
+from __future__ import annotations
+
+import zlib
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from earl.diagnostics import Diagnostic, EarlError, Severity
+from earl.model.elements import Agent, Link, LinkEnd, Subsystem, System
+from earl.model.expressions import ElementReference, Literal
+from earl.model.kinds import Kind
+from earl.model.types import DataType
+from earl.runtime.binding import BindingProblem, UserFunction, bind_function, user_code_path
+from earl.runtime.channels import Channel
+from earl.runtime.engine import (
+    BehaviourRuntime,
+    Destination,
+    FunctionRuntime,
+    StateRuntime,
+    SubsystemEngine,
+    TransitionRuntime,
+)
+from earl.runtime.events import Recorder
+from earl.runtime.names import agent_name, indexed, reference_key, subsystem_name
+from earl.runtime.predicates import PredicateCompileError, compile_predicate
+from earl.runtime.values import TypeSystem, ValueTypeError
+from earl.runtime.views import Context, build_inputs, build_outputs
+
+NANOSECONDS = 1_000_000_000
+
+
+def to_nanoseconds(seconds: float) -> int:
+    return round(seconds * NANOSECONDS)
+
+
+class Network:
+    """The engines of a run, in their deterministic order, and how to find them by name."""
+
+    def __init__(self, types: TypeSystem) -> None:
+        self.types = types
+        self.engines: list[SubsystemEngine] = []
+        self.by_name: dict[str, SubsystemEngine] = {}
+        self.initial_states: dict[str, str] = {}
+        self.links: list[str] = []
+        #: the data type each link carries, and each subsystem's memory types (for trace schemas)
+        self.link_types: dict[str, DataType] = {}
+        self.memory_types: dict[str, dict[str, DataType]] = {}
+        self.output_types: dict[str, dict[str, DataType]] = {}
+        #: link name -> `subsystem.outputBuffer` it carries, so a trace can be read by buffer name
+        self.link_sources: dict[str, str] = {}
+
+
+def build_network(
+    system: System,
+    *,
+    recorder: Recorder,
+    environment: object = None,
+    seed: int = 0,
+    code_directories: list[Path] | None = None,
+    agents: set[str] | None = None,
+) -> Network:
+    """Engines for every subsystem of the expanded `system` (of the agents named in `agents`, if given)."""
+    types = TypeSystem(system)
+    network = Network(types)
+    problems: list[Diagnostic] = []
+    system_parameters = {p.name: _value(p.value) for p in system.parameters}
+    bound: dict[str, UserFunction] = {}
+    directories = code_directories or []
+    keys: dict[tuple[str, int | None, Kind, str, int | None], SubsystemEngine] = {}
+    with user_code_path(directories):
+        for agent in system.agents:
+            if agents is not None and agent_name(agent) not in agents and agent.name not in agents:
+                continue
+            agent_parameters = dict(system_parameters)
+            if agent.family is not None and agent.index is not None:
+                agent_parameters[agent.family.index] = agent.index
+            agent_parameters.update({p.name: _value(p.value) for p in agent.parameters})
+            for subsystem in agent.subsystems:
+                try:
+                    engine = _engine(
+                        agent, subsystem, len(network.engines), agent_parameters, types, recorder, environment, seed
+                    )
+                    _behaviour(engine, subsystem, types, bound, problems)
+                except (ValueTypeError, PredicateCompileError) as error:
+                    problems.append(
+                        Diagnostic(
+                            Severity.ERROR,
+                            f"{subsystem_name(agent, subsystem)} cannot run: {error}",
+                            subsystem.location,
+                            code="EARL-X010",
+                        )
+                    )
+                    continue
+                network.engines.append(engine)
+                network.by_name[engine.name] = engine
+                network.memory_types[engine.name] = {indexed(m.name, m.index): m.data_type for m in subsystem.memories}
+                network.output_types[engine.name] = {
+                    indexed(o.name, o.index): o.data_type for o in subsystem.output_buffers
+                }
+                keys[(agent.name, agent.index, subsystem.kind, subsystem.name, subsystem.index)] = engine
+                if subsystem.fsm is not None:
+                    network.initial_states[engine.name] = subsystem.fsm.initial
+    for agent in system.agents:
+        for link in agent.links:
+            _connect(link, agent, keys, network, problems)
+    for link in system.links:
+        _connect(link, None, keys, network, problems)
+    if problems:
+        raise EarlError(problems, system.sources)  # type: ignore[arg-type]
+    return network
+
+
+def _value(expression: Any) -> Any:
+    return expression.value if isinstance(expression, Literal) else expression
+
+
+def _engine(
+    agent: Agent,
+    subsystem: Subsystem,
+    order: int,
+    agent_parameters: Mapping[str, Any],
+    types: TypeSystem,
+    recorder: Recorder,
+    environment: object,
+    seed: int,
+) -> SubsystemEngine:
+    import numpy
+
+    name = subsystem_name(agent, subsystem)
+    parameters = dict(agent_parameters)
+    if subsystem.family is not None and subsystem.index is not None:
+        parameters[subsystem.family.index] = subsystem.index
+    parameters.update({p.name: _value(p.value) for p in subsystem.parameters})
+    period = None if subsystem.period is None else to_nanoseconds(subsystem.period.seconds)
+    # one stream per subsystem, so that adding a subsystem does not change another's numbers
+    random = numpy.random.default_rng([seed, zlib.crc32(name.encode())])
+    context = Context(name, parameters, None if period is None else period / NANOSECONDS, environment, random)
+    engine = SubsystemEngine(name, order, period, context, recorder)
+    for buffer in subsystem.input_buffers:
+        key = indexed(buffer.name, buffer.index)
+        engine.inputs[key] = types.default(buffer.data_type)
+        engine.new_data[key] = False
+        engine.timed_out[key] = False
+        capacity = None
+        overflow = "dropOldest"
+        if buffer.queue is not None:
+            capacity = int(_value(buffer.queue.capacity))
+            overflow = buffer.queue.overflow
+        engine.channels[key] = Channel(capacity, overflow)
+    for memory in subsystem.memories:
+        key = indexed(memory.name, memory.index)
+        if memory.initial_value is None:
+            engine.memory[key] = types.default(memory.data_type)
+        else:
+            engine.memory[key] = types.constant(memory.initial_value, memory.data_type, f"the initial value of {key}/m")
+    for predicate in subsystem.primitive_predicates:
+        engine.predicates[predicate.name] = compile_predicate(predicate.expression, f"{name} {predicate.name}/pp")
+    return engine
+
+
+def _data_type(subsystem: Subsystem, reference: ElementReference) -> DataType:
+    key = reference_key(reference)
+    if reference.kind is Kind.OUTPUT_BUFFER:
+        for output in subsystem.output_buffers:
+            if indexed(output.name, output.index) == key:
+                return output.data_type
+    else:
+        for memory in subsystem.memories:
+            if indexed(memory.name, memory.index) == key:
+                return memory.data_type
+    raise ValueTypeError(f"`{key}` is not declared in this subsystem")
+
+
+def _behaviour(
+    engine: SubsystemEngine,
+    subsystem: Subsystem,
+    types: TypeSystem,
+    bound: dict[str, UserFunction],
+    problems: list[Diagnostic],
+) -> None:
+    functions: dict[str, FunctionRuntime] = {}
+    for declared in subsystem.partial_transition_functions:
+        try:
+            implementation = declared.implementation
+            cache_key = implementation.path if implementation is not None else ""
+            function = bound.get(cache_key) if cache_key else None
+            if function is None:
+                function = bind_function(declared, engine.name)
+                bound[cache_key] = function
+        except BindingProblem as problem:
+            problems.append(problem.diagnostic)
+            continue
+        functions[declared.name] = FunctionRuntime(
+            declared.name,
+            function,
+            build_inputs(declared.name + "/pf", declared.reads, engine.inputs, engine.memory),
+            build_outputs(
+                declared.name + "/pf",
+                declared.writes,
+                types,
+                engine.memory,
+                lambda reference, s=subsystem: _data_type(s, reference),  # type: ignore[misc]
+            ),
+        )
+    behaviours: dict[str, BehaviourRuntime] = {}
+    for behaviour in subsystem.basic_behaviours:
+        stages = [
+            [functions[reference.name] for reference in stage if reference.name in functions]
+            for stage in behaviour.transition_function.stages
+        ]
+        error_condition = (
+            None
+            if behaviour.error_condition is None
+            else compile_predicate(behaviour.error_condition.expression, f"{engine.name} {behaviour.name}/bb ec")
+        )
+        behaviours[behaviour.name] = BehaviourRuntime(
+            behaviour.name,
+            stages,
+            compile_predicate(behaviour.terminal_condition.expression, f"{engine.name} {behaviour.name}/bb tc"),
+            error_condition,
+        )
+    fsm = subsystem.fsm
+    if fsm is None:
+        problems.append(
+            Diagnostic(Severity.ERROR, f"{engine.name} has no `fsm`, so it cannot run", subsystem.location, "EARL-X011")
+        )
+        return
+    for state in fsm.states:
+        leaving = [
+            (position, transition)
+            for position, transition in enumerate(fsm.transitions)
+            if transition.source == state.name
+        ]
+        # priority 1 first; transitions without a priority after all that have one, in declaration order
+        leaving.sort(key=lambda item: (item[1].priority is None, item[1].priority or 0, item[0]))
+        behaviour_runtime = behaviours.get(state.behaviour)
+        if behaviour_runtime is None:
+            continue
+        obligatory = [reference_key(reference) for reference in state.obligatory]
+        timeout = None if state.timeout is None else to_nanoseconds(state.timeout.seconds)
+        if engine.period is None and not obligatory:
+            problems.append(
+                Diagnostic(
+                    Severity.ERROR,
+                    f"{engine.name} has no `period` and state `{state.name}` waits for no obligatory buffer, "
+                    "so nothing would ever pace it",
+                    state.location,
+                    code="EARL-X012",
+                    hint="give the subsystem a `period`, or list the buffers it waits for: "
+                    "`state NAME: BEHAVIOUR/bb { obligatory x/ib }`",
+                )
+            )
+        engine.states[state.name] = StateRuntime(
+            state.name,
+            behaviour_runtime,
+            obligatory,
+            timeout,
+            [
+                TransitionRuntime(
+                    f"{transition.source},{transition.destination}",
+                    transition.destination,
+                    compile_predicate(
+                        transition.condition.expression,
+                        f"{engine.name} {transition.source},{transition.destination}/t",
+                    ),
+                )
+                for _, transition in leaving
+            ],
+        )
+
+
+def _end_engine(
+    end: LinkEnd,
+    agent: Agent | None,
+    keys: dict[tuple[str, int | None, Kind, str, int | None], SubsystemEngine],
+) -> SubsystemEngine | None:
+    if end.agent is not None:
+        agent_key = (end.agent.name, _index(end.agent))
+    elif agent is not None:
+        agent_key = (agent.name, agent.index)
+    else:
+        return None
+    subsystem = end.subsystem
+    return keys.get((*agent_key, subsystem.kind, subsystem.name, _index(subsystem)))
+
+
+def _index(reference: ElementReference) -> int | None:
+    if not reference.indices:
+        return None
+    index = reference.indices[0]
+    return index.value if isinstance(index, Literal) and isinstance(index.value, int) else None
+
+
+def _connect(
+    link: Link,
+    agent: Agent | None,
+    keys: dict[tuple[str, int | None, Kind, str, int | None], SubsystemEngine],
+    network: Network,
+    problems: list[Diagnostic],
+) -> None:
+    source = _end_engine(link.source, agent, keys)
+    destination = _end_engine(link.destination, agent, keys)
+    if source is None or destination is None:
+        return  # an end that runs elsewhere (another process) or was not built
+    buffer = reference_key(link.destination.buffer)
+    channel = destination.channels.get(buffer)
+    if channel is None:
+        problems.append(
+            Diagnostic(
+                Severity.ERROR,
+                f"the link {link.name_text} ends at `{buffer}/ib`, which {destination.name} does not have",
+                link.location,
+                code="EARL-X013",
+            )
+        )
+        return
+    name = link.name_text
+    if agent is not None:
+        name = f"{agent_name(agent)}:{name}"
+    if link.index is not None and "[" not in name:
+        name = f"{name}[{link.index}]"
+    network.links.append(name)
+    source_buffer = reference_key(link.source.buffer)
+    data_type = network.output_types.get(source.name, {}).get(source_buffer)
+    if data_type is not None:
+        network.link_types[name] = data_type
+    network.link_sources[name] = f"{source.name}.{source_buffer}"
+    source.destinations.setdefault(reference_key(link.source.buffer), []).append(
+        Destination(name, channel, destination, buffer)
+    )

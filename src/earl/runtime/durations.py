@@ -1,0 +1,19 @@
+"""`10s`, `500 ms`, `2.5`: durations as people write them on a command line."""
+
+from __future__ import annotations
+
+import re
+
+_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "min": 60.0, "": 1.0}
+_PATTERN = re.compile(r"^\s*([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)\s*(s|ms|us|min|)\s*$")
+
+
+def parse_duration(text: str) -> float:
+    """Seconds; a bare number is seconds. Raises ValueError with an example of what is accepted."""
+    match = _PATTERN.match(text)
+    if match is None:
+        raise ValueError(f"`{text}` is not a duration; write e.g. `10s`, `500ms`, `2.5` (seconds) or `1min`")
+    value = float(match.group(1)) * _UNITS[match.group(2)]
+    if value <= 0:
+        raise ValueError(f"`{text}`: a duration must be positive")
+    return value

@@ -1,0 +1,268 @@
+"""One subsystem at run time: Figure 5 of the manual, to the letter (docs/semantics.md).
+
+`bb.execute()` is one iteration, split in two halves because the receive in the
+middle may have to wait for obligatory buffers:
+
+    execute_and_send()   1. tf.execute(): the stages in order, the functions of a stage
+                            on one snapshot (Eq. 4–8)
+                         2. tf.pf.ob.send(): every output buffer written this iteration
+                         3. iterationNumber += 1
+    receive_and_decide() 4. tf.pf.ib.receive()
+                         5. ec.fun, then tc.fun; when either holds, fsm.selectState()
+                            enters the next state's behaviour (iterationNumber = 0)
+
+A scheduler (virtual or real time) decides when each half runs.
+"""
+
+from __future__ import annotations
+
+import traceback
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from earl.runtime.binding import UserFunction
+from earl.runtime.channels import Channel
+from earl.runtime.events import Fault, Recorder
+from earl.runtime.predicates import CompiledPredicate
+from earl.runtime.values import ValueTypeError
+from earl.runtime.views import Context, Inputs, Outputs, UndeclaredAccess
+
+
+@dataclass
+class FunctionRuntime:
+    """A bound partial transition function with the views it is called with."""
+
+    name: str
+    function: UserFunction
+    inputs: Inputs
+    outputs: Outputs
+
+
+@dataclass
+class BehaviourRuntime:
+    name: str
+    stages: list[list[FunctionRuntime]]
+    terminal_condition: CompiledPredicate
+    error_condition: CompiledPredicate | None
+    #: the output buffers some function of this behaviour may write (in send order)
+    outputs: list[str] = field(default_factory=list)
+
+
+@dataclass
+class TransitionRuntime:
+    name: str  # `idle,jointMove`
+    destination: str
+    condition: CompiledPredicate
+
+
+@dataclass
+class StateRuntime:
+    name: str
+    behaviour: BehaviourRuntime
+    obligatory: list[str]
+    timeout: int | None  # nanoseconds
+    #: leaving transitions, highest priority first, then in declaration order
+    transitions: list[TransitionRuntime]
+
+
+@dataclass
+class Destination:
+    """Where an output buffer's messages go: an input buffer's channel, and the engine that owns it."""
+
+    link: str
+    channel: Channel
+    engine: SubsystemEngine
+    buffer: str
+
+
+class SubsystemEngine:
+    """The run-time state of one subsystem: buffers, memory, the FSM and the running behaviour."""
+
+    def __init__(
+        self,
+        name: str,
+        order: int,
+        period: int | None,
+        context: Context,
+        recorder: Recorder,
+    ) -> None:
+        self.name = name
+        #: position in the deterministic order in which subsystems due at one instant run
+        self.order = order
+        self.period = period
+        self.context = context
+        self.recorder = recorder
+        self.inputs: dict[str, Any] = {}
+        self.new_data: dict[str, bool] = {}
+        self.timed_out: dict[str, bool] = {}
+        self.channels: dict[str, Channel] = {}
+        self.memory: dict[str, Any] = {}
+        self.destinations: dict[str, list[Destination]] = {}
+        self.predicates: dict[str, CompiledPredicate] = {}
+        self.states: dict[str, StateRuntime] = {}
+        self.state: StateRuntime | None = None
+        self.iteration = 0
+        self.total_iterations = 0
+        self.faults = 0
+        self._error_in_iteration = False
+        self._stuck = False
+        #: set by the scheduler: called when a message reaches an obligatory buffer this engine waits for
+        self.on_delivery: Callable[[SubsystemEngine], None] | None = None
+        self.waiting = False
+        self.iteration_start = 0
+
+    # ------------------------------------------------------------------ set-up
+    def start(self, initial: str, time: int) -> None:
+        """`fsm.run()` begins in the initial state `ifs`."""
+        self.state = self.states[initial]
+        self.iteration = 0
+        self.recorder.state_changed(time, self.name, None, initial, f"*,{initial}")
+        self.recorder.behaviour_started(time, self.name, initial, self.state.behaviour.name)
+
+    # ------------------------------------------------------------------ Figure 5b, steps 1-3
+    def execute_and_send(self, time: int) -> None:
+        state = self.state
+        assert state is not None
+        behaviour = state.behaviour
+        context = self.context
+        context.time = time * 1e-9
+        context.iteration = self.iteration
+        context.state = state.name
+        context.behaviour = behaviour.name
+        self.iteration_start = time
+        self._error_in_iteration = False
+        memory = self.memory
+        sent: dict[str, Any] = {}
+        for stage in behaviour.stages:
+            stage_memory: dict[str, Any] = {}
+            for function in stage:
+                written = function.outputs.written
+                written.clear()
+                try:
+                    function.function(function.inputs, function.outputs, context)
+                except Exception as error:
+                    written.clear()  # a function that failed writes nothing
+                    self._function_fault(time, function.name, error)
+                    continue
+                for (is_memory, key), value in written.items():
+                    if is_memory:
+                        stage_memory[key] = value
+                    else:
+                        sent[key] = value
+            # the stage's writes become visible only now: no function saw another's (Eq. 7-8)
+            memory.update(stage_memory)
+        for key, value in sent.items():
+            for destination in self.destinations.get(key, ()):
+                destination.channel.deliver(value)
+                self.recorder.message_sent(time, destination.link, value)
+                engine = destination.engine
+                if engine.waiting and engine.on_delivery is not None:
+                    engine.on_delivery(engine)
+        self.iteration += 1
+        self.total_iterations += 1
+
+    def _function_fault(self, time: int, function: str, error: Exception) -> None:
+        if isinstance(error, UndeclaredAccess):
+            kind = "undeclared-write" if "writes" in str(error) else "undeclared-read"
+        elif isinstance(error, ValueTypeError):
+            kind = "type"
+        else:
+            kind = "exception"
+        trace = "".join(
+            traceback.format_exception(type(error), error, error.__traceback__.tb_next if error.__traceback__ else None)
+        )
+        self.report_fault(time, kind, f"`{function}/pf` raised {type(error).__name__}: {error}", function, trace)
+        # Faults section of docs/semantics.md: the behaviour's error condition becomes true
+        self._error_in_iteration = True
+
+    def report_fault(self, time: int, kind: str, message: str, function: str = "", trace: str = "") -> None:
+        self.faults += 1
+        state = self.state
+        self.recorder.fault(
+            Fault(
+                time,
+                self.name,
+                kind,
+                message,
+                state.name if state else "",
+                state.behaviour.name if state else "",
+                function,
+                trace,
+            )
+        )
+
+    # ------------------------------------------------------------------ Figure 5b, step 4
+    def obligatory_ready(self) -> bool:
+        state = self.state
+        assert state is not None
+        channels = self.channels
+        return all(channels[key].queue for key in state.obligatory)
+
+    def receive(self, time: int, timed_out: bool = False) -> None:
+        """`tf.pf.ib.receive()`: every input buffer takes what arrived; obligatory ones not filled time out."""
+        state = self.state
+        assert state is not None
+        inputs = self.inputs
+        new_data = self.new_data
+        for key, channel in self.channels.items():
+            if channel.queue:
+                inputs[key] = channel.queue.popleft()
+                new_data[key] = True
+            else:
+                new_data[key] = False
+            if channel.overflowed:
+                channel.overflowed = False
+                self.report_fault(time, "overflow", f"the FIFO of `{key}/ib` overflowed ({channel.dropped} dropped)")
+        flags = self.timed_out
+        for key in state.obligatory:
+            flags[key] = timed_out and not new_data[key]
+
+    # ------------------------------------------------------------------ Figure 5b, step 5 and Figure 5a
+    def _evaluate(self, time: int, predicate: CompiledPredicate, what: str) -> bool:
+        try:
+            return bool(predicate(self.inputs, self.new_data, self.timed_out, self.memory, self.predicates))
+        except Exception as error:
+            self.report_fault(time, "predicate", f"evaluating {what} raised {type(error).__name__}: {error}")
+            return False
+
+    def decide(self, time: int) -> None:
+        """Test `ec` then `tc`; when either holds, `fsm.selectState()`."""
+        state = self.state
+        assert state is not None
+        behaviour = state.behaviour
+        error = self._error_in_iteration
+        if not error and behaviour.error_condition is not None:
+            error = self._evaluate(time, behaviour.error_condition, f"the error condition of `{behaviour.name}/bb`")
+        if error:
+            reason = "error"
+        elif self._evaluate(time, behaviour.terminal_condition, f"the terminal condition of `{behaviour.name}/bb`"):
+            reason = "terminal"
+        else:
+            return
+        for transition in state.transitions:
+            if self._evaluate(time, transition.condition, f"the condition of `{transition.name}/t`"):
+                self._enter(time, transition, reason)
+                return
+        if not self._stuck:
+            # docs/semantics.md, "No transition holds": stay, go on iterating, try again after each iteration
+            self._stuck = True
+            self.report_fault(
+                time,
+                "no-transition",
+                f"`{behaviour.name}/bb` stopped ({reason} condition) in state `{state.name}` but no transition "
+                "out of it holds; the subsystem stays in the state and tries again after every iteration",
+            )
+
+    def _enter(self, time: int, transition: TransitionRuntime, reason: str) -> None:
+        state = self.state
+        assert state is not None
+        self.recorder.behaviour_stopped(time, self.name, state.name, state.behaviour.name, self.iteration, reason)
+        self.recorder.state_changed(time, self.name, state.name, transition.destination, transition.name)
+        self.state = self.states[transition.destination]
+        self.iteration = 0
+        self._stuck = False
+        self.recorder.behaviour_started(time, self.name, self.state.name, self.state.behaviour.name)
+
+    def snapshot(self) -> dict[str, Any]:
+        return dict(self.memory)

@@ -1,0 +1,140 @@
+"""What a run reports as it goes: state changes, behaviours, messages, memory, faults.
+
+The engine reports to a `Recorder`; the MCAP trace writer is one, the run summary
+another.  Times are integer nanoseconds of run time (simulated or wall).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+
+@dataclass
+class Fault:
+    """Something went wrong in a subsystem; the run goes on (docs/semantics.md, "Faults")."""
+
+    time: int
+    subsystem: str
+    kind: str  # "exception" | "undeclared-write" | "type" | "predicate" | "no-transition" | "overflow" | "deadline"
+    message: str
+    state: str = ""
+    behaviour: str = ""
+    function: str = ""
+    traceback: str = ""
+
+
+@dataclass
+class SubsystemStatistics:
+    """Per subsystem: iterations, time in each state, transitions taken, faults (for the summary table)."""
+
+    iterations: int = 0
+    state_time: dict[str, int] = field(default_factory=dict)
+    transitions: dict[str, int] = field(default_factory=dict)
+    faults: int = 0
+    state: str = ""
+    entered: int = 0
+
+
+class Recorder:
+    """Receives the events of a run; this base class ignores them all."""
+
+    def state_changed(self, time: int, subsystem: str, source: str | None, destination: str, transition: str) -> None:
+        pass
+
+    def behaviour_started(self, time: int, subsystem: str, state: str, behaviour: str) -> None:
+        pass
+
+    def behaviour_stopped(
+        self, time: int, subsystem: str, state: str, behaviour: str, iterations: int, reason: str
+    ) -> None:
+        pass
+
+    def message_sent(self, time: int, link: str, value: Any) -> None:
+        pass
+
+    def memory_snapshot(self, time: int, subsystem: str, memory: dict[str, Any]) -> None:
+        pass
+
+    def fault(self, fault: Fault) -> None:
+        pass
+
+    def iteration_done(self, time: int, subsystem: str) -> None:
+        pass
+
+
+class Recorders(Recorder):
+    """Several recorders as one."""
+
+    def __init__(self, recorders: list[Recorder]) -> None:
+        self.recorders = recorders
+
+    def state_changed(self, time: int, subsystem: str, source: str | None, destination: str, transition: str) -> None:
+        for recorder in self.recorders:
+            recorder.state_changed(time, subsystem, source, destination, transition)
+
+    def behaviour_started(self, time: int, subsystem: str, state: str, behaviour: str) -> None:
+        for recorder in self.recorders:
+            recorder.behaviour_started(time, subsystem, state, behaviour)
+
+    def behaviour_stopped(
+        self, time: int, subsystem: str, state: str, behaviour: str, iterations: int, reason: str
+    ) -> None:
+        for recorder in self.recorders:
+            recorder.behaviour_stopped(time, subsystem, state, behaviour, iterations, reason)
+
+    def message_sent(self, time: int, link: str, value: Any) -> None:
+        for recorder in self.recorders:
+            recorder.message_sent(time, link, value)
+
+    def memory_snapshot(self, time: int, subsystem: str, memory: dict[str, Any]) -> None:
+        for recorder in self.recorders:
+            recorder.memory_snapshot(time, subsystem, memory)
+
+    def fault(self, fault: Fault) -> None:
+        for recorder in self.recorders:
+            recorder.fault(fault)
+
+
+class StatisticsRecorder(Recorder):
+    """Counts what the closing summary table shows."""
+
+    def __init__(self) -> None:
+        self.subsystems: dict[str, SubsystemStatistics] = {}
+        self.faults: list[Fault] = []
+        self.messages = 0
+
+    def _of(self, subsystem: str) -> SubsystemStatistics:
+        found = self.subsystems.get(subsystem)
+        if found is None:
+            found = self.subsystems[subsystem] = SubsystemStatistics()
+        return found
+
+    def state_changed(self, time: int, subsystem: str, source: str | None, destination: str, transition: str) -> None:
+        statistics = self._of(subsystem)
+        if source is not None:
+            statistics.state_time[source] = statistics.state_time.get(source, 0) + time - statistics.entered
+            statistics.transitions[transition] = statistics.transitions.get(transition, 0) + 1
+        statistics.state = destination
+        statistics.entered = time
+
+    def behaviour_stopped(
+        self, time: int, subsystem: str, state: str, behaviour: str, iterations: int, reason: str
+    ) -> None:
+        self._of(subsystem).iterations += iterations
+
+    def message_sent(self, time: int, link: str, value: Any) -> None:
+        self.messages += 1
+
+    def fault(self, fault: Fault) -> None:
+        self._of(fault.subsystem).faults += 1
+        self.faults.append(fault)
+
+    def close(self, time: int) -> None:
+        """Account the time of the states the subsystems are in at the end."""
+        for statistics in self.subsystems.values():
+            if statistics.state:
+                statistics.state_time[statistics.state] = (
+                    statistics.state_time.get(statistics.state, 0) + time - statistics.entered
+                )
+                statistics.entered = time

@@ -1,0 +1,134 @@
+"""Predicates compiled to Python: the `fun` operation of Primitive Predicates and conditions (Table 4–5).
+
+A predicate is evaluated every iteration of every subsystem, so it is turned once
+into a Python function over the subsystem's current values instead of walking the
+expression tree each time.  The source is generated from the *model* (names become
+string keys, literals their `repr`), never from text a user wrote, so nothing but the
+expression's own operators can run.
+
+A compiled predicate is called as `predicate(inputs, new_data, timed_out, memory, predicates)`:
+the subsystem's dictionaries of input-buffer values, newData flags, timeout flags,
+memory values, and its compiled primitive predicates by name.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from typing import Any
+
+from earl.model.expressions import (
+    Arithmetic,
+    BooleanOperation,
+    Call,
+    Comparison,
+    Expression,
+    FieldAccess,
+    IndexAccess,
+    ListLiteral,
+    Literal,
+    Name,
+    Negate,
+    Not,
+    Quantifier,
+    Read,
+)
+from earl.model.kinds import Kind
+from earl.runtime.names import reference_key
+
+CompiledPredicate = Callable[
+    [Mapping[str, Any], Mapping[str, bool], Mapping[str, bool], Mapping[str, Any], Mapping[str, Any]], Any
+]
+
+_ARGUMENTS = "ib, nd, to, mem, pp"
+
+
+class PredicateCompileError(ValueError):
+    """The expression cannot be run (it was not expanded, or names something the runtime lacks)."""
+
+
+def compile_predicate(expression: Expression, description: str) -> CompiledPredicate:
+    """A function computing `expression`; `description` names it in tracebacks (`manip/a.cs emergencyStop/pp`)."""
+    source = f"lambda {_ARGUMENTS}: {_source(expression)}"
+    code = compile(source, f"<earl predicate {description}>", "eval")
+    function: CompiledPredicate = eval(code, {"__builtins__": {}})
+    return function
+
+
+def predicate_source(expression: Expression) -> str:
+    """The generated Python for `expression` (shown by tests and in fault reports)."""
+    return _source(expression)
+
+
+def _literal(value: object) -> str:
+    if isinstance(value, float) and not math.isfinite(value):
+        return "1e999" if value > 0 else "-1e999"
+    return repr(value)
+
+
+def _source(expression: Expression) -> str:
+    if isinstance(expression, Literal):
+        return _literal(expression.value)
+    if isinstance(expression, ListLiteral):
+        return "(" + "".join(f"{_source(item)}, " for item in expression.items) + ")"
+    if isinstance(expression, Read):
+        return _read(expression)
+    if isinstance(expression, Call):
+        return _call(expression)
+    if isinstance(expression, Not):
+        return f"(not {_source(expression.operand)})"
+    if isinstance(expression, Negate):
+        return f"(-{_source(expression.operand)})"
+    if isinstance(expression, BooleanOperation):
+        joiner = f" {expression.operator} "
+        return "(" + joiner.join(_source(operand) for operand in expression.operands) + ")"
+    if isinstance(expression, (Comparison, Arithmetic)):
+        return f"({_source(expression.left)} {expression.operator} {_source(expression.right)})"
+    if isinstance(expression, Name):
+        raise PredicateCompileError(f"`{expression.name}` is not a parameter or index with a known value")
+    if isinstance(expression, Quantifier):
+        raise PredicateCompileError("a quantifier must be expanded before it runs")
+    raise PredicateCompileError(f"cannot run the expression {expression!r}")
+
+
+def _read(read: Read) -> str:
+    target = read.target
+    key = repr(reference_key(target))
+    if target.kind is Kind.PRIMITIVE_PREDICATE:
+        if read.path:
+            raise PredicateCompileError(f"`{target.name}/pp` is a Boolean: it has no fields or elements")
+        return f"pp[{key}]({_ARGUMENTS})"
+    if target.kind is Kind.INPUT_BUFFER:
+        base = f"ib[{key}]"
+    elif target.kind in (Kind.MEMORY_INPUT, Kind.MEMORY):
+        base = f"mem[{key}]"
+    else:
+        raise PredicateCompileError(f"a predicate cannot read `{target.name}/{target.kind.value}`")
+    return base + _path(read)
+
+
+def _path(read: Read) -> str:
+    parts = []
+    for accessor in read.path:
+        if isinstance(accessor, FieldAccess):
+            parts.append(f"[{accessor.name!r}]")
+        elif isinstance(accessor, IndexAccess):
+            parts.append(f"[{_source(accessor.index)}]")
+    return "".join(parts)
+
+
+def _call(call: Call) -> str:
+    if len(call.arguments) != 1 or not isinstance(call.arguments[0], Read):
+        raise PredicateCompileError(f"`{call.function}` takes one input buffer")
+    argument = call.arguments[0]
+    if argument.target.kind is not Kind.INPUT_BUFFER:
+        raise PredicateCompileError(f"`{call.function}` takes an input buffer (`/ib`)")
+    key = repr(reference_key(argument.target))
+    if call.function == "newData":
+        if not argument.path:
+            return f"nd[{key}]"
+        # Table 4's newData(manipulatorCommand/ib.msg.jointPosSetpoint): a new message that carries the field
+        return f"(nd[{key}] and ib[{key}]{_path(argument)} is not None)"
+    if call.function == "timeout":
+        return f"to[{key}]"
+    raise PredicateCompileError(f"unknown function `{call.function}`")

@@ -1,0 +1,175 @@
+"""When each subsystem runs: virtual time (default, deterministic) or real time (`--realtime`).
+
+Both schedulers share one event queue.  An event is (time, subsystem order, sequence):
+subsystems due at the same instant run in the spec's declaration order, so the same
+spec and seed always run the same way.  Time is integer nanoseconds, never a float
+that drifts.
+
+Each iteration of a subsystem (docs/semantics.md):
+
+    START   at t: execute_and_send(); if every obligatory buffer of the state has a
+            message, RECEIVE at once; else wait — a message arriving wakes it (RESUME),
+            or the state's timeout expires (TIMEOUT) and `timeout(x/ib)` becomes true
+    then    receive(), decide(); the next START is one period after this START, or at
+            once if the wait made the iteration longer than its period (an overrun).
+
+In virtual time a wait simply advances simulated time; the real-time scheduler
+sleeps until each event is due on the wall clock and measures how late it starts.
+"""
+
+from __future__ import annotations
+
+import heapq
+import time as wall
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from earl.runtime.builder import Network
+from earl.runtime.engine import SubsystemEngine
+from earl.runtime.events import Recorder
+
+_START, _RESUME, _TIMEOUT = 0, 1, 2
+
+
+@dataclass
+class Lateness:
+    """How late iterations started on the wall clock (real time only), in nanoseconds."""
+
+    samples: list[int] = field(default_factory=list)
+    overruns: int = 0
+
+
+class Scheduler:
+    """Runs a network of subsystem engines; `advance_to(t)` runs everything due until `t`."""
+
+    def __init__(
+        self,
+        network: Network,
+        recorder: Recorder,
+        environment: object = None,
+        *,
+        realtime: bool = False,
+        record_memory: set[str] | None = None,
+        clock: Callable[[], int] = wall.perf_counter_ns,
+    ) -> None:
+        self.network = network
+        self.recorder = recorder
+        self.environment = environment
+        self.realtime = realtime
+        self.record_memory = record_memory or set()
+        self.clock = clock
+        self.now = 0
+        self._queue: list[tuple[int, int, int, int, SubsystemEngine, int]] = []
+        self._sequence = 0
+        self._tokens: dict[str, int] = {}
+        self._resume_pending: set[str] = set()
+        self._advance: Callable[[float], Any] | None = getattr(environment, "advance", None)
+        self._environment_time = -1
+        self._wall_start = 0
+        self.lateness: dict[str, Lateness] = {}
+        self.started = False
+
+    # ------------------------------------------------------------------ start
+    def start(self) -> None:
+        for engine in self.network.engines:
+            engine.on_delivery = self._delivered
+            self._tokens[engine.name] = 0
+            initial = self.network.initial_states.get(engine.name)
+            if initial is None or initial not in engine.states:
+                continue
+            engine.start(initial, 0)
+            self._push(0, engine, _START)
+        self._wall_start = self.clock()
+        self.started = True
+
+    def _push(self, time: int, engine: SubsystemEngine, kind: int, token: int = 0) -> None:
+        self._sequence += 1
+        heapq.heappush(self._queue, (time, engine.order, self._sequence, kind, engine, token))
+
+    # ------------------------------------------------------------------ running
+    def advance_to(self, until: int, should_stop: Callable[[], bool] | None = None) -> None:
+        """Run every event due at or before `until` (ns); `now` is `until` afterwards."""
+        if not self.started:
+            self.start()
+        queue = self._queue
+        while queue and queue[0][0] <= until:
+            if should_stop is not None and should_stop():
+                return
+            time, _, _, kind, engine, token = heapq.heappop(queue)
+            self.now = time
+            if self._advance is not None and time > self._environment_time:
+                self._environment_time = time
+                self._advance(time * 1e-9)
+            if self.realtime:
+                self._wait_until(time, engine, kind)
+            if kind == _START:
+                self._start(engine, time)
+            elif kind == _RESUME:
+                if engine.waiting and token == self._tokens[engine.name]:
+                    self._finish(engine, time, timed_out=False)
+            elif engine.waiting and token == self._tokens[engine.name]:  # _TIMEOUT
+                self._finish(engine, time, timed_out=True)
+        self.now = max(self.now, until)
+        if self._advance is not None and self.now > self._environment_time:
+            self._environment_time = self.now
+            self._advance(self.now * 1e-9)
+
+    def _start(self, engine: SubsystemEngine, time: int) -> None:
+        engine.execute_and_send(time)
+        if engine.obligatory_ready():
+            self._finish(engine, time, timed_out=False)
+            return
+        engine.waiting = True
+        token = self._tokens[engine.name] = self._tokens[engine.name] + 1
+        state = engine.state
+        assert state is not None
+        if state.timeout is not None:
+            self._push(time + state.timeout, engine, _TIMEOUT, token)
+
+    def _delivered(self, engine: SubsystemEngine) -> None:
+        """A message reached a waiting engine: wake it now if its obligatory buffers are all filled."""
+        if engine.name in self._resume_pending or not engine.obligatory_ready():
+            return
+        self._resume_pending.add(engine.name)
+        self._push(self.now, engine, _RESUME, self._tokens[engine.name])
+
+    def _finish(self, engine: SubsystemEngine, time: int, *, timed_out: bool) -> None:
+        engine.waiting = False
+        self._resume_pending.discard(engine.name)
+        self._tokens[engine.name] += 1
+        engine.receive(time, timed_out)
+        engine.decide(time)
+        if engine.name in self.record_memory:
+            self.recorder.memory_snapshot(time, engine.name, engine.memory)
+        period = engine.period
+        following = engine.iteration_start + period if period is not None else time
+        self._push(max(following, time), engine, _START)
+
+    def _wait_until(self, time: int, engine: SubsystemEngine, kind: int) -> None:
+        due = self._wall_start + time
+        remaining = due - self.clock()
+        if remaining > 300_000:
+            # sleep most of the way, then spin: a sleep alone wakes up to a scheduler tick late
+            wall.sleep((remaining - 200_000) * 1e-9)
+        while self.clock() < due:
+            pass
+        if kind == _START:
+            late = self.clock() - due
+            record = self.lateness.get(engine.name)
+            if record is None:
+                record = self.lateness[engine.name] = Lateness()
+            record.samples.append(late)
+            if engine.period is not None and late > engine.period:
+                record.overruns += 1
+                if record.overruns == 1:
+                    engine.report_fault(
+                        time,
+                        "deadline",
+                        f"an iteration started {late / 1e6:.3f} ms late, more than its period "
+                        f"({engine.period / 1e6:g} ms); further overruns are only counted",
+                    )
+
+    @property
+    def next_event_time(self) -> int | None:
+        return self._queue[0][0] if self._queue else None

@@ -1,0 +1,268 @@
+"""Running a system: the Python API behind `earl run`.
+
+    >>> import earl
+    >>> sim = earl.simulate(earl.load("examples/counter"), seed=1)
+    >>> sim.advance_to(2.0)                       # seconds of simulated time
+    >>> sim.state_of("counter/a.cs").state
+    'counting'
+
+Like Drake's Simulator, the model (an `earl.System`) stays untouched; the run's
+state lives in the subsystem engines this object owns.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from earl.diagnostics import Diagnostic, EarlError, Severity
+from earl.model.elements import System
+from earl.model.expand import expand
+from earl.runtime.binding import BindingProblem, resolve_callable, user_code_path
+from earl.runtime.builder import NANOSECONDS, Network, build_network, to_nanoseconds
+from earl.runtime.events import Fault, Recorder, Recorders, StatisticsRecorder
+from earl.runtime.scheduler import Scheduler
+from earl.runtime.trace import TraceWriter
+
+ParameterValue = bool | int | float | str
+
+
+@dataclass(frozen=True)
+class SubsystemState:
+    """A subsystem at one instant: its FSM state, behaviour, iteration number, buffers and memory."""
+
+    name: str
+    state: str
+    behaviour: str
+    iteration: int
+    memory: dict[str, Any]
+    inputs: dict[str, Any]
+    new_data: dict[str, bool]
+    timed_out: dict[str, bool]
+    iterations: int
+    faults: int
+    waiting: bool
+
+
+class _FaultList(Recorder):
+    def __init__(self) -> None:
+        self.faults: list[Fault] = []
+
+    def fault(self, fault: Fault) -> None:
+        self.faults.append(fault)
+
+
+class Simulation:
+    """A running system in virtual time (or, with `realtime=True`, paced by the wall clock)."""
+
+    def __init__(
+        self,
+        system: System,
+        *,
+        parameters: Mapping[str, ParameterValue] | None = None,
+        seed: int = 0,
+        environment: object | str | None = None,
+        trace: str | Path | None = None,
+        record_memory: list[str] | None = None,
+        record_links: list[str] | None = None,
+        realtime: bool = False,
+        check: bool = True,
+        agents: list[str] | None = None,
+        recorders: list[Recorder] | None = None,
+    ) -> None:
+        parameters = dict(parameters or {})
+        if check:
+            _check(system, parameters)
+        self.system = system
+        self.expanded = expand(system, parameters)
+        self.seed = seed
+        directories = _code_directories(system)
+        self.environment = _environment(environment, self.expanded, seed, directories, system)
+        self.statistics = StatisticsRecorder()
+        self._faults = _FaultList()
+        own: list[Recorder] = [self.statistics, self._faults, *(recorders or [])]
+        self.recorder = Recorders(own)
+        self.network: Network = build_network(
+            self.expanded,
+            recorder=self.recorder,
+            environment=self.environment,
+            seed=seed,
+            code_directories=directories,
+            agents=set(agents) if agents else None,
+        )
+        memory = set(record_memory or [])
+        if "all" in memory:
+            memory = set(self.network.by_name)
+        unknown = sorted(memory - set(self.network.by_name))
+        if unknown:
+            raise ValueError(
+                f"--record-memory names no subsystem of this run: {', '.join(unknown)} "
+                f"(subsystems are named like {next(iter(self.network.by_name), 'manip/a.cs')})"
+            )
+        self.trace: TraceWriter | None = None
+        if trace is not None:
+            self.trace = TraceWriter(
+                trace,
+                self.network.types,
+                self.network.link_types,
+                self.network.memory_types,
+                record_links,
+                self.network.link_sources,
+            )
+            own.append(self.trace)
+            self.trace.run_started(
+                {"system": system.name, "seed": seed, "parameters": parameters, "realtime": realtime}
+            )
+        self.scheduler = Scheduler(
+            self.network, self.recorder, self.environment, realtime=realtime, record_memory=memory
+        )
+        self.closed = False
+
+    # ------------------------------------------------------------------ running
+    @property
+    def time(self) -> float:
+        """Seconds of run time reached."""
+        return self.scheduler.now / NANOSECONDS
+
+    def advance_to(self, seconds: float, should_stop: Callable[[], bool] | None = None) -> None:
+        """Run every subsystem iteration due until `seconds` of run time."""
+        if self.closed:
+            raise RuntimeError("this simulation is closed")
+        self.scheduler.advance_to(to_nanoseconds(seconds), should_stop)
+
+    def advance_by(self, seconds: float) -> None:
+        self.advance_to(self.time + seconds)
+
+    def close(self) -> None:
+        """End the run: the statistics are closed, the trace file finished, the environment closed."""
+        if self.closed:
+            return
+        self.closed = True
+        self.statistics.close(self.scheduler.now)
+        if self.trace is not None:
+            iterations = {engine.name: engine.total_iterations for engine in self.network.engines}
+            self.trace.close(self.scheduler.now, {"faults": len(self._faults.faults), "iterations": iterations})
+        close = getattr(self.environment, "close", None)
+        if callable(close):
+            close()
+
+    def __enter__(self) -> Simulation:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    # ------------------------------------------------------------------ looking in
+    @property
+    def subsystems(self) -> list[str]:
+        return [engine.name for engine in self.network.engines]
+
+    @property
+    def faults(self) -> list[Fault]:
+        return list(self._faults.faults)
+
+    def state_of(self, subsystem: str) -> SubsystemState:
+        """The FSM state, behaviour, buffers and memory of `subsystem` (e.g. "manip/a.cs")."""
+        engine = self.network.by_name.get(subsystem)
+        if engine is None:
+            from earl.diagnostics import did_you_mean
+
+            hint = did_you_mean(subsystem, list(self.network.by_name)) or ""
+            raise KeyError(f"no subsystem `{subsystem}` in this run. {hint}".strip())
+        state = engine.state
+        return SubsystemState(
+            engine.name,
+            state.name if state else "",
+            state.behaviour.name if state else "",
+            engine.iteration,
+            dict(engine.memory),
+            dict(engine.inputs),
+            dict(engine.new_data),
+            dict(engine.timed_out),
+            engine.total_iterations,
+            engine.faults,
+            engine.waiting,
+        )
+
+
+def simulate(system: System, **options: Any) -> Simulation:
+    """A `Simulation` of `system`; see `Simulation` for the options (seed, environment, trace, …)."""
+    return Simulation(system, **options)
+
+
+def _check(system: System, parameters: Mapping[str, ParameterValue]) -> None:
+    """The checker runs before execution; its errors stop the run (warnings do not)."""
+    from earl.check import check
+
+    errors = [d for d in check(system, parameters) if d.severity is Severity.ERROR]
+    if errors:
+        raise EarlError(errors, system.sources)  # type: ignore[arg-type]
+
+
+def _code_directories(system: System) -> list[Path]:
+    return [Path(system.source_file).resolve().parent] if system.source_file else []
+
+
+def _environment(
+    environment: object | str | None, expanded: System, seed: int, directories: list[Path], system: System
+) -> object:
+    if not isinstance(environment, str):
+        return environment
+    with user_code_path(directories):
+        try:
+            factory = resolve_callable(environment, "the environment", None, arity=2)
+        except BindingProblem as problem:
+            raise EarlError([problem.diagnostic], system.sources) from None  # type: ignore[arg-type]
+        try:
+            return factory(expanded, seed)
+        except Exception as error:
+            raise EarlError(
+                [
+                    Diagnostic(
+                        Severity.ERROR,
+                        f"the environment `{environment}` failed to start: {type(error).__name__}: {error}",
+                        None,
+                        code="EARL-X020",
+                    )
+                ]
+            ) from None
+
+
+@dataclass
+class RunSettings:
+    """Defaults for `earl run` read from a `run.toml` next to the spec (command-line options win)."""
+
+    environment: str | None = None
+    duration: float | None = None
+    seed: int | None = None
+    record_memory: list[str] | None = None
+    report: str | None = None
+
+
+def read_run_settings(spec: Path) -> RunSettings:
+    path = spec.parent / "run.toml"
+    if not path.is_file():
+        return RunSettings()
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as error:
+        raise ValueError(f"{path}: not valid TOML: {error}") from None
+    known = {"environment", "duration", "seed", "record_memory", "report"}
+    unknown = sorted(set(data) - known)
+    if unknown:
+        raise ValueError(f"{path}: unknown setting `{unknown[0]}` (known: {', '.join(sorted(known))})")
+    duration = data.get("duration")
+    if isinstance(duration, str):
+        from earl.runtime.durations import parse_duration
+
+        duration = parse_duration(duration)
+    return RunSettings(
+        environment=data.get("environment"),
+        duration=duration,
+        seed=data.get("seed"),
+        record_memory=data.get("record_memory"),
+        report=data.get("report"),
+    )

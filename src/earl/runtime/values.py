@@ -1,0 +1,298 @@
+"""Run-time values of the spec's data types, and the checks that keep them honest.
+
+A value in a buffer or in memory is immutable, so the functions of one stage can all
+read the same snapshot without copying it (Eq. 7–8: they run "as if in parallel"):
+
+    primitive  -> bool | int | float | str | bytes
+    array      -> tuple
+    struct     -> Record (an immutable mapping with attribute access)
+    absent optional field -> None
+
+`coerce` turns what user code writes (a dict, a list, a NumPy array, an int where a
+double is declared) into that form, or says exactly what does not fit the type.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Iterator, Mapping
+from typing import Any, NoReturn
+
+from earl.model.elements import System
+from earl.model.expressions import ListLiteral, Literal, Negate
+from earl.model.types import ArrayType, DataType, PrimitiveType, StructType, TypeAlias, TypeReference, type_text
+
+Value = Any  # bool | int | float | str | bytes | tuple[Value, ...] | Record | None
+
+_INTEGER_RANGES: dict[str, tuple[int, int]] = {
+    "int8": (-(2**7), 2**7 - 1),
+    "int16": (-(2**15), 2**15 - 1),
+    "int32": (-(2**31), 2**31 - 1),
+    "int64": (-(2**63), 2**63 - 1),
+    "int": (-(2**63), 2**63 - 1),
+    "uint8": (0, 2**8 - 1),
+    "uint16": (0, 2**16 - 1),
+    "uint32": (0, 2**32 - 1),
+    "uint64": (0, 2**64 - 1),
+}
+_REAL_TYPES = ("double", "float32", "float64")
+
+
+class Record(dict[str, Any]):
+    """A struct value: read `msg.jointPosSetpoint` or `msg["jointPosSetpoint"]`; never changed in place.
+
+    It is a dict underneath so that JSON encoding and equality stay cheap; every
+    mutating method is refused, which is what lets one snapshot serve a whole stage.
+    """
+
+    __slots__ = ()
+
+    def __getattr__(self, name: str) -> Any:
+        try:
+            return self[name]
+        except KeyError:
+            fields = ", ".join(self) or "none"
+            raise AttributeError(f"this struct has no field `{name}` (its fields: {fields})") from None
+
+    def _refuse(self, *args: object, **kwargs: object) -> NoReturn:
+        raise TypeError("a received message or a memory value cannot be changed in place; write a new value instead")
+
+    __setitem__ = __delitem__ = __setattr__ = __delattr__ = _refuse
+    clear = pop = popitem = setdefault = update = __ior__ = _refuse  # type: ignore[assignment]
+
+    def replace(self, **changes: Any) -> Record:
+        """A copy with some fields changed: `outputs.state = state.replace(motionFinished=True)`."""
+        unknown = set(changes) - set(self)
+        if unknown:
+            raise AttributeError(f"this struct has no field {', '.join(f'`{u}`' for u in sorted(unknown))}")
+        merged = dict(self)
+        merged.update(changes)
+        return Record(merged)
+
+    def __repr__(self) -> str:
+        return "Record(" + ", ".join(f"{k}={v!r}" for k, v in self.items()) + ")"
+
+
+class ValueTypeError(TypeError):
+    """A value does not fit the declared data type; the message says where and why."""
+
+
+class TypeSystem:
+    """The data types of one (expanded) system: names resolved, defaults and checks at hand."""
+
+    def __init__(self, system: System) -> None:
+        self._definitions: dict[str, StructType | TypeAlias] = {t.name: t for t in system.types}
+        self._defaults: dict[str, Value] = {}
+
+    def resolve(self, data_type: DataType) -> PrimitiveType | ArrayType | StructType:
+        """Follow `type` aliases to a primitive, an array or a struct."""
+        seen: set[str] = set()
+        while isinstance(data_type, TypeReference):
+            if data_type.name in seen:
+                raise ValueTypeError(f"the type `{data_type.name}` is defined in terms of itself")
+            seen.add(data_type.name)
+            definition = self._definitions.get(data_type.name)
+            if definition is None:
+                raise ValueTypeError(f"unknown type `{data_type.name}`")
+            if isinstance(definition, StructType):
+                return definition
+            data_type = definition.data_type
+        return data_type
+
+    def default(self, data_type: DataType) -> Value:
+        """What a buffer holds before its first message, and memory without an initial value."""
+        key = type_text(data_type) if not isinstance(data_type, ArrayType) else None
+        if key is not None and key in self._defaults:
+            return self._defaults[key]
+        resolved = self.resolve(data_type)
+        value: Value
+        if isinstance(resolved, PrimitiveType):
+            value = _primitive_default(resolved.name)
+        elif isinstance(resolved, ArrayType):
+            size = _fixed_size(resolved)
+            value = () if size is None else tuple(self.default(resolved.element) for _ in range(size))
+        else:
+            value = Record({f.name: (None if f.optional else self.default(f.data_type)) for f in resolved.fields})
+        if key is not None:
+            self._defaults[key] = value
+        return value
+
+    def coerce(self, value: Any, data_type: DataType, where: str = "value") -> Value:
+        """`value` in its immutable run-time form, or `ValueTypeError` naming `where` and the type."""
+        resolved = self.resolve(data_type)
+        if isinstance(resolved, PrimitiveType):
+            return _coerce_primitive(value, resolved.name, where)
+        if isinstance(resolved, ArrayType):
+            if isinstance(value, (str, bytes, Mapping)) or not _is_sequence(value):
+                _mismatch(value, data_type, where)
+            items = list(value.tolist() if hasattr(value, "tolist") else value)
+            size = _fixed_size(resolved)
+            if size is not None and len(items) != size:
+                raise ValueTypeError(f"{where} must have {size} elements ({type_text(data_type)}), not {len(items)}")
+            return tuple(self.coerce(item, resolved.element, f"{where}[{i}]") for i, item in enumerate(items))
+        if not isinstance(value, Mapping):
+            _mismatch(value, data_type, where)
+        fields = {f.name: f for f in resolved.fields}
+        unknown = [name for name in value if name not in fields]
+        if unknown:
+            raise ValueTypeError(
+                f"{where}: `{resolved.name}` has no field `{unknown[0]}` (its fields: {', '.join(fields)})"
+            )
+        result: dict[str, Value] = {}
+        for name, declared in fields.items():
+            if name not in value or value[name] is None:
+                if declared.optional:
+                    result[name] = None
+                    continue
+                raise ValueTypeError(f"{where}: the field `{name}` of `{resolved.name}` is missing")
+            result[name] = self.coerce(value[name], declared.data_type, f"{where}.{name}")
+        return Record(result)
+
+    def constant(self, expression: Any, data_type: DataType, where: str) -> Value:
+        """The value of an expanded constant expression (a memory's initial value)."""
+        return self.coerce(_constant(expression), data_type, where)
+
+
+def _constant(expression: Any) -> Any:
+    if isinstance(expression, Literal):
+        return expression.value
+    if isinstance(expression, ListLiteral):
+        return [_constant(item) for item in expression.items]
+    if isinstance(expression, Negate):
+        return -_constant(expression.operand)
+    raise ValueTypeError("an initial value must be a constant")
+
+
+def _fixed_size(array: ArrayType) -> int | None:
+    if array.size is None:
+        return None
+    if not isinstance(array.size, Literal) or not isinstance(array.size.value, int):
+        raise ValueTypeError(f"the size of `{type_text(array)}` is not a known whole number")
+    return array.size.value
+
+
+def _primitive_default(name: str) -> Value:
+    if name == "boolean":
+        return False
+    if name in _REAL_TYPES:
+        return 0.0
+    if name == "string":
+        return ""
+    if name == "bytes":
+        return b""
+    return 0
+
+
+def _is_sequence(value: Any) -> bool:
+    return isinstance(value, (list, tuple)) or (hasattr(value, "tolist") and getattr(value, "ndim", 0) == 1)
+
+
+def _mismatch(value: Any, data_type: DataType, where: str) -> NoReturn:
+    raise ValueTypeError(f"{where} must be {type_text(data_type)}, not {_describe(value)}")
+
+
+def _describe(value: Any) -> str:
+    if value is None:
+        return "nothing (None)"
+    if isinstance(value, bool):
+        return f"the Boolean {value}"
+    if isinstance(value, (int, float)):
+        return f"the number {value!r}"
+    if isinstance(value, str):
+        return f"the string {value!r}"
+    return f"a {type(value).__name__}"
+
+
+def _coerce_primitive(value: Any, name: str, where: str) -> Value:
+    if hasattr(value, "item") and getattr(value, "ndim", None) == 0:
+        value = value.item()  # a NumPy scalar
+    if name == "boolean":
+        if isinstance(value, bool):
+            return value
+        raise ValueTypeError(f"{where} must be a boolean (true or false), not {_describe(value)}")
+    if name in _REAL_TYPES:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ValueTypeError(f"{where} must be a number ({name}), not {_describe(value)}")
+        result = float(value)
+        if math.isnan(result):
+            raise ValueTypeError(f"{where} is NaN (not a number): a computation went wrong upstream")
+        return result
+    if name in _INTEGER_RANGES:
+        if isinstance(value, bool) or not isinstance(value, int):
+            if isinstance(value, float) and value.is_integer():
+                value = int(value)
+            else:
+                raise ValueTypeError(f"{where} must be a whole number ({name}), not {_describe(value)}")
+        low, high = _INTEGER_RANGES[name]
+        if not low <= value <= high:
+            raise ValueTypeError(f"{where} = {value} does not fit {name} ({low}..{high})")
+        return value
+    if name == "string":
+        if isinstance(value, str):
+            return value
+        raise ValueTypeError(f"{where} must be a string, not {_describe(value)}")
+    if name == "bytes":
+        if isinstance(value, (bytes, bytearray)):
+            return bytes(value)
+        raise ValueTypeError(f"{where} must be bytes, not {_describe(value)}")
+    raise ValueTypeError(f"unknown primitive type `{name}`")
+
+
+def to_json(value: Value) -> Any:
+    """A value as JSON data (bytes as a list of numbers), for traces."""
+    if isinstance(value, tuple):
+        return [to_json(v) for v in value]
+    if isinstance(value, dict):
+        return {k: to_json(v) for k, v in value.items()}
+    if isinstance(value, bytes):
+        return list(value)
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+def json_schema(types: TypeSystem, data_type: DataType) -> dict[str, Any]:
+    """A JSON Schema for a data type, so that Foxglove can show the fields of a trace message."""
+    resolved = types.resolve(data_type)
+    if isinstance(resolved, PrimitiveType):
+        if resolved.name == "boolean":
+            return {"type": "boolean"}
+        if resolved.name in _REAL_TYPES:
+            return {"type": "number"}
+        if resolved.name == "string":
+            return {"type": "string"}
+        if resolved.name == "bytes":
+            return {"type": "array", "items": {"type": "integer"}}
+        return {"type": "integer"}
+    if isinstance(resolved, ArrayType):
+        schema: dict[str, Any] = {"type": "array", "items": json_schema(types, resolved.element)}
+        size = _fixed_size(resolved)
+        if size is not None:
+            schema["minItems"] = schema["maxItems"] = size
+        return schema
+    properties = {}
+    for f in resolved.fields:
+        inner = json_schema(types, f.data_type)
+        properties[f.name] = {"anyOf": [inner, {"type": "null"}]} if f.optional else inner
+    return {
+        "type": "object",
+        "title": resolved.name,
+        "properties": properties,
+        "required": [f.name for f in resolved.fields if not f.optional],
+    }
+
+
+def iter_leaves(value: Value, prefix: str = "") -> Iterator[tuple[str, Any]]:
+    """(path, number) for every numeric or Boolean leaf: `position[0]`, `pose.x` — for plots."""
+    if isinstance(value, dict):
+        for key, inner in value.items():
+            yield from iter_leaves(inner, f"{prefix}.{key}" if prefix else key)
+    elif isinstance(value, (list, tuple)):
+        for index, inner in enumerate(value):
+            yield from iter_leaves(inner, f"{prefix}[{index}]")
+    elif isinstance(value, (bool, int, float)):
+        yield prefix, value
+
+
+def freeze_all(values: Iterable[tuple[str, Any]]) -> dict[str, Any]:
+    return dict(values)

@@ -1,0 +1,6 @@
+def show(inputs, outputs, context):
+    outputs.shown = inputs.value
+
+
+def echo(inputs, outputs, context):
+    outputs.echo = inputs.shown
