@@ -16,7 +16,8 @@ import pytest
 import earl
 from earl.check import check, context_for
 from earl.check.registry import RULES
-from earl.diagnostics import Diagnostic, Severity
+from earl.check.rules_doc import ENFORCED_BY_THE_LANGUAGE
+from earl.diagnostics import Diagnostic, EarlError, Severity
 from earl.model.elements import System
 from earl.model.text import expression_text
 
@@ -539,6 +540,191 @@ def test_findings_are_ordered_by_position() -> None:
     assert positions == sorted(positions)
 
 
+# ---------------------------------------------------------------- rules the language enforces
+#
+# Some of the manual's rules are refused while a spec is read (docs/rules.md, "Rules the language
+# itself enforces"): the failing spec stops `earl check` with a reading code at the spot, and BASE,
+# which keeps every one of them, reads cleanly (test_base_spec_is_clean).
+
+FSM_BODY = "            initial run\n            state run: run/bb\n            run -> run when go/pp\n"
+
+READING_CASES: list[tuple[str, str, str, int, int, str]] = [
+    # (the manual's rule, code, failing spec, line, column, part of the message)
+    (
+        "exactly one Control Subsystem per Agent",
+        "EARL-R002",
+        edit(("a1/a {\n    cs {", "a1/a {\n    cs {\n    }\n    cs {")),
+        6,
+        5,
+        "the Control Subsystem `cs` of `a1/a` is declared twice",
+    ),
+    (
+        "the initial state exists",
+        "EARL-R031",
+        edit((FSM_BODY, FSM_BODY.replace("initial run", "initial walk"))),
+        14,
+        9,
+        "the initial state `walk` is not a state of this FSM",
+    ),
+    (
+        "every state has one basic behaviour",
+        "EARL-R030",
+        edit((FSM_BODY, FSM_BODY.replace("state run: run/bb", "state run: walk/bb"))),
+        16,
+        24,
+        "state `run` names `walk/bb`, which `a1/a.cs` does not declare",
+    ),
+    (
+        "every state has only one basic behaviour",
+        "EARL-S006",
+        edit((FSM_BODY, FSM_BODY.replace("state run: run/bb", "state run: run/bb, run/bb"))),
+        16,
+        30,
+        "found `,`",
+    ),
+    (
+        "transitions name existing states",
+        "EARL-R032",
+        edit(("run -> run when go/pp", "run -> walk when go/pp")),
+        17,
+        13,
+        "transition `run,walk/t` names the state `walk`, which this FSM does not declare",
+    ),
+    (
+        "predicates read only their own subsystem's memory",
+        "EARL-R022",
+        edit(("go/pp = x/mi > 1.0", "go/pp = y/mi > 1.0")),  # y/m belongs to a2/a.cs
+        7,
+        17,
+        "`a1/a.cs` has no Internal Memory `y`",
+    ),
+    (
+        "predicates read buffers and memory, never an Output Buffer",
+        "EARL-R021",
+        edit(("go/pp = x/mi > 1.0", "go/pp = out/ob > 1.0")),
+        7,
+        17,
+        "`out/ob` cannot be read by a predicate",
+    ),
+    (
+        "newData applies only to Input Buffers",
+        "EARL-R042",
+        edit(("got/pp = newData(inp/ib)", "got/pp = newData(y/mi)")),
+        26,
+        26,
+        "`newData(…)` applies to an Input Buffer",
+    ),
+    (
+        "a partial transition function reads `ib` and `mi`",
+        "EARL-R021",
+        edit(("emit/pf(x/mi -> out/ob)", "emit/pf(x/mo -> out/ob)")),
+        9,
+        17,
+        "`x/mo` cannot be read by a Partial Transition Function",
+    ),
+    (
+        "a partial transition function writes `mo` and `ob`",
+        "EARL-R021",
+        edit(("take/pf(inp/ib -> y/mo)", "take/pf(inp/ib -> inp/ib)")),
+        27,
+        27,
+        "`inp/ib` cannot be written by a Partial Transition Function",
+    ),
+    (
+        "links run from an Output Buffer to an Input Buffer",
+        "EARL-R054",
+        edit(("link a1,a2: a1/a.cs.out -> a2/a.cs.inp", "link a1,a2: a2/a.cs.inp -> a1/a.cs.out")),
+        40,
+        21,
+        "`a2/a.cs` has no Output Buffer `inp`",
+    ),
+    (
+        "kind suffixes name a kind of element",
+        "EARL-S005",
+        edit(("x/m: double = 0.0", "x/mm: double = 0.0")),
+        6,
+        11,
+        "`mm` is not a kind of element that can stand here",
+    ),
+    (
+        "a reference's kind suffix matches the element it names",
+        "EARL-R022",
+        edit(("tc = go/pp\n", "tc = go/ib\n")),
+        12,
+        18,
+        "`a1/a.cs` has no Input Buffer `go`",
+    ),
+]
+
+
+@pytest.mark.parametrize(
+    ("rule", "code", "failing", "line", "column", "fragment"), READING_CASES, ids=[c[0] for c in READING_CASES]
+)
+def test_rules_the_language_enforces_stop_reading_at_the_spot(
+    rule: str, code: str, failing: str, line: int, column: int, fragment: str
+) -> None:
+    with pytest.raises(EarlError) as raised:
+        earl.loads(failing, "spec.earl")
+    at_spot = [
+        d
+        for d in raised.value.diagnostics
+        if d.code == code and d.location is not None and (d.location.line, d.location.column) == (line, column)
+    ]
+    assert at_spot, [f"{d.code} {d.location} {d.message}" for d in raised.value.diagnostics]
+    assert any(fragment in d.message for d in at_spot), [d.message for d in at_spot]
+    assert all(d.severity is Severity.ERROR for d in at_spot)
+
+
+def test_every_rule_the_language_enforces_has_a_reading_case() -> None:
+    """docs/rules.md names the reading codes that enforce the manual; each has a failing case above."""
+    documented = {code for _, how in ENFORCED_BY_THE_LANGUAGE for code in re.findall(r"EARL-[SR]\d{3}", how)}
+    tested = {case[1] for case in READING_CASES}
+    assert documented - {"EARL-S011"} <= tested  # a second `fsm`: see test_a_second_fsm_is_refused
+
+
+def test_a_second_fsm_is_refused() -> None:
+    """A Subsystem has one FSM (Figure 3): a second `fsm` block is refused where it starts."""
+    block = "        fsm {\n" + FSM_BODY + "        }\n"
+    with pytest.raises(EarlError) as raised:
+        earl.loads(edit((block, block + block)), "spec.earl")
+    assert [(d.code, d.location.line if d.location else None) for d in raised.value.diagnostics] == [("EARL-S011", 19)]
+
+
+# ---------------------------------------------------------------- EARL-E040: how to fix it
+
+
+def test_a_one_stage_function_writing_an_output_is_told_how_to_split() -> None:
+    """`tf = {control/pf}` writing an Output Buffer is refused (Eq. 4–6 put outputs in stage 2), and the
+    hint spells out the fix; applying it literally makes the spec clean."""
+    text = edit(("tf = {compute/pf} then {emit/pf}", "tf = {emit/pf}"), ("        compute/pf(x/mi -> x/mo)\n", ""))
+    (finding,) = findings(text, "EARL-E040")
+    assert finding.message.startswith(
+        "`emit/pf` writes `out/ob` in stage 1 of `run/bb` in `a1/a.cs`: a transition function of one stage"
+    )
+    assert finding.hint is not None
+    assert "let `emit/pf` write memory instead (`-> out/mo`, declared as `/m`)" in finding.hint
+    assert "`tf = {emit/pf} then {send/pf}` with `send/pf(… /mi -> out/ob)`" in finding.hint
+    fixed = edit(
+        ("        emit/pf(x/mi -> out/ob)\n", "        emit/pf(x/mi -> out/mo)\n        send/pf(out/mi -> out/ob)\n"),
+        ("        x/m: double = 0.0\n", "        x/m: double = 0.0\n        out/m: double = 0.0\n"),
+        ("tf = {emit/pf}", "tf = {emit/pf} then {send/pf}"),
+        text=text,
+    )
+    assert findings(fixed) == []
+
+
+def test_an_early_stage_output_names_every_buffer_once() -> None:
+    text = edit(
+        ("        out/ob: double\n", "        out/ob: double\n        extra/ob: double\n"),
+        ("emit/pf(x/mi -> out/ob)", "emit/pf(x/mi -> out/ob, extra/ob)"),
+        ("tf = {compute/pf} then {emit/pf}", "tf = {emit/pf} then {compute/pf}"),
+    )
+    found = [d for d in findings(text, "EARL-E040") if "writes `out/ob`" in d.message]
+    assert len(found) == 1
+    assert "writes `out/ob`, `extra/ob` in stage 1 of `run/bb`" in found[0].message
+    assert found[0].hint is not None and "move `emit/pf` into the last stage (stage 2)" in found[0].hint
+
+
 # ---------------------------------------------------------------- the manual's example
 
 
@@ -701,3 +887,74 @@ def test_table_1_counts_every_member_of_an_agent_family() -> None:
     assert family is not None
     assert context.agent_type(family).name == "CT"
     assert findings(text) == []
+
+
+# ---------------------------------------------------------------- members of a family
+
+
+FAMILY_AGENT = """\
+a3[I in 1..3]/a {
+    cs {
+        cmd[K in 1..2]/ob: double
+        c[K in 1..2]/m: double = 0.0
+        plan/pf(c[*]/mi -> c[*]/mo)
+        send/pf(c[*]/mi -> cmd[*]/ob)
+        run/bb {
+            tf = {plan/pf} then {send/pf}
+            tc = false
+        }
+        fsm {
+            initial run
+            state run: run/bb
+        }
+    }
+    m[K in 1..2]/ve {
+        param which: int = K
+        cmd/ib: double
+        drive/ob: double
+        w[J in 1..2]/m: double = 0.0
+        f/pf(cmd/ib -> w[which]/mo)
+        g/pf(cmd/ib -> w[2]/mo)
+        out/pf(w[*]/mi -> drive/ob)
+        run/bb {
+            tf = {f/pf, g/pf} then {out/pf}
+            tc = false
+        }
+        fsm {
+            initial run
+            state run: run/bb
+        }
+    }
+    d[K in 1..2]/re {
+        drive/ib: double
+    }
+    link cs,m[K in 1..2]: cs.cmd[K] -> m[K]/ve.cmd
+    link m[K in 1..2],d[K]: m[K]/ve.drive -> d[K]/re.drive
+}
+"""
+
+
+def test_a_problem_of_one_family_member_is_found_once() -> None:
+    """`f/pf` and `g/pf` collide only in `m[2]/ve` (where `which` = 2), in every member of the agent
+    family; members whose inside is the same are checked once, and the one that differs is not lost."""
+    text = add(FAMILY_AGENT)
+    (collision,) = findings(text, "EARL-E042")
+    assert "`f/pf` and `g/pf` both write `w[2]/m` in stage 1 of `run/bb` (a3[1]/a.m[2]/ve)" in collision.message
+    assert collision.location is not None and (collision.location.line, collision.location.column) == (72, 25)
+    assert [d.code for d in findings(text) if d.severity is not Severity.NOTE] == ["EARL-E042"]
+
+
+def test_members_that_name_no_index_are_one_subsystem_to_the_rules() -> None:
+    context = context_for(earl.loads(add(FAMILY_AGENT)))
+    members = [(agent.name, agent.index, s.name, s.index) for agent, s in context.subsystems()]
+    distinct = [(agent.name, agent.index, s.name, s.index) for agent, s in context.distinct_subsystems()]
+    assert len(members) == 2 + 3 * 5
+    # a1.cs, a2.cs; then a3's cs (names no index), m[1] and m[2] (they name K through `which`), d (no body)
+    assert distinct == [
+        ("a1", None, "cs", None),
+        ("a2", None, "cs", None),
+        ("a3", 1, "cs", None),
+        ("a3", 1, "m", 1),
+        ("a3", 1, "m", 2),
+        ("a3", 1, "d", 1),
+    ]

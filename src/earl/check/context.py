@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import dataclasses
 from collections import defaultdict
-from collections.abc import Iterator
+from collections.abc import Hashable, Iterator
 from dataclasses import dataclass, field
 from functools import cached_property
+from typing import TypeVar
 
 from earl.model.elements import (
     Agent,
@@ -17,8 +19,9 @@ from earl.model.elements import (
     Subsystem,
     System,
 )
-from earl.model.expressions import ElementReference
+from earl.model.expressions import ElementReference, Literal, Name
 from earl.model.kinds import Kind
+from earl.model.location import SourceLocation
 from earl.model.tables import AgentType, agent_type
 from earl.model.types import ArrayType, DataType, PrimitiveType, StructType, TypeReference
 
@@ -44,6 +47,58 @@ def reference_key(reference: ElementReference) -> str:
     return instance_name(reference.name, value if isinstance(value, int) else None)
 
 
+_Element = TypeVar("_Element", InputBuffer, OutputBuffer, Memory)
+
+
+def _by_instance_name(elements: list[_Element]) -> dict[str, _Element]:
+    """Elements by `name[index]`; the first of two equal names wins, as a scan would find it."""
+    return {instance_name(e.name, e.index): e for e in reversed(elements)}
+
+
+_LEAVES = (str, int, float, bool, type(None), SourceLocation, Kind)
+
+
+def _names_in(root: object) -> frozenset[str]:
+    """Every `Name` anywhere inside a declaration: over-approximating is safe (it only makes two members
+    look different), missing one is not, so the walk is generic rather than field by field."""
+    names: set[str] = set()
+    stack: list[object] = [root]
+    seen: set[int] = set()
+    while stack:
+        node = stack.pop()
+        if isinstance(node, Name):
+            names.add(node.name)
+        elif isinstance(node, _LEAVES) or id(node) in seen:
+            continue
+        else:
+            seen.add(id(node))
+            if isinstance(node, (list, tuple)):
+                stack.extend(node)
+            elif dataclasses.is_dataclass(node):
+                stack.extend(getattr(node, f.name) for f in dataclasses.fields(node))
+    return frozenset(names)
+
+
+def _value_of(name: str, agent: Agent, subsystem: Subsystem) -> object:
+    """The value `name` has inside an expanded subsystem, looked up from the innermost scope out;
+    None for a system parameter or a name bound inside the body (the same for every member)."""
+    if subsystem.family is not None and subsystem.family.index == name:
+        return subsystem.index
+    for parameter in subsystem.parameters:
+        if parameter.name == name:
+            return _literal(parameter.value)
+    if agent.family is not None and agent.family.index == name:
+        return agent.index
+    for parameter in agent.parameters:
+        if parameter.name == name:
+            return _literal(parameter.value)
+    return None
+
+
+def _literal(value: object) -> object:
+    return value.value if isinstance(value, Literal) else id(value)
+
+
 @dataclass
 class ResolvedLink:
     """A concrete link with the subsystems and buffers at its ends."""
@@ -63,6 +118,10 @@ class CheckContext:
     declared: System
     system: System  # expanded: every family member
     _agents: dict[str, Agent] = field(default_factory=dict)
+    _subsystem_tables: dict[int, dict[tuple[Kind, str], Subsystem]] = field(default_factory=dict)
+    _output_tables: dict[int, dict[str, OutputBuffer]] = field(default_factory=dict)
+    _input_tables: dict[int, dict[str, InputBuffer]] = field(default_factory=dict)
+    _memory_tables: dict[int, dict[str, Memory]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         self._agents = {instance_name(a.name, a.index): a for a in self.system.agents}
@@ -72,31 +131,78 @@ class CheckContext:
         return self._agents.get(reference_key(reference))
 
     def subsystem(self, agent: Agent, reference: ElementReference) -> Subsystem | None:
-        key = reference_key(reference)
-        for subsystem in agent.subsystems:
-            if subsystem.kind is reference.kind and instance_name(subsystem.name, subsystem.index) == key:
-                return subsystem
-        return None
+        table = self._subsystem_tables.get(id(agent))
+        if table is None:
+            table = self._subsystem_tables[id(agent)] = {
+                (s.kind, instance_name(s.name, s.index)): s for s in reversed(agent.subsystems)
+            }
+        return table.get((reference.kind, reference_key(reference)))
 
-    @staticmethod
-    def output_buffer(subsystem: Subsystem, reference: ElementReference) -> OutputBuffer | None:
-        key = reference_key(reference)
-        return next((b for b in subsystem.output_buffers if instance_name(b.name, b.index) == key), None)
+    # Links into a subsystem with a family of ten thousand buffers would make a scan per link
+    # quadratic, so each subsystem's buffers are looked up through a table built on first use.
+    def output_buffer(self, subsystem: Subsystem, reference: ElementReference) -> OutputBuffer | None:
+        table = self._output_tables.get(id(subsystem))
+        if table is None:
+            table = self._output_tables[id(subsystem)] = _by_instance_name(subsystem.output_buffers)
+        return table.get(reference_key(reference))
 
-    @staticmethod
-    def input_buffer(subsystem: Subsystem, reference: ElementReference) -> InputBuffer | None:
-        key = reference_key(reference)
-        return next((b for b in subsystem.input_buffers if instance_name(b.name, b.index) == key), None)
+    def input_buffer(self, subsystem: Subsystem, reference: ElementReference) -> InputBuffer | None:
+        table = self._input_tables.get(id(subsystem))
+        if table is None:
+            table = self._input_tables[id(subsystem)] = _by_instance_name(subsystem.input_buffers)
+        return table.get(reference_key(reference))
 
-    @staticmethod
-    def memory(subsystem: Subsystem, reference: ElementReference) -> Memory | None:
-        key = reference_key(reference)
-        return next((m for m in subsystem.memories if instance_name(m.name, m.index) == key), None)
+    def memory(self, subsystem: Subsystem, reference: ElementReference) -> Memory | None:
+        table = self._memory_tables.get(id(subsystem))
+        if table is None:
+            table = self._memory_tables[id(subsystem)] = _by_instance_name(subsystem.memories)
+        return table.get(reference_key(reference))
 
     def subsystems(self) -> Iterator[tuple[Agent, Subsystem]]:
         for agent in self.system.agents:
             for subsystem in agent.subsystems:
                 yield agent, subsystem
+
+    # ------------------------------------------------------------------ one member per distinct content
+    @cached_property
+    def _free_names(self) -> dict[SourceLocation, frozenset[str]]:
+        """For every declared subsystem, the parameters and indices its body names anywhere."""
+        return {
+            subsystem.location: _names_in(subsystem)
+            for agent in self.declared.agents
+            for subsystem in agent.subsystems
+            if subsystem.location is not None
+        }
+
+    def content_key(self, agent: Agent, subsystem: Subsystem) -> Hashable:
+        """Equal for two expanded subsystems exactly when they come from one declaration with the same
+        values of every name its body uses; such members have the same buffers, predicates, functions,
+        behaviours and FSM, and the rules on a subsystem's inside find the same problems in them."""
+        names = self._free_names.get(subsystem.location) if subsystem.location is not None else None
+        if names is None:
+            return id(subsystem)
+        values: list[object] = [subsystem.location]
+        for name in sorted(names):
+            values.append(_value_of(name, agent, subsystem))
+        return tuple(values)
+
+    @cached_property
+    def _distinct(self) -> list[tuple[Agent, Subsystem]]:
+        seen: set[Hashable] = set()
+        result = []
+        for agent, subsystem in self.subsystems():
+            key = self.content_key(agent, subsystem)
+            if key not in seen:
+                seen.add(key)
+                result.append((agent, subsystem))
+        return result
+
+    def distinct_subsystems(self) -> Iterator[tuple[Agent, Subsystem]]:
+        """One expanded subsystem per distinct content (see `content_key`), in declaration order.
+
+        Ten thousand members of `worker[I]/a` whose control subsystems never name `I` are one
+        subsystem to the rules about predicates, functions, behaviours and the FSM."""
+        yield from self._distinct
 
     # ------------------------------------------------------------------ links
     def _end(self, end: LinkEnd, owner: Agent | None) -> tuple[Agent, Subsystem] | None:
@@ -141,24 +247,35 @@ class CheckContext:
             table[id(link.source_buffer)].append(link)
         return table
 
+    @cached_property
+    def _inter_agent_links(self) -> dict[int, list[ResolvedLink]]:
+        table: dict[int, list[ResolvedLink]] = defaultdict(list)
+        for link in self.links:
+            if link.between_agents:
+                table[id(link.source_agent)].append(link)
+                if link.destination_agent is not link.source_agent:
+                    table[id(link.destination_agent)].append(link)
+        return table
+
     def inter_agent_links(self, agent: Agent) -> list[ResolvedLink]:
-        return [
-            link
-            for link in self.links
-            if link.between_agents and (link.source_agent is agent or link.destination_agent is agent)
-        ]
+        """The inter-agent links that start or end at `agent` (an expanded agent)."""
+        return self._inter_agent_links.get(id(agent), [])
 
     # ------------------------------------------------------------------ Table 1
     def instances(self, agent: Agent) -> list[Agent]:
         """The expanded agents `agent` stands for: itself, or, for an agent of the declared system, its
         counterpart (every member of a family).  Links are resolved between expanded agents only."""
-        if any(candidate is agent for candidate in self.system.agents):
+        if id(agent) in self._expanded_agents:
             return [agent]
         return [
             candidate
             for candidate in self.system.agents
             if candidate.name == agent.name and (agent.index is None or candidate.index == agent.index)
         ]
+
+    @cached_property
+    def _expanded_agents(self) -> set[int]:
+        return {id(agent) for agent in self.system.agents}
 
     def agent_type(self, agent: Agent) -> AgentType:
         """The row of Table 1 of an agent of the declared or of the expanded system."""

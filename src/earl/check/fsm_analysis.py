@@ -220,7 +220,7 @@ def analyses(context: CheckContext) -> dict[str, list[Finding]]:
         return cached  # type: ignore[no-any-return]
     result: dict[str, list[Finding]] = {}
     seen: set[tuple[object, ...]] = set()
-    for agent, subsystem in context.subsystems():
+    for agent, subsystem in context.distinct_subsystems():
         if subsystem.fsm is None:
             continue
         key = _fsm_key(subsystem)
@@ -228,7 +228,7 @@ def analyses(context: CheckContext) -> dict[str, list[Finding]]:
             continue
         seen.add(key)
         owner = subsystem_name(agent, subsystem)
-        if subsystem.family is not None:
+        if subsystem.family is not None or agent.family is not None:
             owner = f"{owner} (and the other members of its family)"
         for code, found in analyse(subsystem, subsystem.fsm, owner).findings.items():
             result.setdefault(code, []).extend(found)

@@ -57,7 +57,7 @@ def predicates_are_boolean(context: CheckContext) -> Iterator[Finding]:
     (`fun` returns true or false), and their operators are applied to operands of the right type."""
 
     def findings() -> Iterator[Finding]:
-        for _agent, subsystem in context.subsystems():
+        for _agent, subsystem in context.distinct_subsystems():
             typer = ExpressionTyper(context, subsystem)
             for role, expression, location in _conditions(subsystem):
                 kind = typer.type_of(expression)
@@ -106,13 +106,32 @@ def _writes(
     return stages
 
 
+def _stage_fix(function: str, outputs: list[str], stages: int, number: int) -> str:
+    """How to move output-buffer writes out of an early stage: the hint of EARL-E040."""
+    memory = ", ".join(f"{name.removesuffix('/ob')}/mo" for name in outputs)
+    sends = ", ".join(outputs)
+    if stages == 1:
+        return (
+            f"a one-stage `tf` has no stage for outputs (Eq. 4–6): let `{function}/pf` write memory instead "
+            f"(`-> {memory}`, declared as `/m`) and add a second stage that sends it, "
+            f"`tf = {{{function}/pf}} then {{send/pf}}` with `send/pf(… /mi -> {sends})`"
+        )
+    return (
+        f"move `{function}/pf` into the last stage (stage {stages}) if it reads only memory, or let it write "
+        f"memory (`-> {memory}`) that a last-stage function sends to {sends}"
+    )
+
+
 @rule("EARL-E040", Severity.ERROR, "only the last stage writes output buffers", "Eq. (4), Eq. (6)")
 def output_buffers_in_last_stage(context: CheckContext) -> Iterator[Finding]:
-    """The first-stage functions (`pf`, Eq. 4) write only Internal Memory (`mo`, Eq. 5); the Output Buffers
-    are produced by the second stage (`pfo`, Eq. 6), after all memory is computed."""
+    """The first-stage functions (`pf`, Eq. 4) read Input Buffers and memory and write only Internal Memory
+    (`mo`, Eq. 5); the Output Buffers are produced by the second stage (`pfo`, Eq. 6), which reads only
+    memory (`mi`). So a transition function that sends anything has two stages, even when one function
+    does all the work (`tf = {control/pf}` writing `motor/ob` is refused): the fix is to let that function
+    write memory and add a second-stage function that copies the memory into the Output Buffer."""
 
     def findings() -> Iterator[Finding]:
-        for agent, subsystem in context.subsystems():
+        for agent, subsystem in context.distinct_subsystems():
             for behaviour in subsystem.basic_behaviours:
                 stages = behaviour.transition_function.stages
                 for number, stage in enumerate(stages, start=1):
@@ -122,13 +141,22 @@ def output_buffers_in_last_stage(context: CheckContext) -> Iterator[Finding]:
                         if function is None:
                             continue
                         if not last:
-                            for written in function.writes:
-                                if written.kind is Kind.OUTPUT_BUFFER:
-                                    yield Finding(
-                                        f"`{function.name}/pf` writes `{written.name}/ob` in stage {number} of `{behaviour.name}/bb` in `{subsystem_name(agent, subsystem)}`",
-                                        function_reference.location,
-                                        "Eq. (4)–(6): a first-stage function writes memory (`/mo`); move the output to a second stage (`then { … }`)",
-                                    )
+                            outputs = list(
+                                dict.fromkeys(
+                                    f"{reference_key(w)}/ob" for w in function.writes if w.kind is Kind.OUTPUT_BUFFER
+                                )
+                            )
+                            if outputs:
+                                why = (
+                                    "a transition function of one stage; output buffers are written by a second stage"
+                                    if len(stages) == 1
+                                    else "only the last stage writes output buffers"
+                                )
+                                yield Finding(
+                                    f"`{function.name}/pf` writes `{'`, `'.join(outputs)}` in stage {number} of `{behaviour.name}/bb` in `{subsystem_name(agent, subsystem)}`: {why}",
+                                    function_reference.location,
+                                    _stage_fix(function.name, outputs, len(stages), number),
+                                )
                         else:
                             for element in [*function.reads, *function.writes]:
                                 if element.kind in (Kind.INPUT_BUFFER, Kind.MEMORY_OUTPUT):
@@ -136,7 +164,8 @@ def output_buffers_in_last_stage(context: CheckContext) -> Iterator[Finding]:
                                     yield Finding(
                                         f"`{function.name}/pf` {what} `{reference_text(element)}` in the last stage of `{behaviour.name}/bb`",
                                         function_reference.location,
-                                        "Eq. (6): a second-stage function reads memory (`/mi`) and writes output buffers (`/ob`) only",
+                                        "Eq. (6): a second-stage function reads memory (`/mi`) and writes output buffers (`/ob`) only; "
+                                        "move this work into a function of the first stage",
                                     )
 
     yield from _once(findings())
@@ -175,7 +204,7 @@ def one_writer_per_stage(context: CheckContext) -> Iterator[Finding]:
     two of them may produce the same Internal Memory (Eq. 7) or Output Buffer (Eq. 8)."""
 
     def findings() -> Iterator[Finding]:
-        for agent, subsystem in context.subsystems():
+        for agent, subsystem in context.distinct_subsystems():
             for behaviour in subsystem.basic_behaviours:
                 for number, stage in enumerate(_writes(subsystem, behaviour), start=1):
                     writer: dict[str, str] = {}
@@ -221,7 +250,7 @@ def memory_read_before_written(context: CheckContext) -> Iterator[Finding]:
     function reads before an earlier stage wrote it holds only its type's zero value."""
 
     def findings() -> Iterator[Finding]:
-        for agent, subsystem in context.subsystems():
+        for agent, subsystem in context.distinct_subsystems():
             if subsystem.fsm is None:
                 continue
             state = subsystem.fsm.state_named(subsystem.fsm.initial)
