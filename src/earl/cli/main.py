@@ -13,7 +13,7 @@ import sys
 from collections.abc import Sequence
 
 from earl import __version__
-from earl.cli import check_command, fmt_command, rules_command, run_command, trace_command
+from earl.cli import check_command, diagram_command, doc_command, fmt_command, rules_command, run_command, trace_command
 
 EXIT_OK = 0
 EXIT_INVALID = 1
@@ -55,6 +55,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"earl {__version__}")
     commands = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     check_command.register(commands)
+    diagram_command.register(commands)
+    doc_command.register(commands)
     fmt_command.register(commands)
     rules_command.register(commands)
     run_command.register(commands)

@@ -1,0 +1,616 @@
+"""The document's content: what the manual's §3 shows, computed from a spec.
+
+A system overview with the Table 1 type of every agent and the inter-agent links
+(Figures 8 and 9); per agent its structure and data types (Figures 10 and 11);
+per subsystem its buffers, Table 3 (memory), Table 4 (primitive predicates),
+Table 5 (transition and terminal conditions), the FSM (Figure 12), its partial
+transition functions, Table 6 (compositions) and one activity diagram per basic
+behaviour (Figure 15); the checker's findings, each linked to the section of the
+element it is about.  Names in tables and expressions link to where they are defined.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+from earl import __version__
+from earl.diagnostics import Diagnostic, Severity
+from earl.model.elements import Agent, Subsystem, System
+from earl.model.expressions import ElementReference
+from earl.model.kinds import KIND_TITLES, Kind
+from earl.model.location import SourceLocation
+from earl.model.tables import AGENT_TYPES
+from earl.model.text import reference_text
+from earl.model.types import type_text
+from earl.render.build import Subject
+from earl.render.diagram import Diagram
+from earl.render.document.tree import (
+    BulletList,
+    Cell,
+    Code,
+    Content,
+    Document,
+    Figure,
+    Inline,
+    Link,
+    Paragraph,
+    Section,
+    Strong,
+    Table,
+    Text,
+    cell,
+    code,
+    text,
+)
+from earl.render.names import agent_name, indexed_name, qualified_subsystem_name, slug, subsystem_name
+from earl.render.tables import (
+    composition_table,
+    condition_table,
+    memory_table,
+    predicate_table,
+    transition_table,
+)
+from earl.render.views.activity import activity_view, stage_set_name
+from earl.render.views.agent import agent_links, agent_view
+from earl.render.views.fsm import fsm_view
+from earl.render.views.system import InterAgentLink, inter_agent_links, system_view
+from earl.render.views.types import agent_types, closure, types_view
+
+_REFERENCE = re.compile(r"\b([A-Za-z_]\w*)((?:\[[^\]]*\])?)/(pp|ib|ob|mi|mo|m|bb|pf)\b")
+_WORD = re.compile(r"[A-Za-z_]\w*")
+_SEVERITY_CSS = {Severity.ERROR: "error", Severity.WARNING: "warning", Severity.NOTE: "note"}
+
+
+@dataclass
+class Scope:
+    """The anchors of one subsystem's elements, so its tables and expressions can link to them.
+
+    An element answers to its indexed name (`windingCurrent[K]`, `windingCurrent[3]`)
+    and, when that is not found, to its bare name (a reference `windingCurrent[*]/mo`).
+    """
+
+    prefix: str  # the subsystem's qualified name
+    names: dict[tuple[str, str], str] = field(default_factory=dict)  # (name, kind) → anchor
+
+    @staticmethod
+    def _kind(kind: str) -> str:
+        return "m" if kind in ("mi", "mo") else kind
+
+    def anchor(self, indexed: str, kind: str) -> str:
+        return slug(self._kind(kind), self.prefix, indexed)
+
+    def define(self, name: str, indexed: str, kind: str) -> str:
+        anchor = self.anchor(indexed, kind)
+        self.names[(indexed, self._kind(kind))] = anchor
+        self.names.setdefault((name, self._kind(kind)), anchor)
+        return anchor
+
+    def find(self, name: str, index: str, kind: str) -> str | None:
+        kind = self._kind(kind)
+        return self.names.get((name + index, kind)) or self.names.get((name, kind))
+
+
+@dataclass
+class DocumentBuilder:
+    subject: Subject
+    diagnostics: Sequence[Diagnostic]
+    diagrams: list[Diagram] = field(default_factory=list)
+    type_names: set[str] = field(default_factory=set)
+    #: Where each diagnostic belongs: the anchor of the innermost element whose source holds it.
+    owners: list[tuple[SourceLocation, str, str]] = field(default_factory=list)
+
+    # ------------------------------------------------------------------ inline helpers
+    def figure(self, diagram: Diagram, caption: str) -> Figure:
+        self.diagrams.append(diagram)
+        return Figure(
+            f"diagrams/{diagram.slug}.svg",
+            (Text(caption + ": "), Code(diagram.header)),
+            diagram.header,
+            slug("fig", diagram.slug),
+        )
+
+    def type_content(self, written: str) -> Content:
+        """`JointPosition[]` with `JointPosition` linked to its definition."""
+        parts: list[Inline] = []
+        position = 0
+        for match in _WORD.finditer(written):
+            if match.group() in self.type_names:
+                if match.start() > position:
+                    parts.append(Code(written[position : match.start()]))
+                parts.append(Link(slug("type", match.group()), code(match.group())))
+                position = match.end()
+        if position < len(written):
+            parts.append(Code(written[position:]))
+        return tuple(parts)
+
+    @staticmethod
+    def expression_content(expression: str, scope: Scope) -> Content:
+        """An expression with each `name/kind` linked to the row that defines it."""
+        parts: list[Inline] = []
+        position = 0
+        for match in _REFERENCE.finditer(expression):
+            anchor = scope.find(match.group(1), match.group(2), match.group(3))
+            if anchor is None:
+                continue
+            if match.start() > position:
+                parts.append(Code(expression[position : match.start()]))
+            parts.append(Link(anchor, code(match.group())))
+            position = match.end()
+        if position < len(expression):
+            parts.append(Code(expression[position:]))
+        return tuple(parts)
+
+    # ------------------------------------------------------------------ the document
+    def build(self) -> Document:
+        system = self.subject.shown
+        self.type_names = {definition.name for definition in system.types}
+        self._owners(system)
+        sections = [self.overview(system)]
+        sections += [self.agent_section(system, agent) for agent in system.agents]
+        sections.append(self.types_section(system))
+        sections.append(self.check_section())
+        source = system.source_file or "a specification"
+        mode = "every family member drawn" if self.subject.expand else "indexed families drawn once"
+        subtitle = f"Generated by earl {__version__} from {source} ({mode}). Section and table numbers refer to the EARL reference manual 1.0."
+        return Document(f"{system.name}: an EARL specification", subtitle, sections)
+
+    def _owners(self, system: System) -> None:
+        for agent in system.agents:
+            if agent.location is not None:
+                self.owners.append((agent.location, slug("agent", agent_name(agent)), agent_name(agent)))
+            for subsystem in agent.subsystems:
+                if subsystem.location is not None:
+                    name = qualified_subsystem_name(agent, subsystem)
+                    self.owners.append((subsystem.location, slug("ss", name), name))
+
+    def owner_of(self, location: SourceLocation | None) -> tuple[str, str] | None:
+        if location is None:
+            return None
+        best: tuple[int, str, str] | None = None
+        for span, anchor, name in self.owners:
+            if span.file == location.file and span.line <= location.line <= span.end_line:
+                size = span.end_line - span.line
+                if best is None or size < best[0]:
+                    best = (size, anchor, name)
+        return None if best is None else (best[1], best[2])
+
+    # ------------------------------------------------------------------ §3.1: the system
+    def overview(self, system: System) -> Section:
+        section = Section(text(f"System {system.name}"), "system", 2)
+        robots = ", ".join(f"{r.name}/r" for r in system.robots)
+        section.add(
+            Paragraph(
+                text(
+                    f"{len(system.agents)} agent{'s' if len(system.agents) != 1 else ''}"
+                    + (f" in {robots}" if robots else "")
+                    + f", {len(system.links)} inter-agent link{'s' if len(system.links) != 1 else ''}. "
+                    "The type of each agent is computed from its subsystems and links as in the manual's Table 1."
+                )
+            )
+        )
+        section.add(self.agents_table(system))
+        section.add(self.figure(system_view(system, self.subject.agent_type), "Structure of the system (cf. Figure 8)"))
+        links = inter_agent_links(system)
+        if links:
+            section.add(self.links_table(links))
+            carried = closure(system, [name for link in links for name in _type_words(link.data_type)])
+            if carried:
+                diagram = types_view(carried, system.name, "dataTypes between agents")
+                diagram = Diagram(diagram.view, diagram.header, diagram.dot, "types-between-agents", diagram.names)
+                section.add(self.figure(diagram, "dataTypes transmitted between the agents (cf. Figure 9)"))
+        return section
+
+    def agents_table(self, system: System) -> Table:
+        context = self.subject.context
+        header = [
+            [cell("agent"), cell("robot"), cell("type"), cell("description")]
+            + [cell(f"|{kind}|") for kind in ("cs", "ve", "re", "vr", "rr", "aa")]
+        ]
+        rows = []
+        for agent in system.agents:
+            name = agent_name(agent)
+            robot = next((f"{r.name}/r" for r in system.robots if any(a.name == agent.name for a in r.agents)), "—")
+            row = self.subject.agent_type(agent)
+            instances = context.instances(agent) or [agent]
+            first = instances[0]
+            counts = [
+                len(first.subsystems_of(kind))
+                for kind in (
+                    Kind.CONTROL_SUBSYSTEM,
+                    Kind.VIRTUAL_EFFECTOR,
+                    Kind.REAL_EFFECTOR,
+                    Kind.VIRTUAL_RECEPTOR,
+                    Kind.REAL_RECEPTOR,
+                )
+            ]
+            counts.append(len(context.inter_agent_links(first)))
+            type_cell = cell((Strong(text(row.name)),)) if row is not None else cell("—")
+            rows.append(
+                [
+                    cell((Link(slug("agent", name), code(name)),)),
+                    cell(code(robot) if robot != "—" else text(robot)),
+                    type_cell,
+                    cell(row.description if row is not None else ""),
+                    *[cell(str(count)) for count in counts],
+                ]
+            )
+        known = ", ".join(f"{t.name} ({t.description})" for t in AGENT_TYPES)
+        caption = text(
+            f"Agents and their types (Table 1; counts of one member for a family). Table 1's types: {known}."
+        )
+        return Table(caption, header, rows, "agents")
+
+    def links_table(self, links: list[InterAgentLink]) -> Table:
+        header = [[cell("link"), cell("from"), cell("to"), cell("dataType")]]
+        rows = []
+        for link in links:
+            source = qualified_subsystem_name(link.source, _cs(link.source))
+            destination = qualified_subsystem_name(link.destination, _cs(link.destination))
+            rows.append(
+                [
+                    cell(code(link.link.name_text), anchor=slug("aa", link.link.name_text)),
+                    cell((Link(slug("ob", source, link.source_buffer), code(f"{source}.{link.source_buffer}/ob")),)),
+                    cell(
+                        (
+                            Link(
+                                slug("ib", destination, link.destination_buffer),
+                                code(f"{destination}.{link.destination_buffer}/ib"),
+                            ),
+                        )
+                    ),
+                    cell(self.type_content(link.data_type)),
+                ]
+            )
+        return Table(
+            text("Inter-agent links aa (§2.5: the source agent's name, a comma, the destination's)"),
+            header,
+            rows,
+            "links",
+        )
+
+    # ------------------------------------------------------------------ §3.2: an agent
+    def agent_section(self, system: System, agent: Agent) -> Section:
+        name = agent_name(agent)
+        section = Section((Text("Agent "), Code(name)), slug("agent", name), 2)
+        row = self.subject.agent_type(agent)
+        facts: list[Inline] = []
+        if row is not None:
+            facts += [Text("Type "), Strong(text(row.name)), Text(f" ({row.description}, Table 1). ")]
+        facts.append(Text("Subsystems: "))
+        for position, subsystem in enumerate(agent.subsystems):
+            qualified = qualified_subsystem_name(agent, subsystem)
+            if position:
+                facts.append(Text(", "))
+            facts.append(Link(slug("ss", qualified), code(subsystem_name(subsystem))))
+        facts.append(Text("."))
+        section.add(Paragraph(tuple(facts)))
+        section.add(self.figure(agent_view(agent, system), f"Structure of {name} (cf. Figure 10)"))
+        used = agent_types(system, agent)
+        if used:
+            section.add(self.figure(types_view(used, name), f"dataTypes of {name} (cf. Figure 11)"))
+        links = _buffer_links(system, agent)
+        for subsystem in agent.subsystems:
+            section.add(self.subsystem_section(agent, subsystem, links))
+        return section
+
+    def subsystem_section(self, agent: Agent, subsystem: Subsystem, links: BufferLinks) -> Section:
+        qualified = qualified_subsystem_name(agent, subsystem)
+        scope = Scope(qualified)
+        for buffer in subsystem.input_buffers:
+            scope.define(buffer.name, indexed_name(buffer), "ib")
+        for output in subsystem.output_buffers:
+            scope.define(output.name, indexed_name(output), "ob")
+        for memory in subsystem.memories:
+            scope.define(memory.name, indexed_name(memory), "m")
+        for predicate in subsystem.primitive_predicates:
+            scope.define(predicate.name, predicate.name, "pp")
+        for function in subsystem.partial_transition_functions:
+            scope.define(function.name, function.name, "pf")
+        for behaviour in subsystem.basic_behaviours:
+            scope.define(behaviour.name, behaviour.name, "bb")
+
+        title = (Code(qualified), Text(f" — {KIND_TITLES[subsystem.kind]}"))
+        section = Section(title, slug("ss", qualified), 3)
+        facts = []
+        if subsystem.family is not None and subsystem.index is None:
+            note = subsystem.family
+            facts.append(
+                f"An indexed family, drawn once: {subsystem_name(subsystem)} for {note.index} ∈ "
+                f"{reference_range(subsystem)}."
+            )
+        if subsystem.period is not None:
+            facts.append(f"Period {subsystem.period.value} {subsystem.period.unit}.")
+        if facts:
+            section.add(Paragraph(text(" ".join(facts))))
+        findings = [d for d in self.diagnostics if (self.owner_of(d.location) or ("", ""))[0] == section.anchor]
+        if findings:
+            section.add(self.findings_list(findings))
+        if subsystem.input_buffers or subsystem.output_buffers:
+            section.add(self.buffers_table(subsystem, qualified, scope, links))
+        if subsystem.memories:
+            section.add(self.memory_table(subsystem, qualified, scope))
+        if subsystem.primitive_predicates:
+            section.add(self.predicates_table(subsystem, qualified, scope))
+        if subsystem.fsm is not None or subsystem.basic_behaviours:
+            section.add(self.conditions_table(subsystem, qualified, scope))
+        if subsystem.fsm is not None:
+            section.add(
+                self.figure(
+                    fsm_view(subsystem.fsm, qualified, subsystem, self.subject.expand),
+                    f"{qualified}.fsm; conditions in Table 5 (cf. Figure 12)",
+                )
+            )
+        if subsystem.partial_transition_functions:
+            section.add(self.functions_table(subsystem, qualified, scope))
+        if subsystem.basic_behaviours:
+            section.add(self.composition_table(subsystem, qualified, scope))
+            for behaviour in subsystem.basic_behaviours:
+                diagram = activity_view(behaviour, qualified, subsystem)
+                section.add(self.figure(diagram, f"{behaviour.name}/bb.tf.execute() (cf. Figure 15)"))
+        return section
+
+    def findings_list(self, findings: Sequence[Diagnostic]) -> BulletList:
+        items: list[Content] = []
+        for d in findings:
+            where = f" ({d.location})" if d.location else ""
+            items.append((Strong(text(f"{d.severity.value} {d.code or ''}".strip())), Text(f": {d.message}{where}")))
+        return BulletList(items)
+
+    def buffers_table(self, subsystem: Subsystem, qualified: str, scope: Scope, links: BufferLinks) -> Table:
+        header = [[cell("buffer"), cell("dataType"), cell("linked with")]]
+        rows = []
+        for kind, buffers in (("ib", subsystem.input_buffers), ("ob", subsystem.output_buffers)):
+            for buffer in buffers:
+                name = indexed_name(buffer)
+                others: list[Inline] = []
+                for other_anchor, other_name, link_name in links.get((id(subsystem), kind, name), []):
+                    if others:
+                        others.append(Text(", "))
+                    arrow = "← " if kind == "ib" else "→ "
+                    others += [Text(arrow), Link(other_anchor, code(other_name)), Text(f" ({link_name})")]
+                rows.append(
+                    [
+                        cell(code(f"{name}/{kind}"), anchor=slug(kind, qualified, name)),
+                        cell(self.type_content(type_text(buffer.data_type))),
+                        cell(tuple(others) or text("—")),
+                    ]
+                )
+        return Table(text(f"Input and Output Buffers of {qualified}"), header, rows)
+
+    def memory_table(self, subsystem: Subsystem, qualified: str, scope: Scope) -> Table:
+        header = [[cell("m"), cell("dataType"), cell("initial value")]]
+        rows = [
+            [
+                cell(code(f"{row.name}/m"), anchor=scope.anchor(row.name, "m")),
+                cell(self.type_content(row.data_type)),
+                cell(code(row.initial_value) if row.initial_value is not None else text("—")),
+            ]
+            for row in memory_table(subsystem)
+        ]
+        return Table(text(f"Table 3: {qualified}.m dataTypes"), header, rows)
+
+    def predicates_table(self, subsystem: Subsystem, qualified: str, scope: Scope) -> Table:
+        header = [[cell("pp"), cell("fun")]]
+        rows = [
+            [
+                cell(code(f"{row.name}/pp"), anchor=scope.anchor(row.name, "pp")),
+                cell(self.expression_content(row.fun, scope)),
+            ]
+            for row in predicate_table(subsystem)
+        ]
+        return Table(text(f"Table 4: definitions of {qualified}.pp.fun"), header, rows)
+
+    def conditions_table(self, subsystem: Subsystem, qualified: str, scope: Scope) -> Table:
+        header = [[cell("t"), cell("PREDICATE (initial condition ic)"), cell("priority")]]
+        rows: list[list[Cell]] = []
+        for row in transition_table(subsystem):
+            if row.source is None:
+                name: Content = (Code(f"i,{row.destination}/t"), Text(f" where i ≠ {row.destination}"))
+            else:
+                name = code(f"{row.name}/t")
+            rows.append(
+                [
+                    cell(name, anchor=slug("t", qualified, row.name)),
+                    cell(self.expression_content(row.predicate, scope)),
+                    cell("—" if row.priority is None else str(row.priority)),
+                ]
+            )
+        rows.append(
+            [
+                cell((Strong(text("bb")),)),
+                cell((Strong(text("PREDICATE (terminal condition tc; error condition ec)")),)),
+                cell(""),
+            ]
+        )
+        for condition in condition_table(subsystem):
+            predicate: Content = (Text("tc: "), *self.expression_content(condition.terminal_condition, scope))
+            if condition.error_condition is not None:
+                predicate += (Text("; ec: "), *self.expression_content(condition.error_condition, scope))
+            rows.append(
+                [
+                    cell(code(f"{condition.behaviour}/bb"), anchor=scope.anchor(condition.behaviour, "bb")),
+                    cell(predicate),
+                    cell(""),
+                ]
+            )
+        caption = text(
+            f"Table 5: initial conditions labelling {qualified}.fsm transitions and terminal conditions of {qualified}.bb"
+        )
+        return Table(caption, header, rows)
+
+    def functions_table(self, subsystem: Subsystem, qualified: str, scope: Scope) -> Table:
+        header = [
+            [cell("pf"), cell("reads (ib, mi)"), cell("writes (mo, ob)"), cell("stage set"), cell("implementation")]
+        ]
+        stage_sets = {
+            reference.name: stage_set.name for stage_set in subsystem.stage_sets for reference in stage_set.functions
+        }
+        rows = []
+        for function in subsystem.partial_transition_functions:
+            implementation = function.implementation.path if function.implementation is not None else "—"
+            rows.append(
+                [
+                    cell(code(f"{function.name}/pf"), anchor=scope.anchor(function.name, "pf")),
+                    cell(self._references(function.reads, scope)),
+                    cell(self._references(function.writes, scope)),
+                    cell(code(stage_sets[function.name]) if function.name in stage_sets else text("—")),
+                    # the path is shown, never imported: documenting a spec runs none of its code
+                    cell(code(implementation) if function.implementation is not None else text(implementation)),
+                ]
+            )
+        return Table(text(f"Partial transition functions of {qualified} (§2.2, Figure 6; Eq. 4 and 6)"), header, rows)
+
+    def _references(self, references: Sequence[ElementReference], scope: Scope) -> Content:
+        parts: list[Inline] = []
+        for reference in references:
+            written = reference_text(reference)
+            if parts:
+                parts.append(Text(", "))
+            parts += list(self.expression_content(written, scope))
+        return tuple(parts) or text("—")
+
+    def composition_table(self, subsystem: Subsystem, qualified: str, scope: Scope) -> Table:
+        table = composition_table(subsystem)
+        memory = [c for c in table.columns if c.kind is Kind.MEMORY_OUTPUT]
+        outputs = [c for c in table.columns if c.kind is Kind.OUTPUT_BUFFER]
+        header = [
+            [cell("bb", rowspan=2), cell("pf", rowspan=2)]
+            + ([cell("/mo", colspan=len(memory))] if memory else [])
+            + ([cell("/ob", colspan=len(outputs))] if outputs else []),
+            [cell(code(c.name)) for c in [*memory, *outputs]],
+        ]
+        rows: list[list[Cell]] = []
+        spans: dict[str, int] = {}
+        for row in table.rows:
+            spans[row.behaviour] = spans.get(row.behaviour, 0) + 1
+        seen: set[str] = set()
+        for row in table.rows:
+            cells: list[Cell] = []
+            if row.behaviour not in seen:
+                seen.add(row.behaviour)
+                cells.append(
+                    cell(
+                        (Link(scope.anchor(row.behaviour, "bb"), code(f"{row.behaviour}/bb")),),
+                        rowspan=spans[row.behaviour],
+                    )
+                )
+            function_name = code(f"{row.function}/pf")
+            cells.append(cell((Link(scope.anchor(row.function, "pf"), function_name),) if row.known else function_name))
+            for column in [*memory, *outputs]:
+                cells.append(cell("•", css="bullet") if table.bullet(row, column) else cell("", css="bullet"))
+            rows.append(cells)
+        caption = text(
+            f"Table 6: compositions of Transition Functions {qualified}.bb.tf.pf; a bullet marks the Internal Memory "
+            "and Output Buffers each Partial Transition Function produces"
+        )
+        return Table(caption, header, rows, slug("table6", qualified), css="matrix")
+
+    # ------------------------------------------------------------------ data types and check results
+    def types_section(self, system: System) -> Section:
+        section = Section(text("Data types"), "types", 2)
+        if not system.types:
+            section.add(Paragraph(text("The specification defines no data types; it uses primitive types only.")))
+            return section
+        header = [[cell("dataType"), cell("definition")]]
+        rows = []
+        for definition in system.types:
+            fields: list[Inline] = []
+            if hasattr(definition, "fields"):
+                for field_ in definition.fields:
+                    if fields:
+                        fields.append(Text("; "))
+                    fields += [Code(f"{field_.name}: "), *self.type_content(type_text(field_.data_type))]
+                    if field_.optional:
+                        fields.append(Text(" (optional)"))
+            else:
+                fields += [Text("= "), *self.type_content(type_text(definition.data_type))]
+            rows.append(
+                [cell(code(definition.name), anchor=slug("type", definition.name)), cell(tuple(fields) or text("—"))]
+            )
+        section.add(Table(text("Data types of the specification"), header, rows))
+        section.add(self.figure(types_view(system.types, system.name), "All dataTypes of the specification"))
+        return section
+
+    def check_section(self) -> Section:
+        section = Section(text("Check results"), "check", 2)
+        counts = {severity: sum(1 for d in self.diagnostics if d.severity is severity) for severity in Severity}
+        summary = ", ".join(f"{n} {s.value}{'s' if n != 1 else ''}" for s, n in counts.items())
+        verdict = (
+            "The specification breaks rules of the EARL manual."
+            if counts[Severity.ERROR]
+            else "The specification follows every rule of the EARL manual that `earl check` knows."
+        )
+        section.add(Paragraph(text(f"earl check: {summary}. {verdict}")))
+        if not self.diagnostics:
+            return section
+        header = [[cell("severity"), cell("rule"), cell("where"), cell("message")]]
+        rows = []
+        for d in self.diagnostics:
+            owner = self.owner_of(d.location)
+            where: Content = text(str(d.location) if d.location else "—")
+            if owner is not None:
+                where = (Link(owner[0], code(owner[1])), Text(f" ({d.location})"))
+            message = d.message + (f" — hint: {d.hint}" if d.hint else "")
+            rows.append(
+                [
+                    cell(d.severity.value, css=_SEVERITY_CSS[d.severity]),
+                    cell(code(d.code) if d.code else text("—")),
+                    cell(where),
+                    cell(message),
+                ]
+            )
+        section.add(Table(text("Findings of earl check (docs/rules.md explains each rule)"), header, rows, "findings"))
+        return section
+
+
+# ---------------------------------------------------------------------- helpers
+BufferLinks = dict[tuple[int, str, str], list[tuple[str, str, str]]]
+
+
+def _buffer_links(system: System, agent: Agent) -> BufferLinks:
+    """For each buffer of the agent (subsystem identity, ib|ob, name): the buffers at the other end of its links."""
+    table: BufferLinks = {}
+    for link in agent_links(agent):
+        source = qualified_subsystem_name(agent, link.source)
+        destination = qualified_subsystem_name(agent, link.destination)
+        output, input_ = indexed_name(link.output), indexed_name(link.input)
+        label = ",".join(p.name for p in link.link.name)
+        table.setdefault((id(link.source), "ob", output), []).append(
+            (slug("ib", destination, input_), f"{destination}.{input_}/ib", label)
+        )
+        table.setdefault((id(link.destination), "ib", input_), []).append(
+            (slug("ob", source, output), f"{source}.{output}/ob", label)
+        )
+    for link in inter_agent_links(system):
+        source = qualified_subsystem_name(link.source, _cs(link.source))
+        destination = qualified_subsystem_name(link.destination, _cs(link.destination))
+        label = link.link.name_text
+        if link.source is agent:
+            table.setdefault((id(_cs(agent)), "ob", link.source_buffer), []).append(
+                (slug("ib", destination, link.destination_buffer), f"{destination}.{link.destination_buffer}/ib", label)
+            )
+        if link.destination is agent:
+            table.setdefault((id(_cs(agent)), "ib", link.destination_buffer), []).append(
+                (slug("ob", source, link.source_buffer), f"{source}.{link.source_buffer}/ob", label)
+            )
+    return table
+
+
+def _cs(agent: Agent) -> Subsystem:
+    cs = agent.control_subsystem
+    assert cs is not None  # inter_agent_links only returns agents with a control subsystem
+    return cs
+
+
+def _type_words(written: str) -> list[str]:
+    return _WORD.findall(written)
+
+
+def reference_range(subsystem: Subsystem) -> str:
+    from earl.model.text import expression_text
+
+    family = subsystem.family
+    assert family is not None
+    return f"{expression_text(family.first)}..{expression_text(family.last)}"

@@ -1,0 +1,141 @@
+"""The document as one static HTML page: inline CSS, no script, nothing fetched from the network."""
+
+from __future__ import annotations
+
+from html import escape
+
+from earl.render.document.tree import (
+    Block,
+    BulletList,
+    Cell,
+    Code,
+    Content,
+    Document,
+    Figure,
+    Inline,
+    Link,
+    Paragraph,
+    Section,
+    Strong,
+    Table,
+    Text,
+)
+
+CSS = """
+:root { --ink: #1d2430; --muted: #5b6472; --rule: #d5dae1; --accent: #1f5fa8; --shade: #f4f6f9; }
+* { box-sizing: border-box; }
+body { margin: 0; font: 15px/1.5 -apple-system, "Segoe UI", Helvetica, Arial, sans-serif; color: var(--ink); }
+nav { position: fixed; top: 0; bottom: 0; left: 0; width: 250px; overflow-y: auto; padding: 18px 14px;
+      background: var(--shade); border-right: 1px solid var(--rule); font-size: 13px; }
+nav ul { list-style: none; margin: 0; padding-left: 12px; }
+nav > ul { padding-left: 0; }
+nav a { color: var(--ink); text-decoration: none; display: block; padding: 1px 0; }
+nav a:hover { color: var(--accent); }
+main { margin-left: 250px; padding: 24px 40px 80px; max-width: 1300px; }
+h1 { font-size: 26px; margin: 0 0 4px; }
+h2 { font-size: 21px; margin-top: 40px; padding-top: 8px; border-top: 2px solid var(--rule); }
+h3 { font-size: 17px; margin-top: 30px; }
+.subtitle { color: var(--muted); margin-top: 0; }
+code { font: 13px/1.4 "DejaVu Sans Mono", Menlo, Consolas, monospace; background: #eef1f5; padding: 0 3px;
+       border-radius: 3px; }
+a { color: var(--accent); }
+a code { color: var(--accent); }
+table { border-collapse: collapse; margin: 14px 0 22px; font-size: 13.5px; }
+caption { caption-side: top; text-align: left; font-weight: 600; padding: 0 0 6px; }
+th, td { border: 1px solid var(--rule); padding: 4px 8px; vertical-align: top; text-align: left; }
+th { background: var(--shade); }
+table.matrix td.bullet, table.matrix th { text-align: center; }
+table.matrix td.bullet { font-size: 18px; line-height: 1; min-width: 34px; }
+td.error { color: #b00020; font-weight: 600; }
+td.warning { color: #9a6700; font-weight: 600; }
+td.note { color: var(--muted); }
+tr:target, td:target { background: #fff6cc; }
+figure { margin: 16px 0 28px; }
+figure img { max-width: 100%; height: auto; border: 1px solid var(--rule); background: white; }
+figcaption { color: var(--muted); font-size: 13px; margin-top: 4px; }
+@media print { nav { display: none; } main { margin-left: 0; } }
+"""
+
+
+def inline(part: Inline) -> str:
+    if isinstance(part, Text):
+        return escape(part.text)
+    if isinstance(part, Code):
+        return f"<code>{escape(part.text)}</code>"
+    if isinstance(part, Link):
+        return f'<a href="#{escape(part.anchor)}">{content(part.content)}</a>'
+    if isinstance(part, Strong):
+        return f"<strong>{content(part.content)}</strong>"
+    raise TypeError(part)
+
+
+def content(parts: Content) -> str:
+    return "".join(inline(part) for part in parts)
+
+
+def _cell(tag: str, item: Cell) -> str:
+    attributes = ""
+    if item.rowspan > 1:
+        attributes += f' rowspan="{item.rowspan}"'
+    if item.colspan > 1:
+        attributes += f' colspan="{item.colspan}"'
+    if item.anchor:
+        attributes += f' id="{escape(item.anchor)}"'
+    if item.css:
+        attributes += f' class="{item.css}"'
+    return f"<{tag}{attributes}>{content(item.content)}</{tag}>"
+
+
+def table(item: Table) -> str:
+    attributes = (f' id="{escape(item.anchor)}"' if item.anchor else "") + (f' class="{item.css}"' if item.css else "")
+    head = "".join("<tr>" + "".join(_cell("th", c) for c in row) + "</tr>" for row in item.header)
+    body = "".join("<tr>" + "".join(_cell("td", c) for c in row) + "</tr>" for row in item.rows)
+    return f"<table{attributes}><caption>{content(item.caption)}</caption><thead>{head}</thead><tbody>{body}</tbody></table>"
+
+
+def block(item: Block) -> str:
+    if isinstance(item, Paragraph):
+        return f"<p>{content(item.content)}</p>"
+    if isinstance(item, BulletList):
+        return "<ul>" + "".join(f"<li>{content(entry)}</li>" for entry in item.items) + "</ul>"
+    if isinstance(item, Table):
+        return table(item)
+    if isinstance(item, Figure):
+        anchor = f' id="{escape(item.anchor)}"' if item.anchor else ""
+        return (
+            f'<figure{anchor}><a href="{escape(item.path)}"><img src="{escape(item.path)}" alt="{escape(item.alt)}"></a>'
+            f"<figcaption>{content(item.caption)}</figcaption></figure>"
+        )
+    return section(item)
+
+
+def section(item: Section) -> str:
+    tag = f"h{min(item.level, 6)}"
+    inner = "\n".join(block(b) for b in item.blocks)
+    return f'<section id="{escape(item.anchor)}">\n<{tag}>{content(item.title)}</{tag}>\n{inner}\n</section>'
+
+
+def _navigation(sections: list[Section]) -> str:
+    items = []
+    for item in sections:
+        children = [b for b in item.blocks if isinstance(b, Section)]
+        inner = (
+            "<ul>"
+            + "".join(f'<li><a href="#{escape(c.anchor)}">{content(c.title)}</a></li>' for c in children)
+            + "</ul>"
+        )
+        items.append(f'<li><a href="#{escape(item.anchor)}">{content(item.title)}</a>{inner if children else ""}</li>')
+    return "<nav><ul>" + "".join(items) + "</ul></nav>"
+
+
+def render_html(document: Document) -> str:
+    body = "\n".join(section(s) for s in document.sections)
+    return (
+        "<!DOCTYPE html>\n"
+        '<html lang="en">\n<head>\n<meta charset="utf-8">\n'
+        '<meta name="viewport" content="width=device-width, initial-scale=1">\n'
+        '<meta name="generator" content="earl doc">\n'
+        f"<title>{escape(document.title)}</title>\n<style>{CSS}</style>\n</head>\n<body>\n"
+        f"{_navigation(document.sections)}\n<main>\n<h1>{escape(document.title)}</h1>\n"
+        f'<p class="subtitle">{escape(document.subtitle)}</p>\n{body}\n</main>\n</body>\n</html>\n'
+    )

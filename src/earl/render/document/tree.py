@@ -1,0 +1,106 @@
+"""The document as a tree that both the HTML and the Markdown printers read."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+
+@dataclass(frozen=True)
+class Text:
+    text: str
+
+
+@dataclass(frozen=True)
+class Code:
+    """An element name or an expression, in monospace."""
+
+    text: str
+
+
+@dataclass(frozen=True)
+class Link:
+    """A cross-link to an anchor of the same document."""
+
+    anchor: str
+    content: tuple[Inline, ...]
+
+
+@dataclass(frozen=True)
+class Strong:
+    content: tuple[Inline, ...]
+
+
+Inline = Text | Code | Link | Strong
+Content = tuple[Inline, ...]
+
+
+@dataclass(frozen=True)
+class Cell:
+    content: Content
+    rowspan: int = 1
+    colspan: int = 1
+    anchor: str | None = None  # the element this cell defines
+    css: str = ""  # "bullet", "error", "warning", "note"
+
+
+@dataclass
+class Paragraph:
+    content: Content
+
+
+@dataclass
+class BulletList:
+    items: list[Content]
+
+
+@dataclass
+class Table:
+    caption: Content
+    header: list[list[Cell]]  # header rows; cells may span
+    rows: list[list[Cell]]
+    anchor: str | None = None
+    css: str = ""  # "matrix" for Table 6
+
+
+@dataclass
+class Figure:
+    path: str  # relative to the document, `diagrams/fsm-manip-a-cs.svg`
+    caption: Content
+    alt: str
+    anchor: str | None = None
+
+
+@dataclass
+class Section:
+    title: Content
+    anchor: str
+    level: int
+    blocks: list[Block] = field(default_factory=list)
+
+    def add(self, block: Block) -> None:
+        self.blocks.append(block)
+
+
+Block = Paragraph | BulletList | Table | Figure | Section
+
+
+@dataclass
+class Document:
+    title: str
+    subtitle: str
+    sections: list[Section]
+
+
+def text(value: str) -> Content:
+    return (Text(value),)
+
+
+def code(value: str) -> Content:
+    return (Code(value),)
+
+
+def cell(
+    content: Content | str, *, rowspan: int = 1, colspan: int = 1, anchor: str | None = None, css: str = ""
+) -> Cell:
+    inline = text(content) if isinstance(content, str) else content
+    return Cell(inline, rowspan, colspan, anchor, css)

@@ -1,0 +1,125 @@
+"""`--target manip/a.cs.jointMove/bb`: finding the element a diagram is about.
+
+A target is written in the manual's dot notation: an agent (`manip/a`), a
+subsystem (`manip/a.cs`, `manip/a.motorController/ve`), or a Basic Behaviour
+(`manip/a.cs.jointMove/bb`, optionally followed by `.tf` or `.tf.execute()`).
+A family is named without an index, or with its index variable
+(`motorController[K]/ve`); with `--expand`, a member is named by its number
+(`motorController[3]/ve`).
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from earl.model.elements import Agent, BasicBehaviour, Family, Subsystem, System
+from earl.render.names import agent_name, qualified_subsystem_name
+
+_SEGMENT = re.compile(r"^(?P<name>[A-Za-z_]\w*)(?:\[(?P<index>[^\]]*)\])?(?:/(?P<kind>[a-z]+))?$")
+
+
+class TargetError(Exception):
+    """A `--target` that names nothing; the message lists what could be named instead."""
+
+
+@dataclass(frozen=True)
+class Segment:
+    name: str
+    index: str | None
+    kind: str | None
+
+
+def _segments(text: str) -> list[Segment]:
+    cleaned = text.strip()
+    for suffix in (".tf.execute()", ".tf"):
+        if cleaned.endswith(suffix):
+            cleaned = cleaned[: -len(suffix)]
+    result = []
+    for part in cleaned.split("."):
+        match = _SEGMENT.match(part)
+        if match is None:
+            raise TargetError(f"`{text}` is not a target: `{part}` should look like `name/kind`, e.g. `manip/a.cs`")
+        result.append(Segment(match["name"], match["index"], match["kind"]))
+    return result
+
+
+def _matches(segment: Segment, name: str, family: Family | None, index: int | None, kind: str) -> bool:
+    if segment.name != name or (segment.kind is not None and segment.kind != kind):
+        return False
+    if index is not None:  # a member of an expanded family answers to its number only
+        return segment.index is not None and segment.index.strip() == str(index)
+    if family is None:
+        return segment.index is None
+    # a family drawn once answers to its name, its index variable, or any member's number
+    return True
+
+
+def _choices(names: Sequence[str]) -> str:
+    shown = ", ".join(f"`{n}`" for n in names[:12])
+    return shown + (f" and {len(names) - 12} more" if len(names) > 12 else "")
+
+
+def find_agent(system: System, text: str) -> Agent:
+    segments = _segments(text)
+    first = segments[0]
+    if first.kind is None and len(segments) == 1:
+        first = Segment(first.name, first.index, "a")
+    found = [a for a in system.agents if _matches(first, a.name, a.family, a.index, "a")]
+    if len(found) != 1 or len(segments) != 1:
+        raise TargetError(f"no agent `{text}`; the agents are {_choices([agent_name(a) for a in system.agents])}")
+    return found[0]
+
+
+def _subsystem_in(agent: Agent, segment: Segment) -> Subsystem | None:
+    for subsystem in agent.subsystems:
+        kind = subsystem.kind.value
+        if segment.name == "cs" and segment.kind in (None, "cs") and kind == "cs":
+            return subsystem
+        if segment.kind is not None and _matches(segment, subsystem.name, subsystem.family, subsystem.index, kind):
+            return subsystem
+    return None
+
+
+def all_subsystems(system: System) -> list[tuple[Agent, Subsystem]]:
+    return [(agent, subsystem) for agent in system.agents for subsystem in agent.subsystems]
+
+
+def find_subsystem(system: System, text: str) -> tuple[Agent, Subsystem]:
+    segments = _segments(text)
+    choices = [qualified_subsystem_name(a, s) for a, s in all_subsystems(system)]
+    if len(segments) != 2:
+        raise TargetError(f"`{text}` does not name a subsystem; the subsystems are {_choices(choices)}")
+    try:
+        agent = find_agent(system, segments[0].name + _index(segments[0]) + "/" + (segments[0].kind or "a"))
+    except TargetError:
+        raise TargetError(f"no subsystem `{text}`; the subsystems are {_choices(choices)}") from None
+    subsystem = _subsystem_in(agent, segments[1])
+    if subsystem is None:
+        raise TargetError(f"no subsystem `{text}`; the subsystems are {_choices(choices)}")
+    return agent, subsystem
+
+
+def find_behaviour(system: System, text: str) -> tuple[Agent, Subsystem, BasicBehaviour]:
+    segments = _segments(text)
+    choices = [
+        f"{qualified_subsystem_name(a, s)}.{b.name}/bb" for a, s in all_subsystems(system) for b in s.basic_behaviours
+    ]
+    if len(segments) != 3 or segments[2].kind not in (None, "bb"):
+        raise TargetError(f"`{text}` does not name a basic behaviour; they are {_choices(choices)}")
+    head = ".".join(f"{s.name}{_index(s)}" + (f"/{s.kind}" if s.kind else "") for s in segments[:2])
+    try:
+        agent, subsystem = find_subsystem(system, head)
+    except TargetError:
+        raise TargetError(f"no basic behaviour `{text}`; they are {_choices(choices)}") from None
+    behaviour = subsystem.basic_behaviour(segments[2].name)
+    if behaviour is None:
+        own = [f"{b.name}/bb" for b in subsystem.basic_behaviours]
+        where = qualified_subsystem_name(agent, subsystem)
+        raise TargetError(f"{where} has no basic behaviour `{segments[2].name}/bb`; it has {_choices(own)}")
+    return agent, subsystem, behaviour
+
+
+def _index(segment: Segment) -> str:
+    return "" if segment.index is None else f"[{segment.index}]"

@@ -1,0 +1,153 @@
+"""The agent view (the manual's Figure 10): subsystems, their buffers and memory, inter-subsystem links.
+
+Input Buffers are small squares on the left edge of a subsystem, Output Buffers
+on the right; a link is an arrow from an Output Buffer to an Input Buffer.
+Internal Memory is listed under the buffers with the manual's bidirectional arrow.
+Agents at the other end of this agent's inter-agent links are drawn dashed, outside.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from earl.model.elements import Agent, InputBuffer, Link, OutputBuffer, Subsystem, System
+from earl.model.kinds import KIND_TITLES, Kind
+from earl.model.text import expression_text
+from earl.model.types import type_text
+from earl.render.diagram import Diagram
+from earl.render.dot import FILL, Graph, html
+from earl.render.names import (
+    Key,
+    agent_name,
+    element_key,
+    element_name,
+    family_note,
+    indexed_name,
+    lookup,
+    slug,
+    subsystem_name,
+)
+from earl.render.views.common import Port, block, node_id
+from earl.render.views.system import inter_agent_links
+
+
+@dataclass(frozen=True)
+class SubsystemLink:
+    """A link inside an agent with the subsystems and buffers at its ends."""
+
+    link: Link
+    source: Subsystem
+    output: OutputBuffer
+    destination: Subsystem
+    input: InputBuffer
+
+
+def agent_links(agent: Agent) -> list[SubsystemLink]:
+    """The agent's inter-subsystem links whose ends can be found; the checker reports the others."""
+    subsystems: dict[Key, Subsystem] = {element_key(s, s.kind): s for s in agent.subsystems}
+    result = []
+    for link in agent.links:
+        source = lookup(subsystems, link.source.subsystem)
+        destination = lookup(subsystems, link.destination.subsystem)
+        if source is None or destination is None:
+            continue
+        output = lookup({element_key(b, Kind.OUTPUT_BUFFER): b for b in source.output_buffers}, link.source.buffer)
+        input_ = lookup(
+            {element_key(b, Kind.INPUT_BUFFER): b for b in destination.input_buffers}, link.destination.buffer
+        )
+        if output is not None and input_ is not None:
+            result.append(SubsystemLink(link, source, output, destination, input_))
+    return result
+
+
+def link_label(link: Link) -> str:
+    """`cs,motorController[K]`: the link's name with its index, without the family's range."""
+    return ",".join(
+        part.name if part.index is None else f"{part.name}[{expression_text(part.index)}]" for part in link.name
+    )
+
+
+def port_name(direction: str, element_key_text: str) -> str:
+    return "p_" + direction + "_" + "".join(c if c.isalnum() else "_" for c in element_key_text)
+
+
+def subsystem_block(subsystem: Subsystem) -> str:
+    title = [f"<i>«{html(KIND_TITLES[subsystem.kind])}»</i>", f"<b>{html(subsystem_name(subsystem))}</b>"]
+    notes = [note for note in (family_note(subsystem),) if note]
+    if subsystem.period is not None:
+        notes.append(f"period {subsystem.period.value} {subsystem.period.unit}")
+    inputs = [
+        Port(port_name("ib", indexed_name(b)), element_name(b, Kind.INPUT_BUFFER)) for b in subsystem.input_buffers
+    ]
+    outputs = [
+        Port(port_name("ob", indexed_name(b)), element_name(b, Kind.OUTPUT_BUFFER)) for b in subsystem.output_buffers
+    ]
+    memory = [
+        f'⇅ {html(element_name(m, Kind.MEMORY))} <font color="#666666">: {html(type_text(m.data_type))}</font>'
+        for m in subsystem.memories
+    ]
+    return block(title, inputs, outputs, memory, FILL.get(subsystem.kind.value, "white"), notes)
+
+
+def agent_view(agent: Agent, system: System | None = None) -> Diagram:
+    name = agent_name(agent)
+    graph = Graph(f"ibd [Agent] {name}")
+    graph.graph_attributes["ranksep"] = "1.1"
+    names: list[str] = [name]
+    nodes: dict[Key, tuple[str, Subsystem]] = {}
+    for subsystem in agent.subsystems:
+        key = element_key(subsystem, subsystem.kind)
+        node = node_id("ss", subsystem_name(subsystem))
+        nodes[key] = (node, subsystem)
+        names.append(subsystem_name(subsystem))
+        names += [element_name(b, Kind.INPUT_BUFFER) for b in subsystem.input_buffers]
+        names += [element_name(b, Kind.OUTPUT_BUFFER) for b in subsystem.output_buffers]
+        names += [element_name(m, Kind.MEMORY) for m in subsystem.memories]
+        tooltip = html(f"{name}.{subsystem_name(subsystem)}")
+        graph.add(f'{node} [shape="plain", label={subsystem_block(subsystem)}, tooltip="{tooltip}"];')
+
+    for link in agent_links(agent):
+        source_node = nodes[element_key(link.source, link.source.kind)][0]
+        destination_node = nodes[element_key(link.destination, link.destination.kind)][0]
+        label = link_label(link.link)
+        names.append(label)
+        graph.add(
+            f"{source_node}:{port_name('ob', indexed_name(link.output))}:e -> "
+            f"{destination_node}:{port_name('ib', indexed_name(link.input))}:w "
+            f'[label=<{html(label)}<br/><i>{html(type_text(link.output.data_type))}</i>>, tooltip="{html(label)}"];'
+        )
+
+    if system is not None:
+        _external_links(agent, system, graph, names)
+    return Diagram("agent", graph.header, graph.source(), slug("agent", name), tuple(names))
+
+
+def _external_links(agent: Agent, system: System, graph: Graph, names: list[str]) -> None:
+    """The agents this one talks to, dashed and outside the frame, linked to its Control Subsystem's buffers."""
+    cs = agent.control_subsystem
+    if cs is None:
+        return
+    cs_node = node_id("ss", "cs")
+    others: set[str] = set()
+    for link in inter_agent_links(system):
+        label = f"<{html(link.link.name_text)}<br/><i>{html(link.data_type)}</i>>"
+        if link.source is agent and link.destination is not agent:
+            other = agent_name(link.destination)
+            node = node_id("ext", other)
+            statement = f"{cs_node}:{port_name('ob', link.source_buffer)}:e -> {node} [label={label}, style=dashed];"
+        elif link.destination is agent and link.source is not agent:
+            other = agent_name(link.source)
+            node = node_id("ext", other)
+            statement = (
+                f"{node} -> {cs_node}:{port_name('ib', link.destination_buffer)}:w [label={label}, style=dashed];"
+            )
+        else:
+            continue
+        if other not in others:
+            others.add(other)
+            names.append(other)
+            graph.outside.append(
+                f'{node} [shape="box", style="dashed,rounded", color="#777777", fontcolor="#555555", '
+                f"label=<<i>«Agent»</i><br/>{html(other)}>];"
+            )
+        graph.outside.append(statement)

@@ -1,0 +1,77 @@
+"""The FSM view (the manual's Figure 12): states with their Basic Behaviours, transitions with
+their initial conditions and priorities, and the initial state.
+
+A transition declared from every other state (`* -> emergencyStop`, Table 5's
+`i,emergencyStop/t where i ≠ emergencyStop`) is drawn once from a dashed
+"every state i ≠ …" node, as families are drawn once; with `expand` it is drawn
+from each state, as the checker and the runtime see it.
+"""
+
+from __future__ import annotations
+
+from earl.model.elements import FSM, Subsystem, Transition
+from earl.model.text import expression_text
+from earl.render.diagram import Diagram
+from earl.render.dot import Graph, html, wrapped
+from earl.render.names import slug
+from earl.render.views.common import node_id
+
+
+def transition_label(transition: Transition) -> str:
+    """`[newJointPos/pp and not emergencyStop/pp]` over `priority 2`, as an HTML-like label."""
+    lines = wrapped(f"[{expression_text(transition.condition.expression)}]")
+    text = "<br/>".join(html(line) for line in lines)
+    if transition.priority is not None:
+        text += f'<br/><font color="#555555">priority {transition.priority}</font>'
+    return f"<{text}>"
+
+
+def _state_label(name: str, behaviour: str, subsystem: Subsystem | None, initial: bool) -> str:
+    rows = [f"<tr><td><b>{html(name)}</b></td></tr>", "<hr/>", f"<tr><td>do / {html(behaviour)}/bb</td></tr>"]
+    found = subsystem.basic_behaviour(behaviour) if subsystem is not None else None
+    if found is not None:
+        terminal = wrapped(f"tc: {expression_text(found.terminal_condition.expression)}", 40)
+        for line in terminal:
+            rows.append(f'<tr><td><font point-size="9" color="#555555">{html(line)}</font></td></tr>')
+        if found.error_condition is not None:
+            error = wrapped(f"ec: {expression_text(found.error_condition.expression)}", 40)
+            for line in error:
+                rows.append(f'<tr><td><font point-size="9" color="#555555">{html(line)}</font></td></tr>')
+    fill = "#dbe8f7" if initial else "#f7f9fc"
+    return (
+        f'<<table border="1" style="rounded" cellborder="0" cellspacing="0" cellpadding="3" bgcolor="{fill}">'
+        + "".join(rows)
+        + "</table>>"
+    )
+
+
+def fsm_view(fsm: FSM, owner: str, subsystem: Subsystem | None = None, expand: bool = False) -> Diagram:
+    """`owner` names the subsystem in the manual's dot notation (`manip/a.cs`)."""
+    graph = Graph(f"stm [FSM] {owner}.fsm", rankdir="TB")
+    graph.graph_attributes.update(nodesep="0.6", ranksep="0.7")
+    names: list[str] = []
+    graph.add('initial [shape="circle", style="filled", fillcolor="black", label="", width="0.18", fixedsize="true"];')
+    for state in fsm.states:
+        names += [state.name, f"{state.behaviour}/bb"]
+        label = _state_label(state.name, state.behaviour, subsystem, state.name == fsm.initial)
+        graph.add(f'{node_id("state", state.name)} [shape="plain", label={label}, tooltip="{html(state.name)}"];')
+    if fsm.state_named(fsm.initial) is not None:
+        graph.add(f"initial -> {node_id('state', fsm.initial)};")
+
+    transitions = fsm.concrete_transitions() if expand else fsm.transitions
+    for number, transition in enumerate(transitions):
+        destination = node_id("state", transition.destination)
+        if transition.source is None:
+            any_node = f"any_{number}"
+            note = f"every state i ≠ {transition.destination}"
+            graph.add(
+                f'{any_node} [shape="box", style="dashed,rounded", color="#777777", fontcolor="#555555", '
+                f'label="{html(note)}"];'
+            )
+            source = any_node
+        else:
+            source = node_id("state", transition.source)
+        tooltip = html(f"{transition.name}/t")
+        names.append(f"{transition.name}/t")
+        graph.add(f'{source} -> {destination} [label={transition_label(transition)}, tooltip="{tooltip}"];')
+    return Diagram("fsm", graph.header, graph.source(), slug("fsm", owner), tuple(names))

@@ -1,0 +1,139 @@
+"""The system view (the manual's Figure 8): agents as blocks, inter-agent links with their data types.
+
+The Input and Output Buffers of the Control Subsystems are the ends of the links
+(§2.5), drawn as small squares on the border of their agent's block.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from earl.model.elements import Agent, Link, System
+from earl.model.expressions import ElementReference
+from earl.model.kinds import Kind
+from earl.model.tables import AgentType
+from earl.model.types import type_text
+from earl.render.diagram import Diagram
+from earl.render.dot import FILL, Graph, html
+from earl.render.names import Key, agent_name, element_key, family_note, indexed_name, lookup
+from earl.render.views.common import Port, block, node_id
+
+AgentTypeOf = Callable[[Agent], AgentType | None]
+
+
+@dataclass(frozen=True)
+class InterAgentLink:
+    """An inter-agent link with the agents and Control Subsystem buffers at its ends."""
+
+    link: Link
+    source: Agent
+    source_buffer: str  # the buffer's indexed name
+    destination: Agent
+    destination_buffer: str
+    data_type: str
+
+
+def inter_agent_links(system: System) -> list[InterAgentLink]:
+    """The system's links whose ends can be found; the checker reports the others."""
+    agents: dict[Key, Agent] = {element_key(agent, Kind.AGENT): agent for agent in system.agents}
+    result = []
+    for link in system.links:
+        if link.source.agent is None or link.destination.agent is None:
+            continue
+        source = lookup(agents, link.source.agent)
+        destination = lookup(agents, link.destination.agent)
+        if source is None or destination is None:
+            continue
+        source_cs, destination_cs = source.control_subsystem, destination.control_subsystem
+        if source_cs is None or destination_cs is None:
+            continue
+        outputs = {element_key(b, Kind.OUTPUT_BUFFER): b for b in source_cs.output_buffers}
+        inputs = {element_key(b, Kind.INPUT_BUFFER): b for b in destination_cs.input_buffers}
+        output = lookup(outputs, link.source.buffer)
+        input_ = lookup(inputs, link.destination.buffer)
+        if output is None or input_ is None:
+            continue
+        result.append(
+            InterAgentLink(
+                link, source, indexed_name(output), destination, indexed_name(input_), type_text(output.data_type)
+            )
+        )
+    return result
+
+
+def system_view(system: System, agent_type: AgentTypeOf = lambda agent: None) -> Diagram:
+    graph = Graph(f"ibd [System] {system.name}")
+    links = inter_agent_links(system)
+    ports_in: dict[int, list[Port]] = {id(a): [] for a in system.agents}
+    ports_out: dict[int, list[Port]] = {id(a): [] for a in system.agents}
+    for link in links:
+        _add_port(ports_out[id(link.source)], "ob", link.source_buffer)
+        _add_port(ports_in[id(link.destination)], "ib", link.destination_buffer)
+
+    names: list[str] = [system.name]
+    nodes: dict[int, str] = {}
+    statements: dict[int, str] = {}
+    for agent in system.agents:
+        name = agent_name(agent)
+        names.append(name)
+        nodes[id(agent)] = node_id("agent", name)
+        title = ["<i>«Agent»</i>", f"<b>{html(name)}</b>"]
+        notes = [note for note in (family_note(agent),) if note]
+        row = agent_type(agent)
+        if row is not None:
+            notes.append(f"{row.name}: {row.description}")
+        subsystems = ", ".join(
+            s.kind.value if s.kind is Kind.CONTROL_SUBSYSTEM else f"{indexed_name(s)}/{s.kind.value}"
+            for s in agent.subsystems
+        )
+        middle = [f'<font point-size="9" color="#555555">{html(subsystems)}</font>'] if subsystems else []
+        label = block(title, ports_in[id(agent)], ports_out[id(agent)], middle, FILL["a"], notes)
+        statements[id(agent)] = f'{nodes[id(agent)]} [shape="plain", label={label}, tooltip="{html(name)}"];'
+
+    placed: set[int] = set()
+    agents_by_key = {element_key(a, Kind.AGENT): a for a in system.agents}
+    for number, robot in enumerate(system.robots):
+        members = []
+        for reference in robot.agents:
+            for agent in _robot_members(reference, agents_by_key):
+                if id(agent) not in placed:
+                    placed.add(id(agent))
+                    members.append(agent)
+        robot_name = f"{robot.name}/r"
+        names.append(robot_name)
+        graph.add(f"subgraph cluster_robot_{number} {{")
+        graph.add(f'  label=<<i>«Robot»</i> <b>{html(robot_name)}</b>>; style="dashed,rounded"; color="#777777";')
+        for agent in members:
+            graph.add("  " + statements[id(agent)])
+        graph.add("}")
+    for agent in system.agents:
+        if id(agent) not in placed:
+            graph.add(statements[id(agent)])
+
+    for link in links:
+        name = link.link.name_text
+        names.append(name)
+        source = f"{nodes[id(link.source)]}:{_port('ob', link.source_buffer)}:e"
+        destination = f"{nodes[id(link.destination)]}:{_port('ib', link.destination_buffer)}:w"
+        label = f"<{html(name)}<br/><i>{html(link.data_type)}</i>>"
+        graph.add(f'{source} -> {destination} [label={label}, tooltip="{html(name)}"];')
+    return Diagram("system", graph.header, graph.source(), "system", tuple(names))
+
+
+def _robot_members(reference: ElementReference, agents: dict[Key, Agent]) -> list[Agent]:
+    """The agents a robot lists: one agent, one member, or every member of a family."""
+    found = lookup(agents, reference)
+    if found is not None:
+        return [found]
+    return [agent for key, agent in agents.items() if key[0] == reference.name]
+
+
+def _port(direction: str, buffer: str) -> str:
+    return "p_" + direction + "_" + "".join(c if c.isalnum() else "_" for c in buffer)
+
+
+def _add_port(ports: list[Port], direction: str, buffer: str) -> None:
+    port = _port(direction, buffer)
+    if all(existing.port != port for existing in ports):
+        ports.append(Port(port, f"{buffer}/{direction}"))
