@@ -29,6 +29,11 @@ fi
 if ! "$PYTHON" -c 'import venv, ensurepip' >/dev/null 2>&1; then
     apt_install python3-venv
 fi
+# Graphviz's `dot` draws the diagrams of `earl diagram` and `earl doc`.
+command -v dot >/dev/null 2>&1 || apt_install graphviz
+# Headless Chromium opens the generated document in the tests (driven by Playwright, which may not download
+# a browser of its own here).
+command -v chromium >/dev/null 2>&1 || apt_install chromium
 
 stamp="$VENV/.earl-installed"
 if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ]; then

@@ -9,7 +9,7 @@ from typing import Any
 from earl.check import check
 from earl.cli.common import UsageError, parse_parameter, spec_path, usage_error
 from earl.cli.output import print_diagnostics
-from earl.diagnostics import EarlError, Severity
+from earl.diagnostics import EarlError, Severity, SourceMap
 from earl.lang.loader import load
 from earl.render.build import Subject
 from earl.render.document import write_site
@@ -77,7 +77,11 @@ def run(arguments: argparse.Namespace) -> int:
     errors = sum(1 for d in diagnostics if d.severity is Severity.ERROR)
     print(f"{result.html} ({len(result.diagrams)} diagrams in {result.html.parent / 'diagrams'}), {result.markdown}")
     if errors:
-        print_diagnostics([d for d in diagnostics if d.severity is Severity.ERROR], system.sources)
+        print_diagnostics([d for d in diagnostics if d.severity is Severity.ERROR], _sources(system.sources))
         print(f"earl check found {errors} error{'s' if errors != 1 else ''}; the document shows them")
         return 1
     return 0
+
+
+def _sources(sources: object) -> SourceMap:
+    return sources if isinstance(sources, SourceMap) else SourceMap()

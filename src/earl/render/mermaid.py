@@ -7,12 +7,12 @@ links agents directly (the buffers go in the link's label) and a transition from
 
 from __future__ import annotations
 
-from earl.model.elements import FSM, Subsystem, System
+from earl.model.elements import FSM, Subsystem
 from earl.model.kinds import Kind
 from earl.model.text import expression_text
-from earl.render.build import Subject, TargetError
+from earl.render.build import Subject
 from earl.render.names import agent_name, element_key, lookup, qualified_subsystem_name
-from earl.render.targets import find_subsystem
+from earl.render.targets import TargetError, find_subsystem
 from earl.render.views.system import inter_agent_links
 
 

@@ -35,6 +35,7 @@ from earl.render.document.tree import (
     Figure,
     Inline,
     Link,
+    Monospace,
     Paragraph,
     Section,
     Strong,
@@ -43,6 +44,7 @@ from earl.render.document.tree import (
     cell,
     code,
     text,
+    with_code,
 )
 from earl.render.names import agent_name, indexed_name, qualified_subsystem_name, slug, subsystem_name
 from earl.render.tables import (
@@ -52,7 +54,7 @@ from earl.render.tables import (
     predicate_table,
     transition_table,
 )
-from earl.render.views.activity import activity_view, stage_set_name
+from earl.render.views.activity import activity_view
 from earl.render.views.agent import agent_links, agent_view
 from earl.render.views.fsm import fsm_view
 from earl.render.views.system import InterAgentLink, inter_agent_links, system_view
@@ -127,7 +129,7 @@ class DocumentBuilder:
 
     @staticmethod
     def expression_content(expression: str, scope: Scope) -> Content:
-        """An expression with each `name/kind` linked to the row that defines it."""
+        """An expression in one monospace run, each `name/kind` linked to the row that defines it."""
         parts: list[Inline] = []
         position = 0
         for match in _REFERENCE.finditer(expression):
@@ -135,12 +137,12 @@ class DocumentBuilder:
             if anchor is None:
                 continue
             if match.start() > position:
-                parts.append(Code(expression[position : match.start()]))
-            parts.append(Link(anchor, code(match.group())))
+                parts.append(Text(expression[position : match.start()]))
+            parts.append(Link(anchor, text(match.group())))
             position = match.end()
         if position < len(expression):
-            parts.append(Code(expression[position:]))
-        return tuple(parts)
+            parts.append(Text(expression[position:]))
+        return (Monospace(tuple(parts)),)
 
     # ------------------------------------------------------------------ the document
     def build(self) -> Document:
@@ -355,7 +357,8 @@ class DocumentBuilder:
         items: list[Content] = []
         for d in findings:
             where = f" ({d.location})" if d.location else ""
-            items.append((Strong(text(f"{d.severity.value} {d.code or ''}".strip())), Text(f": {d.message}{where}")))
+            label = Strong(text(f"{d.severity.value} {d.code or ''}".strip()))
+            items.append((label, Text(": "), *with_code(d.message), Text(where)))
         return BulletList(items)
 
     def buffers_table(self, subsystem: Subsystem, qualified: str, scope: Scope, links: BufferLinks) -> Table:
@@ -552,7 +555,7 @@ class DocumentBuilder:
             where: Content = text(str(d.location) if d.location else "—")
             if owner is not None:
                 where = (Link(owner[0], code(owner[1])), Text(f" ({d.location})"))
-            message = d.message + (f" — hint: {d.hint}" if d.hint else "")
+            message = with_code(d.message + (f" — hint: {d.hint}" if d.hint else ""))
             rows.append(
                 [
                     cell(d.severity.value, css=_SEVERITY_CSS[d.severity]),
@@ -583,17 +586,21 @@ def _buffer_links(system: System, agent: Agent) -> BufferLinks:
         table.setdefault((id(link.destination), "ib", input_), []).append(
             (slug("ob", source, output), f"{source}.{output}/ob", label)
         )
-    for link in inter_agent_links(system):
-        source = qualified_subsystem_name(link.source, _cs(link.source))
-        destination = qualified_subsystem_name(link.destination, _cs(link.destination))
-        label = link.link.name_text
-        if link.source is agent:
-            table.setdefault((id(_cs(agent)), "ob", link.source_buffer), []).append(
-                (slug("ib", destination, link.destination_buffer), f"{destination}.{link.destination_buffer}/ib", label)
+    for outer in inter_agent_links(system):
+        source = qualified_subsystem_name(outer.source, _cs(outer.source))
+        destination = qualified_subsystem_name(outer.destination, _cs(outer.destination))
+        label = outer.link.name_text
+        if outer.source is agent:
+            table.setdefault((id(_cs(agent)), "ob", outer.source_buffer), []).append(
+                (
+                    slug("ib", destination, outer.destination_buffer),
+                    f"{destination}.{outer.destination_buffer}/ib",
+                    label,
+                )
             )
-        if link.destination is agent:
-            table.setdefault((id(_cs(agent)), "ib", link.destination_buffer), []).append(
-                (slug("ob", source, link.source_buffer), f"{source}.{link.source_buffer}/ob", label)
+        if outer.destination is agent:
+            table.setdefault((id(_cs(agent)), "ib", outer.destination_buffer), []).append(
+                (slug("ob", source, outer.source_buffer), f"{source}.{outer.source_buffer}/ob", label)
             )
     return table
 

@@ -14,6 +14,7 @@ from earl.render.document.tree import (
     Figure,
     Inline,
     Link,
+    Monospace,
     Paragraph,
     Section,
     Strong,
@@ -40,6 +41,7 @@ code { font: 13px/1.4 "DejaVu Sans Mono", Menlo, Consolas, monospace; background
        border-radius: 3px; }
 a { color: var(--accent); }
 a code { color: var(--accent); }
+code code { background: none; padding: 0; }
 table { border-collapse: collapse; margin: 14px 0 22px; font-size: 13.5px; }
 caption { caption-side: top; text-align: left; font-weight: 600; padding: 0 0 6px; }
 th, td { border: 1px solid var(--rule); padding: 4px 8px; vertical-align: top; text-align: left; }
@@ -66,6 +68,8 @@ def inline(part: Inline) -> str:
         return f'<a href="#{escape(part.anchor)}">{content(part.content)}</a>'
     if isinstance(part, Strong):
         return f"<strong>{content(part.content)}</strong>"
+    if isinstance(part, Monospace):
+        return f"<code>{content(part.content)}</code>"
     raise TypeError(part)
 
 

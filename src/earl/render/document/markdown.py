@@ -16,6 +16,7 @@ from earl.render.document.tree import (
     Figure,
     Inline,
     Link,
+    Monospace,
     Paragraph,
     Section,
     Strong,
@@ -42,6 +43,9 @@ def inline(part: Inline) -> str:
         return f"[{content(part.content)}](#{part.anchor})"
     if isinstance(part, Strong):
         return f"**{content(part.content)}**"
+    if isinstance(part, Monospace):
+        # Markdown has no links inside code spans: each piece becomes its own span
+        return "".join(inline(Code(piece.text)) if isinstance(piece, Text) else inline(piece) for piece in part.content)
     raise TypeError(part)
 
 

@@ -30,7 +30,14 @@ class Strong:
     content: tuple[Inline, ...]
 
 
-Inline = Text | Code | Link | Strong
+@dataclass(frozen=True)
+class Monospace:
+    """An expression in one monospace run, with links inside it (its Text parts are code)."""
+
+    content: tuple[Inline, ...]
+
+
+Inline = Text | Code | Link | Strong | Monospace
 Content = tuple[Inline, ...]
 
 
@@ -97,6 +104,15 @@ def text(value: str) -> Content:
 
 def code(value: str) -> Content:
     return (Code(value),)
+
+
+def with_code(message: str) -> Content:
+    """A message whose `backticked` names become code, as the checker writes them."""
+    parts: list[Inline] = []
+    for position, piece in enumerate(message.split("`")):
+        if piece:
+            parts.append(Code(piece) if position % 2 else Text(piece))
+    return tuple(parts)
 
 
 def cell(

@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 
 from earl.model.elements import Agent, System
-from earl.model.types import ArrayType, DataType, StructType, TypeAlias, TypeDefinition, TypeReference, type_text
+from earl.model.types import ArrayType, DataType, StructType, TypeDefinition, TypeReference, type_text
 from earl.render.diagram import Diagram
 from earl.render.dot import Graph, html
 from earl.render.names import slug
@@ -50,8 +50,10 @@ def agent_types(system: System, agent: Agent) -> list[TypeDefinition]:
     """The types an agent's buffers and memory hold (Figure 11 for `manip/a`)."""
     roots: list[str] = []
     for subsystem in agent.subsystems:
-        for element in [*subsystem.input_buffers, *subsystem.output_buffers, *subsystem.memories]:
-            roots += referenced_type_names(element.data_type)
+        held = [b.data_type for b in subsystem.input_buffers] + [b.data_type for b in subsystem.output_buffers]
+        held += [m.data_type for m in subsystem.memories]
+        for data_type in held:
+            roots += referenced_type_names(data_type)
     return closure(system, roots)
 
 
