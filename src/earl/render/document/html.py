@@ -26,13 +26,13 @@ CSS = """
 :root { --ink: #1d2430; --muted: #5b6472; --rule: #d5dae1; --accent: #1f5fa8; --shade: #f4f6f9; }
 * { box-sizing: border-box; }
 body { margin: 0; font: 15px/1.5 -apple-system, "Segoe UI", Helvetica, Arial, sans-serif; color: var(--ink); }
-nav { position: fixed; top: 0; bottom: 0; left: 0; width: 250px; overflow-y: auto; padding: 18px 14px;
+nav { position: fixed; top: 0; bottom: 0; left: 0; width: 280px; overflow-y: auto; padding: 18px 14px;
       background: var(--shade); border-right: 1px solid var(--rule); font-size: 13px; }
 nav ul { list-style: none; margin: 0; padding-left: 12px; }
 nav > ul { padding-left: 0; }
-nav a { color: var(--ink); text-decoration: none; display: block; padding: 1px 0; }
+nav a { color: var(--ink); text-decoration: none; display: block; padding: 1px 0; overflow-wrap: anywhere; }
 nav a:hover { color: var(--accent); }
-main { margin-left: 250px; padding: 24px 40px 80px; max-width: 1300px; }
+main { margin-left: 280px; padding: 24px 40px 80px; max-width: 1300px; }
 h1 { font-size: 26px; margin: 0 0 4px; }
 h2 { font-size: 21px; margin-top: 40px; padding-top: 8px; border-top: 2px solid var(--rule); }
 h3 { font-size: 17px; margin-top: 30px; }

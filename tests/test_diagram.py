@@ -1,0 +1,268 @@
+"""`earl diagram`: each view of the manual's §3 example as SVG, PNG, DOT and Mermaid, and its errors.
+
+Every SVG must be well-formed XML whose text names the elements the view is
+about, in the manual's notation, inside a SysML frame whose header says the
+diagram kind.  Needs Graphviz's `dot` (scripts/setup.sh installs it).
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import xml.etree.ElementTree as ElementTree
+from pathlib import Path
+
+import pytest
+
+import earl
+from earl.cli.main import main
+from earl.model.elements import System
+from earl.render import GraphvizError, TargetError, build_diagram
+from earl.render.build import Subject
+from earl.render.mermaid import mermaid_of
+
+ROOT = Path(__file__).resolve().parent.parent
+EXAMPLE = ROOT / "examples" / "pick_and_place" / "system.earl"
+MOBILE = ROOT / "examples" / "mobile_robot" / "system.earl"
+SVG_NAMESPACE = "{http://www.w3.org/2000/svg}"
+
+
+@pytest.fixture(scope="module")
+def system() -> System:
+    return earl.load(EXAMPLE)
+
+
+def svg_text(svg: str) -> str:
+    """Every text run of the drawing, joined: what a reader of the picture sees."""
+    root = ElementTree.fromstring(svg)  # raises on anything that is not well-formed XML
+    assert root.tag == f"{SVG_NAMESPACE}svg"
+    return "\n".join("".join(node.itertext()) for node in root.iter(f"{SVG_NAMESPACE}text"))
+
+
+# (view, target, expected header, names the picture must show)
+CASES = [
+    (
+        "system",
+        None,
+        "ibd [System] pickAndPlace",
+        ["task/a", "manip/a", "grip/a", "manipulationRobot/r", "task,manip", "ManipulatorCommand", "GripperStatus"],
+    ),
+    (
+        "agent",
+        "manip/a",
+        "ibd [Agent] manip/a",
+        [
+            "cs",
+            "motorController[K]/ve",
+            "motor[K]/re",
+            "K ∈ 1..N",
+            "manipulatorCommand/ib",
+            "motorControllerCommand[K]/ob",
+            "windingCurrent[K]/m",
+            "cs,motorController[K]",
+            "task/a",
+        ],
+    ),
+    (
+        "fsm",
+        "manip/a.cs",
+        "stm [FSM] manip/a.cs.fsm",
+        [
+            "idle",
+            "jointMove",
+            "operationalMove",
+            "emergencyStop",
+            "do / jointMove/bb",
+            "[newJointPos/pp and not emergencyStop/pp]",
+            "priority 3",
+            "every state i ≠ emergencyStop",
+        ],
+    ),
+    (
+        "activity",
+        "manip/a.cs.jointMove/bb",
+        "act [Operation] manip/a.cs.jointMove/bb.tf.execute()",
+        ["calculatePosition/pf", "jointMove/pf", "outputManipState/pf", "outputMotorCon/pf", "stage 1: pf", "stage 2: pfo"],
+    ),
+    (
+        "types",
+        "manip/a",
+        "bdd [Package] manip/a dataTypes",
+        ["ManipulatorCommand", "MotorControllerState", "jointPosSetpoint: JointPosition [0..1]", "= double[N]"],
+    ),
+    ("types", None, "bdd [Package] pickAndPlace dataTypes", ["GripperCommand", "EncoderReading", "OperPosition"]),
+]
+
+
+@pytest.mark.parametrize(("view", "target", "header", "names"), CASES, ids=[f"{c[0]}-{c[1]}" for c in CASES])
+def test_each_view_is_valid_svg_naming_its_elements(
+    system: System, view: str, target: str | None, header: str, names: list[str]
+) -> None:
+    diagram = build_diagram(system, view, target)
+    assert diagram.header == header
+    shown = svg_text(diagram.svg())
+    kind, _, rest = header.partition(" ")
+    # The frame's tab: the kind in bold, then the rest (a no-break space keeps them apart in every viewer).
+    assert kind in shown and rest in shown.replace("\xa0", " ")
+    missing = [name for name in names if name not in shown]
+    assert missing == []
+
+
+def test_a_family_is_drawn_once_with_its_index_and_expand_draws_every_member(system: System) -> None:
+    once = svg_text(build_diagram(system, "agent", "manip/a", parameters={"N": 3}).svg())
+    assert once.count("motorController[K]/ve") == 1
+    assert "motorController[1]/ve" not in once
+    every = svg_text(build_diagram(system, "agent", "manip/a", expand=True, parameters={"N": 3}).svg())
+    for member in (1, 2, 3):
+        assert f"motorController[{member}]/ve" in every
+        assert f"cs,motorController[{member}]" in every
+    assert "motorController[K]/ve" not in every and "motorController[4]/ve" not in every
+
+
+def test_expanded_fsm_draws_the_wildcard_transition_from_every_other_state(system: System) -> None:
+    once = build_diagram(system, "fsm", "manip/a.cs")
+    every = build_diagram(system, "fsm", "manip/a.cs", expand=True)
+    assert "every state i ≠ emergencyStop" not in svg_text(every.svg())
+    # three states other than emergencyStop, each with its own arrow into it
+    assert sum(1 for name in every.names if name.endswith(",emergencyStop/t")) == 3
+    assert sum(1 for name in once.names if name.endswith(",emergencyStop/t")) == 1
+
+
+def test_png_is_a_png(system: System) -> None:
+    assert build_diagram(system, "fsm", "manip/a.cs").render("png").startswith(b"\x89PNG\r\n\x1a\n")
+
+
+def test_targets_name_what_can_be_drawn(system: System) -> None:
+    with pytest.raises(TargetError, match=r"`manip/a\.cs`.*`grip/a\.fingerDrive/re`"):
+        build_diagram(system, "fsm", "manip/a.cx")
+    with pytest.raises(TargetError, match="has no basic behaviour `walk/bb`; it has `idle/bb`"):
+        build_diagram(system, "activity", "manip/a.cs.walk/bb")
+    with pytest.raises(TargetError, match="the agents are `task/a`, `manip/a`, `grip/a`"):
+        build_diagram(system, "agent", "arm/a")
+    with pytest.raises(TargetError, match="needs --target"):
+        build_diagram(system, "agent")
+    # a family answers to its name, with or without the index variable; `.tf.execute()` may follow a behaviour
+    assert build_diagram(system, "fsm", "manip/a.motorController[K]/ve").header.endswith("motorController[K]/ve.fsm")
+    assert build_diagram(system, "activity", "manip/a.cs.idle/bb.tf.execute()").header.startswith("act")
+    # a member is named by its number once families are expanded
+    member = build_diagram(system, "fsm", "manip/a.motorController[2]/ve", expand=True)
+    assert member.header == "stm [FSM] manip/a.motorController[2]/ve.fsm"
+
+
+def test_mermaid_system_and_fsm(system: System) -> None:
+    flowchart = mermaid_of(Subject(system), "system", None)
+    assert flowchart.splitlines()[3] == "flowchart LR"
+    assert 'a_task_a -->|"task,manip: manipulatorCommand/ob → manipulatorCommand/ib : ManipulatorCommand"| a_manip_a' in (
+        flowchart
+    )
+    assert "CET: teleoperated agent" in flowchart
+    states = mermaid_of(Subject(system), "fsm", "manip/a.cs")
+    lines = states.splitlines()
+    assert "stateDiagram-v2" in lines
+    assert "    [*] --> s_idle" in lines
+    transitions = [line for line in lines if " --> " in line and "[*]" not in line]
+    # Table 5: six transitions between named states and `i,emergencyStop/t` from each of the three others
+    assert len(transitions) == 9
+    assert "    s_jointMove --> s_idle : [not emergencyStop/pp] priority 3" in lines
+    with pytest.raises(TargetError, match="system and fsm views only"):
+        mermaid_of(Subject(system), "types", None)
+
+
+def test_jupyter_displays_model_objects_as_svg(system: System) -> None:
+    interactive = pytest.importorskip("IPython.core.interactiveshell")
+    shell = interactive.InteractiveShell.instance()
+    try:
+        from earl.render import load_ipython_extension
+
+        load_ipython_extension(shell)
+        cs = system.agent("manip").control_subsystem  # type: ignore[union-attr]
+        assert cs is not None
+        for element, expected in [
+            (system, "ibd"),
+            (system.agent("manip"), "motorController[K]/ve"),
+            (cs, "stm"),
+            (cs.basic_behaviour("jointMove"), "calculatePosition/pf"),
+            (system.type_named("ManipulatorCommand"), "emergencyStopCommand: boolean"),
+        ]:
+            data, _ = shell.display_formatter.format(element)
+            assert expected in svg_text(data["image/svg+xml"])
+    finally:
+        interactive.InteractiveShell.clear_instance()
+
+
+# ---------------------------------------------------------------- the command line
+
+
+def test_cli_writes_svg_png_dot_and_mermaid(tmp_path: Path) -> None:
+    for name, view, target in [
+        ("agent.svg", "agent", "manip/a"),
+        ("fsm.png", "fsm", "manip/a.cs"),
+        ("system.dot", "system", None),
+        ("fsm.mmd", "fsm", "grip/a.cs"),
+    ]:
+        arguments = ["diagram", str(EXAMPLE), "--view", view, "-o", str(tmp_path / name)]
+        assert main([*arguments, *(["--target", target] if target else [])]) == 0
+    svg_text((tmp_path / "agent.svg").read_text(encoding="utf-8"))
+    assert (tmp_path / "fsm.png").read_bytes()[:4] == b"\x89PNG"
+    assert (tmp_path / "system.dot").read_text(encoding="utf-8").startswith("digraph earl {")
+    assert "stateDiagram-v2" in (tmp_path / "fsm.mmd").read_text(encoding="utf-8")
+
+
+def test_cli_prints_to_stdout_and_expands_with_parameters(capfdbinary: pytest.CaptureFixture[bytes]) -> None:
+    status = main(["diagram", str(EXAMPLE), "--view", "agent", "--target", "manip/a", "--expand", "--param", "N=2"])
+    assert status == 0
+    shown = svg_text(capfdbinary.readouterr().out.decode("utf-8"))
+    assert "motor[2]/re" in shown and "motor[3]/re" not in shown
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [
+        (["--view", "fsm", "--target", "nowhere/a.cs"], "no subsystem `nowhere/a.cs`"),
+        (["--view", "types", "--format", "mermaid"], "Mermaid text exists for the system and fsm views"),
+        (["--view", "system", "-o", "x.svg", "--format", "png"], "does not match"),
+        (["--view", "system", "-o", "x.pdf"], "cannot tell the format"),
+        (["--view", "system", "--target", "manip/a"], "leave out --target"),
+    ],
+)
+def test_cli_usage_errors_exit_2(arguments: list[str], message: str, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["diagram", str(EXAMPLE), *arguments]) == 2
+    assert message in capsys.readouterr().err
+
+
+def test_missing_dot_is_a_clear_usage_error(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    monkeypatch.setenv("PATH", str(tmp_path))  # an empty directory: no `dot` anywhere
+    monkeypatch.delenv("EARL_DOT", raising=False)
+    assert main(["diagram", str(EXAMPLE), "--view", "system", "-o", str(tmp_path / "s.svg")]) == 2
+    err = capsys.readouterr().err
+    assert "Graphviz's `dot` program, which was not found" in err
+    assert "apt-get install graphviz" in err
+    assert "Traceback" not in err
+    assert not (tmp_path / "s.svg").exists()
+    assert main(["doc", str(EXAMPLE), "-o", str(tmp_path / "site")]) == 2
+    assert "apt-get install graphviz" in capsys.readouterr().err
+    with pytest.raises(GraphvizError):
+        build_diagram(earl.load(EXAMPLE), "system").svg()
+
+
+def test_an_unreadable_spec_exits_1_with_located_diagnostics(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    broken = tmp_path / "broken.earl"
+    broken.write_text("system broken\n\nrobot/a {\n    cs {\n        x/m: nosuchtype\n    }\n}\n", encoding="utf-8")
+    assert main(["diagram", str(broken), "--view", "system"]) == 1
+    assert "broken.earl:5" in capsys.readouterr().err
+
+
+def test_every_example_draws_every_view_it_has() -> None:
+    system = earl.load(MOBILE)
+    svg_text(build_diagram(system, "system").svg())
+    for agent in system.agents:
+        svg_text(build_diagram(system, "agent", f"{agent.name}/a").svg())
+
+
+def test_importing_the_model_loads_no_renderer() -> None:
+    # The model must import nothing of the renderers (design brief): checked in a fresh interpreter.
+    code = "import sys, earl, earl.model; print(sorted(m for m in sys.modules if m.startswith('earl.render')))"
+    completed = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert completed.stdout.strip() == "[]"
