@@ -47,6 +47,9 @@ caption { caption-side: top; text-align: left; font-weight: 600; padding: 0 0 6p
 th, td { border: 1px solid var(--rule); padding: 4px 8px; vertical-align: top; text-align: left; }
 th { background: var(--shade); }
 table.matrix td.bullet, table.matrix th { text-align: center; }
+table.matrix thead tr:nth-child(2) th { writing-mode: vertical-rl; transform: rotate(180deg); white-space: nowrap;
+                                        vertical-align: bottom; padding: 6px 4px; }
+.wide { overflow-x: auto; max-width: 100%; }
 table.matrix td.bullet { font-size: 18px; line-height: 1; min-width: 34px; }
 td.error { color: #b00020; font-weight: 600; }
 td.warning { color: #9a6700; font-weight: 600; }
@@ -94,7 +97,10 @@ def table(item: Table) -> str:
     attributes = (f' id="{escape(item.anchor)}"' if item.anchor else "") + (f' class="{item.css}"' if item.css else "")
     head = "".join("<tr>" + "".join(_cell("th", c) for c in row) + "</tr>" for row in item.header)
     body = "".join("<tr>" + "".join(_cell("td", c) for c in row) + "</tr>" for row in item.rows)
-    return f"<table{attributes}><caption>{content(item.caption)}</caption><thead>{head}</thead><tbody>{body}</tbody></table>"
+    return (
+        f'<div class="wide"><table{attributes}><caption>{content(item.caption)}</caption>'
+        f"<thead>{head}</thead><tbody>{body}</tbody></table></div>"
+    )
 
 
 def block(item: Block) -> str:
