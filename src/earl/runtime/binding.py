@@ -36,8 +36,16 @@ class BindingProblem(Exception):
 
 @contextlib.contextmanager
 def user_code_path(directories: list[Path]) -> Iterator[None]:
-    """Put the spec's directory first on `sys.path` while user modules are imported."""
-    added = [str(d.resolve()) for d in directories if str(d.resolve()) not in sys.path]
+    """Put the spec's directory first on `sys.path` while user modules are imported.
+
+    Two specs may both ship a package of the same name (every example has its own); a
+    package already imported from elsewhere is forgotten when the spec's directory has
+    its own, so each run binds the code beside its spec.
+    """
+    resolved = [d.resolve() for d in directories]
+    for directory in resolved:
+        _forget_shadowed(directory)
+    added = [str(d) for d in resolved if str(d) not in sys.path]
     sys.path[:0] = added
     try:
         yield
@@ -45,6 +53,16 @@ def user_code_path(directories: list[Path]) -> Iterator[None]:
         for entry in added:
             with contextlib.suppress(ValueError):
                 sys.path.remove(entry)
+
+
+def _forget_shadowed(directory: Path) -> None:
+    for name, module in list(sys.modules.items()):
+        top = name.partition(".")[0]
+        if not ((directory / top).is_dir() or (directory / f"{top}.py").is_file()):
+            continue
+        location = getattr(module, "__file__", None)
+        if location is None or not Path(location).resolve().is_relative_to(directory):
+            del sys.modules[name]
 
 
 def resolve_callable(path: str, what: str, location: SourceLocation | None, arity: int = 3) -> Callable[..., Any]:

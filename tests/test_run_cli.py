@@ -1,0 +1,181 @@
+"""`earl run`, `earl trace summary` and `earl plot` as a person uses them: real processes, real files."""
+
+from __future__ import annotations
+
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+import earl
+from earl.diagnostics import EarlError
+
+SPECS = Path(__file__).parent / "runtime_specs"
+EARL = [sys.executable, "-m", "earl.cli.main"]
+
+
+def earl_cli(*arguments: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([*EARL, *arguments], capture_output=True, text=True, timeout=120, cwd=cwd, check=False)
+
+
+def counter_copy(tmp_path: Path, old: str = "", new: str = "") -> Path:
+    target = tmp_path / "counter"
+    shutil.copytree(SPECS / "counter", target)
+    spec = target / "system.earl"
+    if old:
+        text = spec.read_text()
+        assert old in text
+        spec.write_text(text.replace(old, new))
+    return spec
+
+
+def test_run_prints_a_summary_and_writes_a_trace_that_summary_and_plot_read(tmp_path: Path) -> None:
+    trace = tmp_path / "run.mcap"
+    result = earl_cli(
+        "run", str(SPECS / "counter"), "--duration", "200ms", "--trace", str(trace), "--record-memory", "all"
+    )
+    assert result.returncode == 0, result.stderr
+    assert "counter/a.cs" in result.stdout and "finished" in result.stdout
+    assert "ran 0.200 s of virtual time" in result.stdout
+    summary = earl_cli("trace", "summary", str(trace))
+    assert summary.returncode == 0, summary.stderr
+    assert "counting,finished" in summary.stdout
+    assert "finished: 0.180 s" in summary.stdout
+    png = tmp_path / "count.png"
+    plot = earl_cli(
+        "plot", str(trace), "--signal", "counter/a.cs.count", "--signal", "counter/a.relay/ve.forward", "-o", str(png)
+    )
+    assert plot.returncode == 0, plot.stderr
+    assert png.read_bytes().startswith(b"\x89PNG")
+
+
+def test_plot_of_a_signal_the_trace_lacks_says_how_to_record_it(tmp_path: Path) -> None:
+    trace = tmp_path / "run.mcap"
+    assert earl_cli("run", str(SPECS / "counter"), "--duration", "50ms", "--trace", str(trace)).returncode == 0
+    result = earl_cli("plot", str(trace), "--signal", "counter/a.cs.sent", "-o", str(tmp_path / "x.png"))
+    assert result.returncode == 1
+    assert "--record-memory counter/a.cs" in result.stderr
+    assert "Traceback" not in result.stderr
+    # what an output buffer sent is in the trace without recording memory
+    sent = earl_cli("plot", str(trace), "--signal", "counter/a.relay/ve.back", "-o", str(tmp_path / "z.png"))
+    assert sent.returncode == 0, sent.stderr
+    assert (tmp_path / "z.png").is_file()
+
+
+def test_a_trace_summary_of_something_else_is_a_clear_error(tmp_path: Path) -> None:
+    junk = tmp_path / "junk.mcap"
+    junk.write_bytes(b"not an mcap file at all")
+    result = earl_cli("trace", "summary", str(junk))
+    assert result.returncode == 1
+    assert "not a readable MCAP trace" in result.stderr
+    assert earl_cli("trace", "summary", str(tmp_path / "missing.mcap")).returncode == 2
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "code", "fragment"),
+    [
+        ('"counting.cs:increment"', '"counting.nowhere:increment"', "EARL-X002", "cannot be found (no module"),
+        ('"counting.cs:increment"', '"counting.cs:incremnt"', "EARL-X004", "did you mean `increment`"),
+        ('"counting.cs:increment"', '"increment"', "EARL-X001", "write `module:function`"),
+    ],
+)
+def test_code_that_is_not_where_the_spec_says_is_reported_at_the_spec_line(
+    tmp_path: Path, old: str, new: str, code: str, fragment: str
+) -> None:
+    spec = counter_copy(tmp_path, old, new)
+    line = next(n for n, text in enumerate(spec.read_text().splitlines(), 1) if "increment/pf(" in text)
+    result = earl_cli("run", str(spec), "--duration", "10ms")
+    assert result.returncode == 1
+    output = result.stdout + result.stderr
+    assert f"system.earl:{line}:" in output
+    assert code in output and fragment in output
+    assert "Traceback" not in output
+    assert "nothing was executed" in output
+
+
+def test_a_function_with_the_wrong_signature_is_refused_before_the_run(tmp_path: Path) -> None:
+    spec = counter_copy(tmp_path)
+    (spec.parent / "counting" / "cs.py").write_text(
+        "def increment(inputs, outputs):\n    pass\n\n\ndef send(inputs, outputs, context):\n    pass\n\n\n"
+        "def rest(inputs, outputs, context):\n    pass\n"
+    )
+    with pytest.raises(EarlError) as raised:
+        earl.simulate(earl.load(spec))
+    [diagnostic] = raised.value.diagnostics
+    assert diagnostic.code == "EARL-X005"
+    assert "with 3 arguments" in diagnostic.message
+    assert diagnostic.location is not None and diagnostic.location.line > 1
+
+
+def test_a_module_that_fails_to_import_is_reported_with_its_error(tmp_path: Path) -> None:
+    spec = counter_copy(tmp_path)
+    (spec.parent / "counting" / "cs.py").write_text("raise ImportError('the lab printer is offline')\n")
+    with pytest.raises(EarlError) as raised:
+        earl.simulate(earl.load(spec))
+    assert any("the lab printer is offline" in d.message and d.code == "EARL-X003" for d in raised.value.diagnostics)
+
+
+def test_the_checker_runs_first_and_its_errors_stop_the_run(tmp_path: Path) -> None:
+    spec = counter_copy(tmp_path, "counterRobot/r {\n    counter/a\n}", "")
+    marker = tmp_path / "ran"
+    (spec.parent / "counting" / "cs.py").write_text(
+        f"from pathlib import Path\nPath({str(marker)!r}).write_text('imported')\n"
+        "def increment(i, o, c): pass\ndef send(i, o, c): pass\ndef rest(i, o, c): pass\n"
+    )
+    result = earl_cli("run", str(spec), "--duration", "10ms")
+    assert result.returncode == 1
+    assert "EARL-E001" in result.stdout + result.stderr
+    assert not marker.exists()  # a spec with errors never imports its code
+
+
+@pytest.mark.parametrize(
+    ("arguments", "fragment"),
+    [
+        (["--duration", "ten seconds"], "is not a duration"),
+        (["--record-memory", "counter/a.nothing"], "names no subsystem"),
+        (["--param", "LIMIT"], "NAME=VALUE"),
+    ],
+)
+def test_usage_errors_exit_2_with_one_line(arguments: list[str], fragment: str) -> None:
+    result = earl_cli("run", str(SPECS / "counter"), *arguments)
+    assert result.returncode == 2
+    assert fragment in result.stderr
+    assert "Traceback" not in result.stderr
+
+
+def test_ctrl_c_stops_the_run_cleanly_and_the_trace_stays_readable(tmp_path: Path) -> None:
+    trace = tmp_path / "run.mcap"
+    process = subprocess.Popen(
+        [*EARL, "run", str(SPECS / "counter"), "--realtime", "--duration", "60s", "--trace", str(trace)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    deadline = time.monotonic() + 30
+    while not trace.exists() and time.monotonic() < deadline:
+        time.sleep(0.1)
+    time.sleep(1.0)
+    process.send_signal(signal.SIGINT)
+    stdout, stderr = process.communicate(timeout=30)
+    assert process.returncode == 130, stderr
+    assert "interrupted at" in stderr
+    assert "Traceback" not in stderr
+    summary = earl_cli("trace", "summary", str(trace))
+    assert summary.returncode == 0, summary.stderr
+    assert "counting,finished" in summary.stdout
+
+
+def test_run_help_teaches_with_examples() -> None:
+    result = earl_cli("run", "--help")
+    assert result.returncode == 0
+    assert "examples:" in result.stdout and "exit codes:" in result.stdout and "run.toml" in result.stdout
+
+
+@pytest.fixture(autouse=True)
+def _wide_terminal(monkeypatch: pytest.MonkeyPatch) -> None:
+    # Rich wraps tables to the terminal; a wide one keeps each row on one line for the assertions
+    monkeypatch.setenv("COLUMNS", "200")

@@ -1,0 +1,227 @@
+"""The runtime executes Figure 5 exactly: state sequences, iteration numbers, newData, send/receive order,
+snapshot isolation, refused undeclared writes, faults and recovery, FIFOs, timeouts, deterministic traces."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+import earl
+from earl.runtime.events import Recorder
+from earl.runtime.simulation import Simulation
+
+SPECS = Path(__file__).parent / "runtime_specs"
+MS = 1_000_000
+
+
+class Events(Recorder):
+    """Everything the engines report, in order."""
+
+    def __init__(self) -> None:
+        self.states: list[tuple[int, str, str | None, str]] = []
+        self.messages: list[tuple[int, str, Any]] = []
+        self.stops: list[tuple[int, str, str, int, str]] = []
+
+    def state_changed(self, time: int, subsystem: str, source: str | None, destination: str, transition: str) -> None:
+        self.states.append((time, subsystem, source, destination))
+
+    def message_sent(self, time: int, link: str, value: Any) -> None:
+        self.messages.append((time, link, value))
+
+    def behaviour_stopped(
+        self, time: int, subsystem: str, state: str, behaviour: str, iterations: int, reason: str
+    ) -> None:
+        self.stops.append((time, subsystem, behaviour, iterations, reason))
+
+
+def copy_spec(name: str, tmp_path: Path, replacements: dict[str, str] | None = None) -> Path:
+    target = tmp_path / name
+    shutil.copytree(SPECS / name, target)
+    spec = target / "system.earl"
+    text = spec.read_text()
+    for old, new in (replacements or {}).items():
+        assert old in text, old
+        text = text.replace(old, new)
+    spec.write_text(text)
+    return spec
+
+
+def simulate(spec: Path, **options: Any) -> tuple[Simulation, Events]:
+    events = Events()
+    parameters = options.pop("parameters", None)
+    system = earl.load(spec, parameters)
+    return earl.simulate(system, parameters=parameters, recorders=[events], **options), events
+
+
+# ---------------------------------------------------------------------- Figure 5, step by step
+def test_counter_runs_its_fsm_and_stops_counting_at_the_limit() -> None:
+    sim, events = simulate(SPECS / "counter")
+    sim.advance_to(0.05)
+    assert [(t, s, a, b) for t, s, a, b in events.states if s == "counter/a.cs"] == [
+        (0, "counter/a.cs", None, "counting"),
+        (20 * MS, "counter/a.cs", "counting", "finished"),
+    ]
+    # counting/bb ran three iterations (t = 0, 10, 20 ms) before its terminal condition held
+    assert events.stops == [(20 * MS, "counter/a.cs", "counting", 3, "terminal")]
+    cs = sim.state_of("counter/a.cs")
+    assert cs.memory["count"] == 3
+    assert cs.memory["sent"] == 3  # rest/pf of finished/bb copied it
+    assert cs.iteration == 3  # finished/bb ran at 30, 40, 50 ms; the number restarts at 0 in a new state
+    assert sim.state_of("counter/a.relay/ve").iteration == 6
+
+
+def test_messages_are_sent_after_the_transition_function_and_received_at_the_next_iteration() -> None:
+    sim, events = simulate(SPECS / "counter")
+    sim.advance_to(0.0)
+    # at t = 0 every subsystem runs once, in declaration order: cs, relay, display
+    assert events.messages == [
+        (0, "counter/a:cs,relay", 1),  # cs incremented count to 1 in stage 1, stage 2 sent it
+        (0, "counter/a:relay,display", 0),  # the relay forwards what it had before receiving (nothing yet)
+        (0, "counter/a:relay,cs", 0),
+        (0, "counter/a:display,relay", 0),  # the display's echo wakes the relay waiting for it
+    ]
+    relay = sim.state_of("counter/a.relay/ve")
+    assert relay.inputs == {"command": 1, "echo": 0}
+    assert relay.new_data == {"command": True, "echo": True}
+    cs = sim.state_of("counter/a.cs")
+    # the cs received before the relay sent anything: its echo buffer is not new
+    assert cs.new_data == {"echo": False}
+    sim.advance_to(0.010)
+    assert sim.state_of("counter/a.cs").new_data == {"echo": True}
+    assert sim.state_of("counter/a.cs").inputs == {"echo": 0}
+
+
+def test_new_data_is_false_when_nothing_arrived_since_the_last_receive() -> None:
+    sim, _ = simulate(SPECS / "counter")
+    sim.advance_to(0.06)
+    relay = sim.state_of("counter/a.relay/ve")
+    # the cs stopped sending after its count reached the limit
+    assert relay.new_data["command"] is False
+    assert relay.inputs["command"] == 3
+
+
+def test_an_obligatory_buffer_not_filled_in_time_times_out_and_predicates_see_it(tmp_path: Path) -> None:
+    # the display runs every 20 ms, so every other echo the relay waits for (3 ms) never comes
+    spec = copy_spec("counter", tmp_path, {"display/re {\n        period 10 ms": "display/re {\n        period 20 ms"})
+    sim, events = simulate(spec)
+    sim.advance_to(0.0131)
+    relay = sim.state_of("counter/a.relay/ve")
+    assert relay.state == "lost"
+    relay_changes = [(t, a, b) for t, s, a, b in events.states if s == "counter/a.relay/ve"]
+    assert relay_changes == [(0, None, "run"), (13 * MS, "run", "lost")]
+    sim.advance_to(0.0201)
+    relay = sim.state_of("counter/a.relay/ve")
+    assert relay.state == "run"  # the echo came at 20 ms: not timed out, back to run
+    assert relay.timed_out == {"command": False, "echo": False}
+    assert relay.memory["lost"] == 1
+    sim.advance_to(0.0331)
+    assert sim.state_of("counter/a.relay/ve").memory["lost"] == 1
+    assert sim.state_of("counter/a.relay/ve").state == "lost"
+
+
+# ---------------------------------------------------------------------- stages (Eq. 7-8)
+def test_functions_of_one_stage_see_one_snapshot() -> None:
+    sim, _ = simulate(SPECS / "probe")
+    sim.advance_to(0.0)
+    memory = sim.state_of("probe/a.cs").memory
+    # swapA wrote x = y + 1 = 21 and swapB y = x = 10 from the same snapshot (x=10, y=20)
+    assert (memory["x"], memory["y"]) == (21, 10)
+    sim.advance_to(0.001)
+    memory = sim.state_of("probe/a.cs").memory
+    assert (memory["x"], memory["y"]) == (11, 21)
+
+
+@pytest.mark.parametrize(
+    ("mode", "kind", "message"),
+    [
+        (1, "exception", "RuntimeError: the probe trips on purpose"),
+        (2, "undeclared-write", "does not declare that it writes `recoveries`; it writes: trips"),
+        (3, "type", "trips/mo must be a whole number (int), not the string 'many'"),
+    ],
+)
+def test_a_failing_function_makes_the_error_condition_true_and_the_fsm_recovers(
+    mode: int, kind: str, message: str
+) -> None:
+    sim, events = simulate(SPECS / "probe", parameters={"MODE": mode})
+    sim.advance_to(0.004)
+    [fault] = sim.faults
+    assert fault.kind == kind
+    assert message in fault.message
+    assert fault.time == 2 * MS and fault.state == "work" and fault.function == "trip"
+    if kind == "exception":
+        assert "the probe trips on purpose" in fault.traceback and "stages.py" in fault.traceback
+    assert [(t, a, b) for t, _, a, b in events.states] == [
+        (0, None, "work"),
+        (2 * MS, "work", "recover"),
+        (3 * MS, "recover", "work"),
+    ]
+    assert events.stops[0] == (2 * MS, "probe/a.cs", "work", 3, "error")
+    memory = sim.state_of("probe/a.cs").memory
+    # the failed call wrote nothing: neither the undeclared 99 nor the string; recover/pf ran once
+    assert memory["recoveries"] == 1
+    assert memory["trips"] == 3
+
+
+def test_when_no_transition_holds_the_subsystem_stays_and_the_fault_is_recorded_once(tmp_path: Path) -> None:
+    spec = copy_spec(
+        "probe",
+        tmp_path,
+        {"tc = not true/pp": "tc = true/pp", "work -> recover when true/pp": "work -> recover when not true/pp"},
+    )
+    sim, events = simulate(spec)
+    sim.advance_to(0.005)
+    assert sim.state_of("probe/a.cs").state == "work"
+    assert [f.kind for f in sim.faults] == ["no-transition"]
+    assert "stays in the state" in sim.faults[0].message
+    assert sim.state_of("probe/a.cs").iteration == 6  # the behaviour went on, its number not reset
+
+
+# ---------------------------------------------------------------------- FIFOs
+@pytest.mark.parametrize(
+    ("policy", "seen", "faults"),
+    [
+        ("dropOldest", (0, 1, 3, 6, 9), 0),
+        ("dropNewest", (0, 1, 2, 3, 5), 0),
+        ("fault", (0, 1, 3, 6, 9), 4),
+    ],
+)
+def test_a_fifo_input_buffer_keeps_its_capacity_by_its_overflow_policy(
+    tmp_path: Path, policy: str, seen: tuple[int, ...], faults: int
+) -> None:
+    spec = copy_spec("fifo", tmp_path, {"overflow dropOldest": f"overflow {policy}"})
+    sim, _ = simulate(spec)
+    sim.advance_to(0.0125)
+    assert sim.state_of("pipe/a.consumer/ve").memory["seen"] == seen
+    assert len([f for f in sim.faults if f.kind == "overflow"]) == faults
+
+
+# ---------------------------------------------------------------------- determinism and traces
+def test_the_same_spec_and_seed_give_a_byte_identical_trace(tmp_path: Path) -> None:
+    traces = []
+    for name, seed in (("a", 7), ("b", 7), ("c", 8)):
+        path = tmp_path / f"{name}.mcap"
+        sim, _ = simulate(SPECS / "counter", seed=seed, trace=path, record_memory=["all"])
+        sim.advance_to(0.2)
+        sim.close()
+        traces.append(path.read_bytes())
+    assert traces[0] == traces[1]
+    assert traces[0] != traces[2]  # the display's noise comes from the seeded stream
+
+
+def test_state_of_an_unknown_subsystem_suggests_the_right_name() -> None:
+    sim, _ = simulate(SPECS / "counter")
+    with pytest.raises(KeyError, match="counter/a.relay/ve"):
+        sim.state_of("counter/a.relay")
+
+
+def test_the_real_time_scheduler_paces_by_the_wall_clock_and_measures_lateness() -> None:
+    sim, events = simulate(SPECS / "counter", realtime=True)
+    sim.advance_to(0.05)
+    sim.close()
+    lateness = sim.scheduler.lateness["counter/a.cs"]
+    assert len(lateness.samples) == 6  # 0, 10, …, 50 ms
+    assert all(sample >= 0 for sample in lateness.samples)
+    assert [(t, b) for t, s, _, b in events.states if s == "counter/a.cs"] == [(0, "counting"), (20 * MS, "finished")]
