@@ -160,7 +160,7 @@ def test_ctrl_c_stops_the_run_cleanly_and_the_trace_stays_readable(tmp_path: Pat
         time.sleep(0.1)
     time.sleep(1.0)
     process.send_signal(signal.SIGINT)
-    stdout, stderr = process.communicate(timeout=30)
+    _, stderr = process.communicate(timeout=30)
     assert process.returncode == 130, stderr
     assert "interrupted at" in stderr
     assert "Traceback" not in stderr

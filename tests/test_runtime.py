@@ -171,7 +171,7 @@ def test_when_no_transition_holds_the_subsystem_stays_and_the_fault_is_recorded_
         tmp_path,
         {"tc = not true/pp": "tc = true/pp", "work -> recover when true/pp": "work -> recover when not true/pp"},
     )
-    sim, events = simulate(spec)
+    sim, _ = simulate(spec)
     sim.advance_to(0.005)
     assert sim.state_of("probe/a.cs").state == "work"
     assert [f.kind for f in sim.faults] == ["no-transition"]
@@ -213,7 +213,7 @@ def test_the_same_spec_and_seed_give_a_byte_identical_trace(tmp_path: Path) -> N
 
 def test_state_of_an_unknown_subsystem_suggests_the_right_name() -> None:
     sim, _ = simulate(SPECS / "counter")
-    with pytest.raises(KeyError, match="counter/a.relay/ve"):
+    with pytest.raises(KeyError, match=r"counter/a\.relay/ve"):
         sim.state_of("counter/a.relay")
 
 
