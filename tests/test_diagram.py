@@ -82,7 +82,14 @@ CASES = [
         "activity",
         "manip/a.cs.jointMove/bb",
         "act [Operation] manip/a.cs.jointMove/bb.tf.execute()",
-        ["calculatePosition/pf", "jointMove/pf", "outputManipState/pf", "outputMotorCon/pf", "stage 1: pf", "stage 2: pfo"],
+        [
+            "calculatePosition/pf",
+            "jointMove/pf",
+            "outputManipState/pf",
+            "outputMotorCon/pf",
+            "stage 1: pf",
+            "stage 2: pfo",
+        ],
     ),
     (
         "types",
@@ -152,8 +159,9 @@ def test_targets_name_what_can_be_drawn(system: System) -> None:
 def test_mermaid_system_and_fsm(system: System) -> None:
     flowchart = mermaid_of(Subject(system), "system", None)
     assert flowchart.splitlines()[3] == "flowchart LR"
-    assert 'a_task_a -->|"task,manip: manipulatorCommand/ob → manipulatorCommand/ib : ManipulatorCommand"| a_manip_a' in (
-        flowchart
+    assert (
+        'a_task_a -->|"task,manip: manipulatorCommand/ob → manipulatorCommand/ib : ManipulatorCommand"| a_manip_a'
+        in flowchart
     )
     assert "CET: teleoperated agent" in flowchart
     states = mermaid_of(Subject(system), "fsm", "manip/a.cs")
@@ -247,7 +255,9 @@ def test_missing_dot_is_a_clear_usage_error(
         build_diagram(earl.load(EXAMPLE), "system").svg()
 
 
-def test_an_unreadable_spec_exits_1_with_located_diagnostics(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_an_unreadable_spec_exits_1_with_located_diagnostics(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     broken = tmp_path / "broken.earl"
     broken.write_text("system broken\n\nrobot/a {\n    cs {\n        x/m: nosuchtype\n    }\n}\n", encoding="utf-8")
     assert main(["diagram", str(broken), "--view", "system"]) == 1

@@ -233,7 +233,9 @@ def test_documenting_never_imports_code_the_spec_names(tmp_path: Path, monkeypat
     )
     spec = tmp_path / "trap.earl"
     spec.write_text(
-        EXAMPLE.read_text(encoding="utf-8").replace('python "pick_and_place.manip:joint_move"', 'python "trap_module:f"'),
+        EXAMPLE.read_text(encoding="utf-8").replace(
+            'python "pick_and_place.manip:joint_move"', 'python "trap_module:f"'
+        ),
         encoding="utf-8",
     )
     monkeypatch.syspath_prepend(str(tmp_path))  # the module could be imported, if anything tried
