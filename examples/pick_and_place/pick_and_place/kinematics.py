@@ -1,0 +1,190 @@
+"""The controller's own model of the robot, built from the robot's MJCF (not from the plant).
+
+A real controller does not look inside the world it acts on: it knows the robot from
+its description and its drives' datasheets.  So `RobotModel` loads
+`earl.sim.arm.robot_mjcf(N)` — the arm and gripper alone, no table, no box — into a
+MuJoCo model of its own and uses it for forward kinematics, Jacobians (inverse
+kinematics by damped least squares) and inverse dynamics (gravity and inertia
+feed-forward).  Only measured joint positions and set-points ever go into it.
+
+With a levelling wrist (N < 5) two passive joints follow the shoulder and the elbow;
+the coupling matrix `C` (nv × N) maps motor joint velocities to all of the model's
+joint velocities, so Jacobians are `J·C` and torques are `Cᵀ·τ`.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+from numpy.typing import NDArray
+
+from earl.sim import arm
+
+Vector = NDArray[np.float64]
+
+#: weight of one radian of orientation error against one metre of position error in IK
+ORIENTATION_WEIGHT = 0.2
+_WEIGHTS = np.array([1.0, 1.0, 1.0, ORIENTATION_WEIGHT, ORIENTATION_WEIGHT, ORIENTATION_WEIGHT])
+
+
+@dataclass(frozen=True)
+class Pose:
+    position: Vector
+    #: unit quaternion w, x, y, z
+    orientation: Vector
+
+
+class RobotModel:
+    """Kinematics and dynamics of the N-joint arm, for one controller."""
+
+    def __init__(self, n: int) -> None:
+        self.n = n
+        self.model = mujoco.MjModel.from_xml_string(arm.robot_mjcf(n))
+        # the controller's model never collides: it is only for kinematics and dynamics
+        self.model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
+        self.data = mujoco.MjData(self.model)
+        self.drives = arm.drives(n)
+        self.gear = np.array([d.gear_ratio for d in self.drives])
+        self.torque_per_ampere = np.array([d.torque_per_ampere for d in self.drives])
+        self.current_limit = np.array([d.current_limit for d in self.drives])
+        self.site = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_SITE, arm.GRASP_SITE)
+        self.coupling = self._coupling()
+        low = np.array([self.model.jnt_range[self._joint(k)][0] for k in range(1, n + 1)])
+        high = np.array([self.model.jnt_range[self._joint(k)][1] for k in range(1, n + 1)])
+        self.lower, self.upper = low, high
+        self._configured: tuple[float, ...] | None = None
+        self._dynamics = False
+
+    def _joint(self, k: int) -> int:
+        return int(mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_JOINT, arm.joint_name(k)))
+
+    def _coupling(self) -> Vector:
+        """C: every degree of freedom as a linear function of the N motor joints."""
+        m = self.model
+        coupling = np.zeros((m.nv, self.n))
+        column_of_dof = {}
+        for k in range(1, self.n + 1):
+            dof = int(m.jnt_dofadr[self._joint(k)])
+            coupling[dof, k - 1] = 1.0
+            column_of_dof[dof] = k - 1
+        for e in range(m.neq):
+            if m.eq_type[e] != mujoco.mjtEq.mjEQ_JOINT:
+                continue
+            follower = int(m.jnt_dofadr[m.eq_obj1id[e]])
+            leader = int(m.jnt_dofadr[m.eq_obj2id[e]])
+            if leader in column_of_dof:
+                coupling[follower, column_of_dof[leader]] = float(m.eq_data[e][1])
+        return coupling
+
+    # ------------------------------------------------------------ kinematics
+
+    def motor_to_joint(self, motor_positions: Vector) -> Vector:
+        return np.asarray(motor_positions, dtype=float) / self.gear
+
+    def joint_to_motor(self, joint_positions: Vector) -> Vector:
+        return np.asarray(joint_positions, dtype=float) * self.gear
+
+    def _configure(self, q: Vector, qd: Vector | None = None) -> None:
+        """Positions (and, given velocities, everything dynamics needs) for the joints at `q`."""
+        dynamics = qd is not None
+        key = (*q, *qd) if qd is not None else tuple(q)
+        if key == self._configured and (self._dynamics or not dynamics):
+            return
+        m, d = self.model, self.data
+        d.qpos[:] = self.coupling @ q
+        if qd is None:
+            mujoco.mj_kinematics(m, d)
+            mujoco.mj_comPos(m, d)
+        else:
+            d.qvel[:] = self.coupling @ qd
+            mujoco.mj_forward(m, d)
+        self._configured = key
+        self._dynamics = dynamics
+
+    def forward(self, q: Vector) -> Pose:
+        """The grasp point's pose with the joints at `q`."""
+        self._configure(np.asarray(q, dtype=float))
+        quaternion = np.empty(4)
+        mujoco.mju_mat2Quat(quaternion, self.data.site_xmat[self.site])
+        return Pose(self.data.site_xpos[self.site].copy(), quaternion)
+
+    def jacobian(self, q: Vector) -> Vector:
+        """6 × N: the grasp point's linear and angular velocity per motor joint velocity."""
+        self._configure(np.asarray(q, dtype=float))
+        jacp = np.zeros((3, self.model.nv))
+        jacr = np.zeros((3, self.model.nv))
+        mujoco.mj_jacSite(self.model, self.data, jacp, jacr, self.site)
+        result: Vector = np.vstack([jacp, jacr]) @ self.coupling
+        return result
+
+    def pose_error(self, target: Pose, q: Vector) -> Vector:
+        """[position error; rotation vector taking the current orientation to the target], world frame."""
+        current = self.forward(q)
+        conjugate = current.orientation * np.array([1.0, -1.0, -1.0, -1.0])
+        difference = np.empty(4)
+        mujoco.mju_mulQuat(difference, target.orientation, conjugate)
+        rotation = np.empty(3)
+        mujoco.mju_quat2Vel(rotation, difference, 1.0)
+        return np.concatenate([target.position - current.position, rotation])
+
+    def inverse_kinematics(
+        self, target: Pose, q: Vector, iterations: int = 3, damping: float = 0.02, max_step: float = 0.2
+    ) -> Vector:
+        """Damped least squares from `q` towards `target`: at most `iterations` steps.
+
+        Each step solves (JᵀWJ + λ²I) Δq = JᵀW e; the damping keeps steps bounded near
+        singular configurations, and starting from the previous solution keeps a
+        redundant arm (N = 7) from wandering.
+        """
+        q = np.asarray(q, dtype=float).copy()
+        for _ in range(iterations):
+            error = self.pose_error(target, q) * _WEIGHTS
+            if float(error @ error) < 1e-14:
+                break
+            jac = self.jacobian(q) * _WEIGHTS[:, None]
+            step = np.linalg.solve(jac.T @ jac + damping**2 * np.eye(self.n), jac.T @ error)
+            largest = float(np.max(np.abs(step)))
+            if largest > max_step:
+                step *= max_step / largest
+            q = np.clip(q + step, self.lower, self.upper)
+        return q
+
+    # ------------------------------------------------------------ dynamics
+
+    def inverse_dynamics(self, q: Vector, qd: Vector, qdd: Vector) -> Vector:
+        """Joint torques for the motion (q, q̇, q̈) of the robot alone: M·q̈ + bias + viscous friction."""
+        q = np.asarray(q, dtype=float)
+        qd = np.asarray(qd, dtype=float)
+        self._configure(q, qd)
+        d = self.data
+        acceleration = np.empty(self.model.nv)
+        mujoco.mj_mulM(self.model, d, acceleration, self.coupling @ np.asarray(qdd, dtype=float))
+        friction = self.model.dof_damping * (self.coupling @ qd)
+        torques: Vector = self.coupling.T @ (acceleration + d.qfrc_bias + friction)
+        return torques
+
+    def joint_inertia(self, q: Vector) -> Vector:
+        """The diagonal of Cᵀ·M·C: each motor joint's inertia (with the rotor's) at `q`."""
+        q = np.asarray(q, dtype=float)
+        self._configure(q, np.zeros_like(q))
+        full = np.zeros((self.model.nv, self.model.nv))
+        mujoco.mj_fullM(self.model, self.data, full)
+        inertia: Vector = np.diag(self.coupling.T @ full @ self.coupling).copy()
+        return inertia
+
+
+@functools.cache
+def robot_model(n: int) -> RobotModel:
+    """One model per N, shared by the functions of a run (they run one at a time)."""
+    return RobotModel(n)
+
+
+def tool_down_orientation(yaw: float) -> Vector:
+    """Rz(yaw)·Ry(π) as a quaternion: the gripper pointing down, fingers closing radially."""
+    half = yaw / 2.0
+    # Rz(yaw) = (cos h, 0, 0, sin h); Ry(π) = (0, 0, 1, 0); their product:
+    return np.array([0.0, -math.sin(half), math.cos(half), 0.0])

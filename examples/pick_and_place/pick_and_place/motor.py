@@ -1,0 +1,52 @@
+"""`motor[K]/re` and `fingerDrive/re`: the drives, bound to the MuJoCo plant of the run.
+
+A drive applies the winding current its controller sent (the plant's actuator turns
+it into torque: motor constant × current × gear ratio, within the current limit)
+and reads its encoder: the motor shaft position in whole counts, and whether the
+driver reports a fault.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from earl.sim import arm
+
+
+class NoPlant(RuntimeError):
+    """A drive ran without the physics it drives."""
+
+
+def _plant(context: Any) -> Any:
+    environment = context.environment
+    if environment is None or not hasattr(environment, "plant"):
+        raise NoPlant(
+            f"{context.subsystem} drives a simulated motor and needs the MuJoCo environment: run with "
+            "`environment = \"pick_and_place.environment:make_environment\"` (examples/pick_and_place/run.toml)"
+        )
+    return environment.plant
+
+
+def _apply(actuator: str, inputs: Any, outputs: Any, context: Any) -> None:
+    outputs.appliedCurrent = _plant(context).set_input(actuator, float(inputs.motorCommand.windingCurrent))
+
+
+def _read(actuator: str, outputs: Any, context: Any) -> None:
+    plant = _plant(context)
+    outputs.encoderReading = {"motorPos": plant.encoder(actuator), "driverFault": plant.driver_fault(actuator)}
+
+
+def apply_current(inputs: Any, outputs: Any, context: Any) -> None:
+    _apply(arm.actuator_name(int(context.parameters["joint"])), inputs, outputs, context)
+
+
+def read_encoder(inputs: Any, outputs: Any, context: Any) -> None:
+    _read(arm.actuator_name(int(context.parameters["joint"])), outputs, context)
+
+
+def apply_finger_current(inputs: Any, outputs: Any, context: Any) -> None:
+    _apply(arm.FINGER_ACTUATOR, inputs, outputs, context)
+
+
+def read_finger_encoder(inputs: Any, outputs: Any, context: Any) -> None:
+    _read(arm.FINGER_ACTUATOR, outputs, context)

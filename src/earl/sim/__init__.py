@@ -1,0 +1,22 @@
+"""Plant adapters: bind Real Effectors and Real Receptors to a physics engine (MuJoCo).
+
+    from earl.sim import MujocoPlant
+    from earl.sim.arm import workcell_mjcf
+
+`earl.sim.plant` steps a model in lockstep with virtual time and reads quantised
+encoders; `earl.sim.arm` writes the project's N-joint arm as MJCF; `earl.sim.render`
+takes pictures offscreen.  See docs/simulation.md.
+"""
+
+from __future__ import annotations
+
+import os
+
+# MuJoCo picks its OpenGL backend when it is first imported; without a display the
+# only backends that work are EGL and OSMesa, and EGL is the faster one.
+if "MUJOCO_GL" not in os.environ and not os.environ.get("DISPLAY"):
+    os.environ["MUJOCO_GL"] = "egl"
+
+from earl.sim.plant import Encoder, MujocoPlant, PlantError, Pose  # noqa: E402
+
+__all__ = ["Encoder", "MujocoPlant", "PlantError", "Pose"]

@@ -1,0 +1,283 @@
+"""`MujocoPlant`: a MuJoCo model stepped in lockstep with a run's virtual time.
+
+Real effectors write actuator inputs by name (`set_input("motor3", 1.2)`, a winding
+current in amperes for the arm's drives); real receptors read quantised encoders,
+poses and contacts.  The runtime calls `advance(time)` before the subsystems due at
+`time` run, so every subsystem sees the world as it is at its own instant.
+
+    plant = MujocoPlant.from_xml(workcell_mjcf(6, ...), seed=1)
+    plant.set_input("motor2", 1.5)
+    plant.advance(0.010)
+    plant.encoder("motor2")      # motor shaft position, rad, to the encoder's resolution
+
+An encoder is declared in the MJCF as `<numeric name="earl.encoder.ACTUATOR"
+data="GEAR COUNTS"/>`: it reports the actuated joint's position times the gear ratio
+(the motor shaft), rounded down to whole counts of `COUNTS` per revolution.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import mujoco
+import numpy as np
+from numpy.typing import NDArray
+
+ENCODER_PREFIX = "earl.encoder."
+
+FloatArray = NDArray[np.float64]
+_FrameHook = Callable[["MujocoPlant"], None]
+
+
+class PlantError(ValueError):
+    """A name that the model does not have, or a time that has already passed."""
+
+
+@dataclass(frozen=True)
+class Encoder:
+    """An incremental encoder on an actuator's motor shaft."""
+
+    actuator: str
+    joint_address: int
+    gear_ratio: float
+    counts_per_revolution: int
+
+    @property
+    def resolution(self) -> float:
+        return 2.0 * math.pi / self.counts_per_revolution
+
+    def read(self, joint_position: float) -> float:
+        """The motor position the encoder reports: whole counts, never more than the true position."""
+        counts = math.floor(joint_position * self.gear_ratio / self.resolution + 1e-9)
+        return counts * self.resolution
+
+
+@dataclass(frozen=True)
+class Pose:
+    """A position in metres and a unit quaternion (w, x, y, z), in the world frame."""
+
+    position: tuple[float, float, float]
+    orientation: tuple[float, float, float, float]
+
+
+class MujocoPlant:
+    """One MuJoCo model and its state, advanced to each instant the runtime asks for."""
+
+    def __init__(self, model: mujoco.MjModel, seed: int = 0, keyframe: str | None = None) -> None:
+        self.model = model
+        self.data = mujoco.MjData(model)
+        self._actuators = {model.actuator(i).name: i for i in range(model.nu)}
+        self.seed = seed
+        #: for whatever the environment randomises; the physics itself is deterministic
+        self.random = np.random.default_rng(seed)
+        if keyframe is not None:
+            key = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_KEY, keyframe)
+            if key < 0:
+                raise PlantError(f"the model has no keyframe named `{keyframe}`")
+            mujoco.mj_resetDataKeyframe(model, self.data, key)
+        mujoco.mj_forward(model, self.data)
+        self.encoders = self._read_encoders()
+        self._faults: dict[str, float] = {}
+        self._steps = 0
+        self._closers: list[Callable[[], None]] = []
+        self._frame_hooks: list[tuple[float, _FrameHook]] = []
+        self._next_frame: list[float] = []
+
+    @classmethod
+    def from_xml(cls, xml: str, seed: int = 0, keyframe: str | None = None) -> MujocoPlant:
+        """Build from MJCF text (errors from MuJoCo are reported as `PlantError`)."""
+        try:
+            model = mujoco.MjModel.from_xml_string(xml)
+        except ValueError as error:
+            raise PlantError(f"MuJoCo could not read the model: {error}") from None
+        return cls(model, seed, keyframe)
+
+    @classmethod
+    def from_file(cls, path: str | Path, seed: int = 0, keyframe: str | None = None) -> MujocoPlant:
+        try:
+            model = mujoco.MjModel.from_xml_path(str(path))
+        except ValueError as error:
+            raise PlantError(f"{path}: MuJoCo could not read the model: {error}") from None
+        return cls(model, seed, keyframe)
+
+    # ------------------------------------------------------------ time
+
+    @property
+    def time(self) -> float:
+        """Simulated time, seconds."""
+        return float(self.data.time)
+
+    @property
+    def timestep(self) -> float:
+        return float(self.model.opt.timestep)
+
+    def advance(self, time: float) -> None:
+        """Step the physics until simulated time reaches `time` (to within half a step).
+
+        The number of steps is computed from the step count, not by adding up floats,
+        so that equal calls give equal states however the calls are split.
+        """
+        target = round(time / self.timestep)
+        if target < self._steps:
+            raise PlantError(f"cannot go back in time: the plant is at {self.time:.6f} s, asked for {time:.6f} s")
+        while self._steps < target:
+            mujoco.mj_step(self.model, self.data)
+            self._steps += 1
+            if self._frame_hooks:
+                self._call_frame_hooks()
+
+    # ------------------------------------------------------------ actuators
+
+    def _actuator(self, name: str) -> int:
+        try:
+            return self._actuators[name]
+        except KeyError:
+            names = ", ".join(self.actuator_names())
+            raise PlantError(f"the model has no actuator named `{name}` (it has: {names})") from None
+
+    def actuator_names(self) -> list[str]:
+        return [self.model.actuator(i).name for i in range(self.model.nu)]
+
+    def set_input(self, actuator: str, value: float) -> float:
+        """Set an actuator's input (a winding current for a `motor` with gear = kt·G); returns what is applied.
+
+        A limited actuator (`ctrlrange`) saturates at its range, as a current-limited driver does;
+        a driver in fault applies nothing.
+        """
+        index = self._actuator(actuator)
+        applied = float(value)
+        if not math.isfinite(applied) or self.driver_fault(actuator):
+            applied = 0.0
+        if self.model.actuator_ctrllimited[index]:
+            low, high = self.model.actuator_ctrlrange[index]
+            applied = min(max(applied, float(low)), float(high))
+        self.data.ctrl[index] = applied
+        return applied
+
+    def applied_input(self, actuator: str) -> float:
+        return float(self.data.ctrl[self._actuator(actuator)])
+
+    def actuator_force(self, actuator: str) -> float:
+        """The joint torque (or force) the actuator produces now."""
+        return float(self.data.actuator_force[self._actuator(actuator)])
+
+    # ------------------------------------------------------------ faults
+
+    def inject_fault(self, actuator: str, at_time: float) -> None:
+        """From `at_time` on, the actuator's driver reports a fault and applies no current."""
+        self._actuator(actuator)
+        self._faults[actuator] = at_time
+
+    def driver_fault(self, actuator: str) -> bool:
+        start = self._faults.get(actuator)
+        return start is not None and self.time >= start - 0.5 * self.timestep
+
+    # ------------------------------------------------------------ sensors
+
+    def _read_encoders(self) -> dict[str, Encoder]:
+        encoders: dict[str, Encoder] = {}
+        for i in range(self.model.nnumeric):
+            name = self.model.numeric(i).name
+            if not name.startswith(ENCODER_PREFIX):
+                continue
+            actuator = name[len(ENCODER_PREFIX) :]
+            index = self._actuator(actuator)
+            data = self.model.numeric(i).data
+            if len(data) != 2:
+                raise PlantError(f"encoder `{name}` needs data=\"GEAR COUNTS\", got {len(data)} numbers")
+            joint = int(self.model.actuator_trnid[index, 0])
+            encoders[actuator] = Encoder(actuator, int(self.model.jnt_qposadr[joint]), float(data[0]), int(data[1]))
+        return encoders
+
+    def encoder(self, actuator: str) -> float:
+        """The motor shaft position the actuator's encoder reports, rad (quantised)."""
+        try:
+            encoder = self.encoders[actuator]
+        except KeyError:
+            raise PlantError(
+                f"no encoder is declared for `{actuator}` (declared: {', '.join(self.encoders) or 'none'})"
+            ) from None
+        return encoder.read(float(self.data.qpos[encoder.joint_address]))
+
+    def joint_position(self, joint: str) -> float:
+        """The true joint position (for tests and plots; a controller reads encoders)."""
+        return float(self.data.joint(self._joint(joint)).qpos[0])
+
+    def joint_velocity(self, joint: str) -> float:
+        return float(self.data.joint(self._joint(joint)).qvel[0])
+
+    def _joint(self, name: str) -> int:
+        index = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_JOINT, name)
+        if index < 0:
+            raise PlantError(f"the model has no joint named `{name}`")
+        return int(index)
+
+    def body_pose(self, body: str) -> Pose:
+        index = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, body)
+        if index < 0:
+            raise PlantError(f"the model has no body named `{body}`")
+        return _pose(self.data.xpos[index], self.data.xquat[index])
+
+    def site_pose(self, site: str) -> Pose:
+        index = self._site(site)
+        quaternion = np.empty(4)
+        mujoco.mju_mat2Quat(quaternion, self.data.site_xmat[index])
+        return _pose(self.data.site_xpos[index], quaternion)
+
+    def site_jacobian(self, site: str) -> tuple[FloatArray, FloatArray]:
+        """Translational and rotational Jacobians (3 × nv each) of a site, at the current state."""
+        jacp = np.zeros((3, self.model.nv))
+        jacr = np.zeros((3, self.model.nv))
+        mujoco.mj_jacSite(self.model, self.data, jacp, jacr, self._site(site))
+        return jacp, jacr
+
+    def _site(self, name: str) -> int:
+        index = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_SITE, name)
+        if index < 0:
+            raise PlantError(f"the model has no site named `{name}`")
+        return int(index)
+
+    def contacts_between(self, body_a: str, body_b: str) -> int:
+        """How many contacts touch the two bodies now."""
+        a = self.model.body(body_a).id
+        b = self.model.body(body_b).id
+        count = 0
+        for i in range(self.data.ncon):
+            contact = self.data.contact[i]
+            pair = {int(self.model.geom_bodyid[contact.geom1]), int(self.model.geom_bodyid[contact.geom2])}
+            count += pair == {a, b}
+        return count
+
+    # ------------------------------------------------------------ frames
+
+    def every(self, interval: float, hook: _FrameHook) -> None:
+        """Call `hook(plant)` every `interval` seconds of simulated time (e.g. to record video frames)."""
+        if interval <= 0:
+            raise PlantError(f"a frame interval must be positive, got {interval} s")
+        self._frame_hooks.append((interval, hook))
+        self._next_frame.append(self.time)
+
+    def _call_frame_hooks(self) -> None:
+        for i, (interval, hook) in enumerate(self._frame_hooks):
+            if self.time + 0.5 * self.timestep >= self._next_frame[i]:
+                self._next_frame[i] += interval
+                hook(self)
+
+    def on_close(self, closer: Callable[[], None]) -> None:
+        """Run `closer` when the plant is closed (a renderer to release, a video to finish)."""
+        self._closers.append(closer)
+
+    def close(self) -> None:
+        """Finish what was attached to the plant (renderers, recordings), once."""
+        closers, self._closers = self._closers, []
+        for closer in closers:
+            closer()
+
+
+def _pose(position: FloatArray, quaternion: FloatArray) -> Pose:
+    p = (float(position[0]), float(position[1]), float(position[2]))
+    q = (float(quaternion[0]), float(quaternion[1]), float(quaternion[2]), float(quaternion[3]))
+    return Pose(p, q)
