@@ -31,6 +31,8 @@ if ! "$PYTHON" -c 'import venv, ensurepip' >/dev/null 2>&1; then
 fi
 # Graphviz's `dot` draws the diagrams of `earl diagram` and `earl doc`.
 command -v dot >/dev/null 2>&1 || apt_install graphviz
+# MuJoCo renders the pick-and-place pictures offscreen through EGL (docs/simulation.md).
+ldconfig -p 2>/dev/null | grep -q 'libEGL.so.1 ' || apt_install libegl1 libgl1
 # Headless Chromium opens the generated document in the tests (driven by Playwright, which may not download
 # a browser of its own here).
 command -v chromium >/dev/null 2>&1 || apt_install chromium
