@@ -28,6 +28,8 @@ Vector = NDArray[np.float64]
 
 #: weight of one radian of orientation error against one metre of position error in IK
 ORIENTATION_WEIGHT = 0.2
+#: how fast a redundant arm's null-space motion returns the posture (fraction per IK step)
+POSTURE_GAIN = 0.05
 _WEIGHTS = np.array([1.0, 1.0, 1.0, ORIENTATION_WEIGHT, ORIENTATION_WEIGHT, ORIENTATION_WEIGHT])
 
 
@@ -56,6 +58,9 @@ class RobotModel:
         low = np.array([self.model.jnt_range[self._joint(k)][0] for k in range(1, n + 1)])
         high = np.array([self.model.jnt_range[self._joint(k)][1] for k in range(1, n + 1)])
         self.lower, self.upper = low, high
+        #: the roll joints' preferred position; the others are free (used only by a redundant arm)
+        self.posture = np.zeros(n)
+        self.roll_joints = np.array([1.0 if kind == "roll" else 0.0 for kind in arm.joint_layout(n)])
         self._configured: tuple[float, ...] | None = None
         self._dynamics = False
 
@@ -138,7 +143,8 @@ class RobotModel:
 
         Each step solves (JᵀWJ + λ²I) Δq = JᵀW e; the damping keeps steps bounded near
         singular configurations, and starting from the previous solution keeps a
-        redundant arm (N = 7) from wandering.
+        redundant arm (N = 7) from wandering; for that arm a second task, projected into
+        the Jacobian's null space, turns the roll joints back towards zero.
         """
         q = np.asarray(q, dtype=float).copy()
         for _ in range(iterations):
@@ -147,6 +153,10 @@ class RobotModel:
                 break
             jac = self.jacobian(q) * _WEIGHTS[:, None]
             step = np.linalg.solve(jac.T @ jac + damping**2 * np.eye(self.n), jac.T @ error)
+            if self.n > 6:
+                # a redundant arm: in the Jacobian's null space, turn the roll joints back towards zero
+                null_space = np.eye(self.n) - np.linalg.pinv(jac, rcond=1e-3) @ jac
+                step += null_space @ (POSTURE_GAIN * self.roll_joints * (self.posture - q))
             largest = float(np.max(np.abs(step)))
             if largest > max_step:
                 step *= max_step / largest
@@ -168,12 +178,18 @@ class RobotModel:
         return torques
 
     def joint_inertia(self, q: Vector) -> Vector:
-        """The diagonal of Cᵀ·M·C: each motor joint's inertia (with the rotor's) at `q`."""
+        """Each motor joint's inertia at `q` as its regulator feels it: 1 / (M⁻¹)ₖₖ, rotor included.
+
+        With the other joints free to move, a joint feels less than Mₖₖ where the arm's
+        inertias are coupled (the N = 7 arm's base and upper-arm roll), so gains placed on
+        this value do not push the coupled modes too high.
+        """
         q = np.asarray(q, dtype=float)
         self._configure(q, np.zeros_like(q))
         full = np.zeros((self.model.nv, self.model.nv))
         mujoco.mj_fullM(self.model, self.data, full)
-        inertia: Vector = np.diag(self.coupling.T @ full @ self.coupling).copy()
+        reduced = self.coupling.T @ full @ self.coupling
+        inertia: Vector = 1.0 / np.diag(np.linalg.inv(reduced))
         return inertia
 
 

@@ -134,13 +134,13 @@ def joint_layout(n: int) -> tuple[str, ...]:
 
 @functools.cache
 def drives(n: int) -> tuple[Drive, ...]:
-    """The drive of each joint 1..N: the base, then the shoulder and elbow, then the wrist."""
+    """The drive of each joint 1..N: the base; large drives up to the elbow, which carry the arm; small after it."""
     layout = joint_layout(n)
     result = [BASE_DRIVE]
     pitches = 0
     for kind in layout[1:]:
         pitches += kind == _PITCH
-        result.append(LARGE_DRIVE if kind == _PITCH and pitches <= 2 else SMALL_DRIVE)
+        result.append(LARGE_DRIVE if pitches <= 2 and not (kind == _ROLL and pitches == 2) else SMALL_DRIVE)
     return tuple(result)
 
 

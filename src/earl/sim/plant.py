@@ -160,9 +160,10 @@ class MujocoPlant:
     def applied_input(self, actuator: str) -> float:
         return float(self.data.ctrl[self._actuator(actuator)])
 
-    def actuator_force(self, actuator: str) -> float:
-        """The joint torque (or force) the actuator produces now."""
-        return float(self.data.actuator_force[self._actuator(actuator)])
+    def joint_torque(self, actuator: str) -> float:
+        """The torque (or force) the actuator applies at its joint now: gear × its input (kt·G·i for a drive)."""
+        index = self._actuator(actuator)
+        return float(self.data.actuator_force[index] * self.model.actuator_gear[index, 0])
 
     # ------------------------------------------------------------ faults
 
