@@ -8,16 +8,19 @@ from importlib import resources
 from typing import Any
 
 from lark import Lark, Token
-from lark.exceptions import UnexpectedInput, VisitError
+from lark.exceptions import UnexpectedInput
 
 from earl.diagnostics import Diagnostic, EarlError, Severity, SourceMap
+from earl.lang import reductions
+from earl.lang.lexing import FastContextualLexer
 from earl.lang.syntax_errors import translate
 from earl.lang.transformer import ElementBuilder, ParsedFile, SpecificationSyntaxError
 from earl.model.location import SourceLocation
 
-#: Larger files are refused before parsing: a spec of a thousand agents is far smaller, and the
-#: parser reads some 100-200 KB a second, so a bigger file would look like a hang.
-MAX_FILE_BYTES = 2 * 1024 * 1024
+#: Larger files are refused before parsing.  The benchmark's thousand agents take about
+#: 2 MB; the parser reads roughly a megabyte every few seconds on a small machine, so a
+#: file several times larger than that would look like a hang rather than a spec.
+MAX_FILE_BYTES = 8 * 1024 * 1024
 
 
 class _CommentCollector:
@@ -34,17 +37,55 @@ class _CommentCollector:
 _collector = _CommentCollector()
 
 
+def _grammar() -> str:
+    return resources.files("earl.lang").joinpath("earl.lark").read_text(encoding="utf-8")
+
+
 @lru_cache(maxsize=1)
 def _parser() -> Lark:
-    grammar = resources.files("earl.lang").joinpath("earl.lark").read_text(encoding="utf-8")
+    """The parser that builds a tree: only used to explain a syntax error, from its stack."""
     return Lark(
-        grammar,
+        _grammar(),
         parser="lalr",
         propagate_positions=True,
         maybe_placeholders=False,
         strict=True,  # a shift/reduce conflict in the grammar is an error, never a silent choice
-        lexer_callbacks={"COMMENT": _collector},
+        cache=True,  # the LALR tables are computed once per grammar and kept in the temporary directory
     )
+
+
+class _ElementParser:
+    """Lark's LALR parser with callbacks that build elements as it reduces (see `reductions.py`)."""
+
+    def __init__(self) -> None:
+        self.lark = Lark(
+            _grammar(),
+            parser="lalr",
+            propagate_positions=False,  # spans are measured by the callbacks, more cheaply
+            maybe_placeholders=False,
+            strict=True,
+            cache=True,
+            lexer_callbacks={"COMMENT": _collector},
+        )
+        self.builder = ElementBuilder("<text>")
+        self.spans = reductions.SpanTable()
+        reductions.install(self.lark.parser.parser.parser, self.builder, self.spans)
+        FastContextualLexer.adopt(self.lark.parser.lexer)
+
+    def parse(self, text: str, path: str) -> ParsedFile:
+        self.builder.reset(path)
+        self.spans.clear()
+        try:
+            parsed: ParsedFile = self.lark.parse(text)  # type: ignore[assignment]  # the callbacks build it
+        finally:
+            self.spans.clear()
+            self.builder.reset("<text>")
+        return parsed
+
+
+@lru_cache(maxsize=1)
+def _element_parser() -> _ElementParser:
+    return _ElementParser()
 
 
 @lru_cache(maxsize=1)
@@ -109,27 +150,34 @@ def parse_text(text: str, path: str = "<text>", sources: SourceMap | None = None
     """The declarations of one file, or an `EarlError` with one located diagnostic."""
     sources = sources if sources is not None else SourceMap()
     sources.add(path, text)
-    parser = _parser()
     _collector.comments = []
     try:
-        tree = parser.parse(text)
+        parsed = _element_parser().parse(text, path)
     except UnexpectedInput as error:
-        raise EarlError([translate(error, path, text, keyword_terminals())], sources) from None
-    comments = _collector.comments
-    try:
-        parsed: ParsedFile = ElementBuilder(path).transform(tree)
-    except VisitError as error:
-        if isinstance(error.orig_exc, SpecificationSyntaxError):
-            raise EarlError([error.orig_exc.diagnostic], sources) from None
-        raise
+        raise EarlError([_explain(error, path, text)], sources) from None
     except SpecificationSyntaxError as error:
         raise EarlError([error.diagnostic], sources) from None
+    comments = _collector.comments
     if parsed.system_location is not None:
         header_line = parsed.system_location.line
         parsed.header_comments = [str(c) for c in comments if (c.line or 1) <= header_line]
         comments = [c for c in comments if (c.line or 1) > header_line]
     parsed.closing_comments = attach_comments(parsed.declarations, comments, path)
     return parsed
+
+
+def _explain(error: UnexpectedInput, path: str, text: str) -> Diagnostic:
+    """The syntax error as one sentence, read from the stack of the tree-building parser.
+
+    The element parser's stack holds elements, not the trees `syntax_errors` reads, so
+    the text is parsed again, as trees, up to the same error; an error is rare and the
+    second parse stops where the first did.
+    """
+    try:
+        _parser().parse(text)
+    except UnexpectedInput as again:
+        error = again
+    return translate(error, path, text, keyword_terminals())
 
 
 def _statements(declarations: list[Any]) -> list[Any]:

@@ -1,8 +1,10 @@
-"""Turns Lark's parse tree of one `.earl` file into declared model elements.
+"""Builds the declared model elements of one `.earl` file, one method per grammar rule.
 
-The transformer is non-recursive (`Transformer_NonRecursive`) because a spec may
-nest expressions deeply; depth is measured here and refused above a bound so
-that nothing later in the pipeline can run out of stack.
+The methods are called while the LALR parser reduces (see `reductions.py`): each gets
+the span of text its rule covered and the rule's children (tokens, and what the
+methods of the inner rules returned).  The parser's own stack is a list, so a deeply
+nested expression cannot exhaust Python's stack here; depth is still measured and
+refused above a bound so that nothing later in the pipeline can.
 """
 
 from __future__ import annotations
@@ -10,11 +12,10 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 from typing import Any
 
-from lark import Token, Tree
-from lark.tree import Meta
-from lark.visitors import Transformer_NonRecursive, v_args
+from lark import Token
 
 from earl.diagnostics import Diagnostic, Severity
+from earl.lang.reductions import Span
 from earl.model.elements import (
     FSM,
     SUBSYSTEM_CLASSES,
@@ -117,26 +118,36 @@ class _BodyItem:
     value: Any
 
 
-def _location(path: str, meta: Meta | Token) -> SourceLocation:
+#: What a method gets as `meta`: the span its rule covered, or one token.
+Meta = Span | Token | None
+
+#: The source of `* -> state`, until the transition is built (its model value is None).
+_ANY_STATE = object()
+
+
+def _location(path: str, meta: Meta) -> SourceLocation:
     if isinstance(meta, Token):
         line = meta.line or 1
         column = meta.column or 1
         return SourceLocation(path, line, column, meta.end_line or line, meta.end_column or column + 1)
-    if getattr(meta, "empty", True):
+    if meta is None:
         return SourceLocation(path, 1, 1, 1, 1)
-    return SourceLocation(path, meta.line, meta.column, meta.end_line, meta.end_column)
+    return SourceLocation(path, *meta)
 
 
-@v_args(meta=True)
-class ElementBuilder(Transformer_NonRecursive[Token, Any]):
-    """One callback per grammar rule; each returns a model element or a piece of one."""
+class ElementBuilder:
+    """One method per grammar rule; each returns a model element or a piece of one."""
 
     def __init__(self, path: str) -> None:
-        super().__init__()
         self.path = path
         self._depth: dict[int, int] = {}
 
-    def _loc(self, meta: Meta | Token) -> SourceLocation:
+    def reset(self, path: str) -> None:
+        """Start on another file."""
+        self.path = path
+        self._depth.clear()
+
+    def _loc(self, meta: Meta) -> SourceLocation:
         return _location(self.path, meta)
 
     # ------------------------------------------------------------------ file
@@ -501,7 +512,7 @@ class ElementBuilder(Transformer_NonRecursive[Token, Any]):
     def transition(self, meta: Meta, children: list[Any]) -> Transition:
         source, destination, condition, *priority = children
         return Transition(
-            source,
+            None if source is _ANY_STATE else source,
             str(destination),
             Predicate(condition, condition.location),
             int(priority[0]) if priority else None,
@@ -511,8 +522,8 @@ class ElementBuilder(Transformer_NonRecursive[Token, Any]):
     def transition_source(self, meta: Meta, children: list[Token]) -> str:
         return str(children[0])
 
-    def any_state(self, meta: Meta, children: list[Token]) -> None:
-        return None
+    def any_state(self, meta: Meta, children: list[Token]) -> object:
+        return _ANY_STATE
 
     def assumption(self, meta: Meta, children: list[Any]) -> Assumption:
         return Assumption(children[0], self._loc(meta))
@@ -652,4 +663,4 @@ def with_location(element: Any, location: SourceLocation) -> Any:
     return replace(element, location=location)
 
 
-__all__ = ["MAX_EXPRESSION_DEPTH", "ElementBuilder", "ParsedFile", "SpecificationSyntaxError", "Tree"]
+__all__ = ["MAX_EXPRESSION_DEPTH", "ElementBuilder", "ParsedFile", "SpecificationSyntaxError"]
