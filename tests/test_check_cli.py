@@ -131,6 +131,23 @@ def test_human_output_quotes_the_line_with_a_caret_and_a_hint(
     assert err.index("EARL-W040") < err.index("EARL-E060")
 
 
+def test_human_output_groups_findings_by_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """With an imported file, each file's findings come under its own heading, the spec's own first."""
+    write(tmp_path, "lonely/a {\n    cs {\n    }\n}\n", "lib.earl")
+    spec = write(tmp_path, WARNING.replace("system demo\n", 'system demo\n\nimport "lib.earl"\n'))
+    status, out, err = run(capsys, "check", str(spec))
+    assert status == 0 and "(2 warnings)" in out
+    lines = err.splitlines()
+    headings = [line for line in lines if line.startswith("── ")]
+    assert headings == [f"── {spec}: 1 warning", f"── {tmp_path / 'lib.earl'}: 1 warning"]
+    own, imported = lines.index(headings[0]), lines.index(headings[1])
+    assert own < lines.index(f" --> {spec}:8:9") < imported < lines.index(f" --> {tmp_path / 'lib.earl'}:1:1")
+    assert "warning[EARL-W001]: agent `lonely/a` is of type C (zombie)" in err
+    # one file: no headings
+    _, _, err = run(capsys, "check", str(write(tmp_path, WARNING, "single.earl")))
+    assert "── " not in err
+
+
 def test_human_output_of_a_clean_spec_says_ok(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     spec = write(tmp_path, CLEAN)
     status, out, err = run(capsys, "check", str(spec))

@@ -11,6 +11,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 from earl.check import fsm_analysis, rules_behaviour, rules_communication, rules_structure
+from earl.check.collector import collector_paused
 from earl.check.context import CheckContext
 from earl.check.registry import RULES, Finding, Rule
 from earl.diagnostics import Diagnostic, Severity
@@ -28,19 +29,30 @@ def context_for(system: System, parameters: Mapping[str, bool | int | float | st
 
 
 def check(system: System, parameters: Mapping[str, bool | int | float | str] | None = None) -> list[Diagnostic]:
-    """Every finding of every rule, ordered by file, line and column."""
-    context = context_for(system, parameters)
-    diagnostics: list[Diagnostic] = []
-    seen: set[tuple[str, object, str]] = set()
-    for rule in RULES.values():
-        for finding in rule.check(context):
-            key = (rule.code, finding.location, finding.message)
-            if key in seen:
-                continue
-            seen.add(key)
-            diagnostics.append(Diagnostic(rule.severity, finding.message, finding.location, rule.code, finding.hint))
+    """Every finding of every rule, ordered by file (the spec's own first), line and column."""
+    with collector_paused():
+        return check_context(context_for(system, parameters))
+
+
+def check_context(context: CheckContext) -> list[Diagnostic]:
+    """Every finding of every rule over an already expanded system (`context_for`)."""
+    with collector_paused():
+        diagnostics: list[Diagnostic] = []
+        seen: set[tuple[str, object, str]] = set()
+        for rule in RULES.values():
+            for finding in rule.check(context):
+                key = (rule.code, finding.location, finding.message)
+                if key in seen:
+                    continue
+                seen.add(key)
+                diagnostics.append(
+                    Diagnostic(rule.severity, finding.message, finding.location, rule.code, finding.hint)
+                )
+    root = context.declared.source_file
     diagnostics.sort(
         key=lambda d: (
+            # the spec itself first, then the files it imports
+            d.location is None or d.location.file != root,
             d.location.file if d.location else "",
             d.location.line if d.location else 0,
             d.location.column if d.location else 0,
@@ -50,4 +62,4 @@ def check(system: System, parameters: Mapping[str, bool | int | float | str] | N
     return diagnostics
 
 
-__all__ = ["RULES", "CheckContext", "Finding", "Rule", "check", "context_for"]
+__all__ = ["RULES", "CheckContext", "Finding", "Rule", "check", "check_context", "collector_paused", "context_for"]

@@ -47,12 +47,24 @@ def reference_key(reference: ElementReference) -> str:
     return instance_name(reference.name, value if isinstance(value, int) else None)
 
 
+MemberKey = tuple[str, int | None]
+
+
+def member_key(reference: ElementReference) -> MemberKey:
+    """`reference_key` as a (name, index) pair: the lookup tables' key, with no text to build."""
+    indices = reference.indices
+    if not indices:
+        return reference.name, None
+    value = getattr(indices[0], "value", None)
+    return reference.name, value if isinstance(value, int) and not isinstance(value, bool) else None
+
+
 _Element = TypeVar("_Element", InputBuffer, OutputBuffer, Memory)
 
 
-def _by_instance_name(elements: list[_Element]) -> dict[str, _Element]:
-    """Elements by `name[index]`; the first of two equal names wins, as a scan would find it."""
-    return {instance_name(e.name, e.index): e for e in reversed(elements)}
+def _by_member(elements: list[_Element]) -> dict[MemberKey, _Element]:
+    """Elements by (name, index); the first of two equal names wins, as a scan would find it."""
+    return {(e.name, e.index): e for e in reversed(elements)}
 
 
 _LEAVES = (str, int, float, bool, type(None), SourceLocation, Kind)
@@ -117,46 +129,46 @@ class ResolvedLink:
 class CheckContext:
     declared: System
     system: System  # expanded: every family member
-    _agents: dict[str, Agent] = field(default_factory=dict)
-    _subsystem_tables: dict[int, dict[tuple[Kind, str], Subsystem]] = field(default_factory=dict)
-    _output_tables: dict[int, dict[str, OutputBuffer]] = field(default_factory=dict)
-    _input_tables: dict[int, dict[str, InputBuffer]] = field(default_factory=dict)
-    _memory_tables: dict[int, dict[str, Memory]] = field(default_factory=dict)
+    _agents: dict[MemberKey, Agent] = field(default_factory=dict)
+    _subsystem_tables: dict[int, dict[tuple[Kind, str, int | None], Subsystem]] = field(default_factory=dict)
+    _output_tables: dict[int, dict[MemberKey, OutputBuffer]] = field(default_factory=dict)
+    _input_tables: dict[int, dict[MemberKey, InputBuffer]] = field(default_factory=dict)
+    _memory_tables: dict[int, dict[MemberKey, Memory]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        self._agents = {instance_name(a.name, a.index): a for a in self.system.agents}
+        self._agents = {(a.name, a.index): a for a in reversed(self.system.agents)}
 
     # ------------------------------------------------------------------ lookups
     def agent(self, reference: ElementReference) -> Agent | None:
-        return self._agents.get(reference_key(reference))
+        return self._agents.get(member_key(reference))
 
     def subsystem(self, agent: Agent, reference: ElementReference) -> Subsystem | None:
         table = self._subsystem_tables.get(id(agent))
         if table is None:
             table = self._subsystem_tables[id(agent)] = {
-                (s.kind, instance_name(s.name, s.index)): s for s in reversed(agent.subsystems)
+                (s.kind, s.name, s.index): s for s in reversed(agent.subsystems)
             }
-        return table.get((reference.kind, reference_key(reference)))
+        return table.get((reference.kind, *member_key(reference)))
 
     # Links into a subsystem with a family of ten thousand buffers would make a scan per link
     # quadratic, so each subsystem's buffers are looked up through a table built on first use.
     def output_buffer(self, subsystem: Subsystem, reference: ElementReference) -> OutputBuffer | None:
         table = self._output_tables.get(id(subsystem))
         if table is None:
-            table = self._output_tables[id(subsystem)] = _by_instance_name(subsystem.output_buffers)
-        return table.get(reference_key(reference))
+            table = self._output_tables[id(subsystem)] = _by_member(subsystem.output_buffers)
+        return table.get(member_key(reference))
 
     def input_buffer(self, subsystem: Subsystem, reference: ElementReference) -> InputBuffer | None:
         table = self._input_tables.get(id(subsystem))
         if table is None:
-            table = self._input_tables[id(subsystem)] = _by_instance_name(subsystem.input_buffers)
-        return table.get(reference_key(reference))
+            table = self._input_tables[id(subsystem)] = _by_member(subsystem.input_buffers)
+        return table.get(member_key(reference))
 
     def memory(self, subsystem: Subsystem, reference: ElementReference) -> Memory | None:
         table = self._memory_tables.get(id(subsystem))
         if table is None:
-            table = self._memory_tables[id(subsystem)] = _by_instance_name(subsystem.memories)
-        return table.get(reference_key(reference))
+            table = self._memory_tables[id(subsystem)] = _by_member(subsystem.memories)
+        return table.get(member_key(reference))
 
     def subsystems(self) -> Iterator[tuple[Agent, Subsystem]]:
         for agent in self.system.agents:
