@@ -146,7 +146,7 @@ def test_levelling_wrist_keeps_the_gripper_pointing_down() -> None:
         plant.advance(i * 0.001)
     assert abs(plant.joint_position("joint2")) > 0.01  # it did move
     pose = plant.site_pose(arm.GRASP_SITE)
-    w, x, y, z = pose.orientation
+    _, x, y, _ = pose.orientation
     tool_axis_z = 1.0 - 2.0 * (x * x + y * y)  # the z component of the gripper's z axis
     assert tool_axis_z == pytest.approx(-1.0, abs=2e-3)
 

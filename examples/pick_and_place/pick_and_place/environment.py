@@ -63,12 +63,15 @@ class PickAndPlaceEnvironment:
         output: str | Path | None = None,
         operator_stop_at: float | None = None,
         driver_fault: tuple[int, float] | None = None,
+        start: list[float] | None = None,
     ) -> None:
         self.n = n
         random = np.random.default_rng(seed)
         jitter = random.uniform(-scene.BOX_JITTER, scene.BOX_JITTER, size=2)
         self.box_start = (scene.BOX_XY[0] + float(jitter[0]), scene.BOX_XY[1] + float(jitter[1]))
-        xml = arm.workcell_mjcf(n, self.box_start, scene.TARGET_XY, park_configuration(n))
+        # the arm starts parked above the box, unless a test asks for another posture
+        initial = park_configuration(n) if start is None else list(start)
+        xml = arm.workcell_mjcf(n, self.box_start, scene.TARGET_XY, initial)
         self.plant = MujocoPlant.from_xml(xml, seed=seed, keyframe="initial")
         self.operator_stop_at = operator_stop_at
         if driver_fault is not None:
@@ -164,6 +167,4 @@ def make_environment_operator_stop(system: Any, seed: int) -> PickAndPlaceEnviro
 
 def make_environment_driver_fault(system: Any, seed: int) -> PickAndPlaceEnvironment:
     """As make_environment, and joint FAULTY_JOINT's driver faults at STOP_TIME."""
-    return PickAndPlaceEnvironment(
-        joints_of(system), seed, output=_output(), driver_fault=(FAULTY_JOINT, STOP_TIME)
-    )
+    return PickAndPlaceEnvironment(joints_of(system), seed, output=_output(), driver_fault=(FAULTY_JOINT, STOP_TIME))

@@ -51,7 +51,9 @@ def _stopped(context: Any, opening: float) -> bool:
     slow = previous is not None and abs(opening - previous) / context.period < STALL_SPEED
     memory["slow"] = memory.get("slow", 0) + 1 if slow else 0
     memory["opening"] = opening
-    started = abs(opening - memory.get("start", opening)) > START_DISTANCE or context.iteration * context.period >= START_TIME
+    started = (
+        abs(opening - memory.get("start", opening)) > START_DISTANCE or context.iteration * context.period >= START_TIME
+    )
     return started and int(memory["slow"]) >= STALL_ITERATIONS
 
 

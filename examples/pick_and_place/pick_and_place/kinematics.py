@@ -88,10 +88,12 @@ class RobotModel:
     # ------------------------------------------------------------ kinematics
 
     def motor_to_joint(self, motor_positions: Vector) -> Vector:
-        return np.asarray(motor_positions, dtype=float) / self.gear
+        joints: Vector = np.asarray(motor_positions, dtype=float) / self.gear
+        return joints
 
     def joint_to_motor(self, joint_positions: Vector) -> Vector:
-        return np.asarray(joint_positions, dtype=float) * self.gear
+        motors: Vector = np.asarray(joint_positions, dtype=float) * self.gear
+        return motors
 
     def _configure(self, q: Vector, qd: Vector | None = None) -> None:
         """Positions (and, given velocities, everything dynamics needs) for the joints at `q`."""

@@ -22,7 +22,7 @@ def _plant(context: Any) -> Any:
     if environment is None or not hasattr(environment, "plant"):
         raise NoPlant(
             f"{context.subsystem} drives a simulated motor and needs the MuJoCo environment: run with "
-            "`environment = \"pick_and_place.environment:make_environment\"` (examples/pick_and_place/run.toml)"
+            '`environment = "pick_and_place.environment:make_environment"` (examples/pick_and_place/run.toml)'
         )
     return environment.plant
 

@@ -10,6 +10,7 @@ seed still compute the same currents.
 
 from __future__ import annotations
 
+import contextlib
 import weakref
 from typing import Any
 
@@ -27,10 +28,9 @@ def state_of(context: Any) -> dict[str, Any]:
         bucket = _BY_ENVIRONMENT.get(key)  # type: ignore[assignment]
         if bucket is None:
             bucket = _BY_ENVIRONMENT[key] = {}
-            try:
+            # an environment that cannot be weakly referenced keeps its state until the process ends
+            with contextlib.suppress(TypeError):
                 weakref.finalize(environment, _BY_ENVIRONMENT.pop, key, None)
-            except TypeError:  # not weak-referenceable: kept until the process ends
-                pass
     slot = bucket.setdefault(context.subsystem, {})
     now = float(context.time)
     if slot.get("__time__", now) > now:

@@ -194,4 +194,3 @@ def send_manipulator_command(inputs: Any, outputs: Any, context: Any) -> None:
 def send_gripper_command(inputs: Any, outputs: Any, context: Any) -> None:
     if inputs.commandIssued:
         outputs.gripperCommand = inputs.gripperSetpoint
-

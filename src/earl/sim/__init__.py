@@ -17,6 +17,6 @@ import os
 if "MUJOCO_GL" not in os.environ and not os.environ.get("DISPLAY"):
     os.environ["MUJOCO_GL"] = "egl"
 
-from earl.sim.plant import Encoder, MujocoPlant, PlantError, Pose  # noqa: E402
+from earl.sim.plant import Encoder, MujocoPlant, PlantError, Pose
 
 __all__ = ["Encoder", "MujocoPlant", "PlantError", "Pose"]

@@ -241,7 +241,7 @@ def _robot_body(n: int, indent: str) -> str:
     depth = 0
     previous = 0.0
     for k in range(1, arm_joints + 1):
-        kind, height = layout[k - 1], heights[k - 1]
+        height = heights[k - 1]
         pad = indent + "  " * depth
         lines.append(f'{pad}<body name="link{k}" pos="0 0 {_f(height - previous)}">')
         lines.append(_joint_line(n, k, pad + "  "))
@@ -333,20 +333,27 @@ def _actuators_and_sensors(n: int) -> str:
     lines.append("  <custom>")
     for k in range(1, n + 1):
         d = drive(n, k)
-        lines.append(f'    <numeric name="earl.encoder.{actuator_name(k)}" data="{_f(d.gear_ratio)} {d.encoder_counts}"/>')
-    lines.append(
-        f'    <numeric name="earl.encoder.{FINGER_ACTUATOR}" data="{_f(f.gear_ratio)} {f.encoder_counts}"/>'
-    )
+        lines.append(
+            f'    <numeric name="earl.encoder.{actuator_name(k)}" data="{_f(d.gear_ratio)} {d.encoder_counts}"/>'
+        )
+    lines.append(f'    <numeric name="earl.encoder.{FINGER_ACTUATOR}" data="{_f(f.gear_ratio)} {f.encoder_counts}"/>')
     lines.append("  </custom>")
     return "\n".join(lines)
 
 
 def _equalities(n: int) -> str:
-    lines = ["  <equality>", f'    <joint joint1="finger_right" joint2="{FINGER_JOINT}" polycoef="0 1 0 0 0" solref="0.004 1"/>']
+    lines = [
+        "  <equality>",
+        f'    <joint joint1="finger_right" joint2="{FINGER_JOINT}" polycoef="0 1 0 0 0" solref="0.004 1"/>',
+    ]
     if n < 5:
         shoulder, elbow = pitch_joints(n)[:2]
-        lines.append(f'    <joint joint1="level_shoulder" joint2="{joint_name(shoulder)}" polycoef="0 -1 0 0 0" solref="0.004 1"/>')
-        lines.append(f'    <joint joint1="level_elbow" joint2="{joint_name(elbow)}" polycoef="0 -1 0 0 0" solref="0.004 1"/>')
+        lines.append(
+            f'    <joint joint1="level_shoulder" joint2="{joint_name(shoulder)}" polycoef="0 -1 0 0 0" solref="0.004 1"/>'
+        )
+        lines.append(
+            f'    <joint joint1="level_elbow" joint2="{joint_name(elbow)}" polycoef="0 -1 0 0 0" solref="0.004 1"/>'
+        )
     lines.append("  </equality>")
     return "\n".join(lines)
 
@@ -427,7 +434,15 @@ def workcell_mjcf(
         keyframe = _keyframe(n, initial_configuration, (bx, by))
     # The box comes after the robot so that the keyframe's qpos lists the robot's joints first.
     return "".join(
-        [head, "  <worldbody>\n", body, "\n".join(scene), "\n", "  </worldbody>\n", tail.replace("</mujoco>", keyframe + "</mujoco>")]
+        [
+            head,
+            "  <worldbody>\n",
+            body,
+            "\n".join(scene),
+            "\n",
+            "  </worldbody>\n",
+            tail.replace("</mujoco>", keyframe + "</mujoco>"),
+        ]
     )
 
 

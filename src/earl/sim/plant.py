@@ -188,7 +188,7 @@ class MujocoPlant:
             index = self._actuator(actuator)
             data = self.model.numeric(i).data
             if len(data) != 2:
-                raise PlantError(f"encoder `{name}` needs data=\"GEAR COUNTS\", got {len(data)} numbers")
+                raise PlantError(f'encoder `{name}` needs data="GEAR COUNTS", got {len(data)} numbers')
             joint = int(self.model.actuator_trnid[index, 0])
             encoders[actuator] = Encoder(actuator, int(self.model.jnt_qposadr[joint]), float(data[0]), int(data[1]))
         return encoders
