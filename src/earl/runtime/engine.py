@@ -92,6 +92,7 @@ class SubsystemEngine:
         self.order = order
         self.period = period
         self.context = context
+        context._engine = self
         self.recorder = recorder
         self.inputs: dict[str, Any] = {}
         self.new_data: dict[str, bool] = {}
@@ -107,6 +108,7 @@ class SubsystemEngine:
         self.faults = 0
         self._error_in_iteration = False
         self._stuck = False
+        self._timeouts_set = False
         #: set by the scheduler: called when a message reaches an obligatory buffer this engine waits for
         self.on_delivery: Callable[[SubsystemEngine], None] | None = None
         self.waiting = False
@@ -126,10 +128,6 @@ class SubsystemEngine:
         assert state is not None
         behaviour = state.behaviour
         context = self.context
-        context.time = time * 1e-9
-        context.iteration = self.iteration
-        context.state = state.name
-        context.behaviour = behaviour.name
         self.iteration_start = time
         self._error_in_iteration = False
         memory = self.memory
@@ -137,30 +135,36 @@ class SubsystemEngine:
         for stage in behaviour.stages:
             stage_memory: dict[str, Any] = {}
             for function in stage:
-                written = function.outputs.written
-                written.clear()
+                outputs = function.outputs
+                outputs.clear()
+                function.inputs.refresh()
                 try:
-                    function.function(function.inputs, function.outputs, context)
+                    function.function(function.inputs, outputs, context)
                 except Exception as error:
-                    written.clear()  # a function that failed writes nothing
+                    outputs.clear()  # a function that failed writes nothing
                     self._function_fault(time, function.name, error)
                     continue
-                for (is_memory, key), value in written.items():
-                    if is_memory:
-                        stage_memory[key] = value
-                    else:
-                        sent[key] = value
+                if outputs.memory_written:
+                    stage_memory.update(outputs.memory_written)
+                if outputs.sent:
+                    sent.update(outputs.sent)
             # the stage's writes become visible only now: no function saw another's (Eq. 7-8)
-            memory.update(stage_memory)
+            if stage_memory:
+                memory.update(stage_memory)
+        if sent:
+            self._send(time, sent)
+        self.iteration += 1
+        self.total_iterations += 1
+
+    def _send(self, time: int, sent: dict[str, Any]) -> None:
+        recorder = self.recorder
         for key, value in sent.items():
             for destination in self.destinations.get(key, ()):
                 destination.channel.deliver(value)
-                self.recorder.message_sent(time, destination.link, value)
+                recorder.message_sent(time, destination.link, value)
                 engine = destination.engine
                 if engine.waiting and engine.on_delivery is not None:
                     engine.on_delivery(engine)
-        self.iteration += 1
-        self.total_iterations += 1
 
     def _function_fault(self, time: int, function: str, error: Exception) -> None:
         if isinstance(error, UndeclaredAccess):
@@ -197,7 +201,10 @@ class SubsystemEngine:
         state = self.state
         assert state is not None
         channels = self.channels
-        return all(channels[key].queue for key in state.obligatory)
+        for key in state.obligatory:
+            if not channels[key].queue:
+                return False
+        return True
 
     def receive(self, time: int, timed_out: bool = False) -> None:
         """`tf.pf.ib.receive()`: every input buffer takes what arrived; obligatory ones not filled time out."""
@@ -206,17 +213,23 @@ class SubsystemEngine:
         inputs = self.inputs
         new_data = self.new_data
         for key, channel in self.channels.items():
-            if channel.queue:
-                inputs[key] = channel.queue.popleft()
+            queue = channel.queue
+            if queue:
+                inputs[key] = queue.popleft()
                 new_data[key] = True
             else:
                 new_data[key] = False
             if channel.overflowed:
                 channel.overflowed = False
                 self.report_fault(time, "overflow", f"the FIFO of `{key}/ib` overflowed ({channel.dropped} dropped)")
-        flags = self.timed_out
-        for key in state.obligatory:
-            flags[key] = timed_out and not new_data[key]
+        if state.obligatory or self._timeouts_set:
+            flags = self.timed_out
+            obligatory = state.obligatory
+            any_set = False
+            for key in flags:
+                flag = flags[key] = timed_out and key in obligatory and not new_data[key]
+                any_set = any_set or flag
+            self._timeouts_set = any_set
 
     # ------------------------------------------------------------------ Figure 5b, step 5 and Figure 5a
     def _evaluate(self, time: int, predicate: CompiledPredicate, what: str) -> bool:
@@ -236,10 +249,18 @@ class SubsystemEngine:
             error = self._evaluate(time, behaviour.error_condition, f"the error condition of `{behaviour.name}/bb`")
         if error:
             reason = "error"
-        elif self._evaluate(time, behaviour.terminal_condition, f"the terminal condition of `{behaviour.name}/bb`"):
-            reason = "terminal"
         else:
-            return
+            try:
+                terminal = behaviour.terminal_condition(
+                    self.inputs, self.new_data, self.timed_out, self.memory, self.predicates
+                )
+            except Exception:
+                terminal = self._evaluate(
+                    time, behaviour.terminal_condition, f"the terminal condition of `{behaviour.name}/bb`"
+                )
+            if not terminal:
+                return
+            reason = "terminal"
         for transition in state.transitions:
             if self._evaluate(time, transition.condition, f"the condition of `{transition.name}/t`"):
                 self._enter(time, transition, reason)

@@ -93,39 +93,57 @@ class Scheduler:
         if not self.started:
             self.start()
         queue = self._queue
+        pop = heapq.heappop
+        advance = self._advance
+        realtime = self.realtime
+        tokens = self._tokens
         while queue and queue[0][0] <= until:
             if should_stop is not None and should_stop():
                 return
-            time, _, _, kind, engine, token = heapq.heappop(queue)
+            time, _, _, kind, engine, token = pop(queue)
             self.now = time
-            if self._advance is not None and time > self._environment_time:
+            if advance is not None and time > self._environment_time:
                 self._environment_time = time
-                self._advance(time * 1e-9)
-            if self.realtime:
+                advance(time * 1e-9)
+            if realtime:
                 self._wait_until(time, engine, kind)
             if kind == _START:
-                self._start(engine, time)
+                following = self._start(engine, time)
+                # The engine alone is due before anything else: run it on without the queue
+                # (same order as through the queue, only cheaper).
+                while (
+                    following is not None
+                    and following <= until
+                    and advance is None
+                    and not realtime
+                    and (not queue or following < queue[0][0])
+                ):
+                    self.now = following
+                    following = self._start(engine, following)
+                if following is not None:
+                    self._push(following, engine, _START)
             elif kind == _RESUME:
-                if engine.waiting and token == self._tokens[engine.name]:
-                    self._finish(engine, time, timed_out=False)
-            elif engine.waiting and token == self._tokens[engine.name]:  # _TIMEOUT
-                self._finish(engine, time, timed_out=True)
+                if engine.waiting and token == tokens[engine.name]:
+                    self._push(self._finish(engine, time, timed_out=False), engine, _START)
+            elif engine.waiting and token == tokens[engine.name]:  # _TIMEOUT
+                self._push(self._finish(engine, time, timed_out=True), engine, _START)
         self.now = max(self.now, until)
-        if self._advance is not None and self.now > self._environment_time:
+        if advance is not None and self.now > self._environment_time:
             self._environment_time = self.now
-            self._advance(self.now * 1e-9)
+            advance(self.now * 1e-9)
 
-    def _start(self, engine: SubsystemEngine, time: int) -> None:
+    def _start(self, engine: SubsystemEngine, time: int) -> int | None:
+        """One iteration from START; the time of the next START, or None while the engine waits."""
         engine.execute_and_send(time)
-        if engine.obligatory_ready():
-            self._finish(engine, time, timed_out=False)
-            return
-        engine.waiting = True
-        token = self._tokens[engine.name] = self._tokens[engine.name] + 1
         state = engine.state
         assert state is not None
+        if not state.obligatory or engine.obligatory_ready():
+            return self._finish(engine, time, timed_out=False)
+        engine.waiting = True
+        token = self._tokens[engine.name] = self._tokens[engine.name] + 1
         if state.timeout is not None:
             self._push(time + state.timeout, engine, _TIMEOUT, token)
+        return None
 
     def _delivered(self, engine: SubsystemEngine) -> None:
         """A message reached a waiting engine: wake it now if its obligatory buffers are all filled."""
@@ -134,17 +152,21 @@ class Scheduler:
         self._resume_pending.add(engine.name)
         self._push(self.now, engine, _RESUME, self._tokens[engine.name])
 
-    def _finish(self, engine: SubsystemEngine, time: int, *, timed_out: bool) -> None:
-        engine.waiting = False
-        self._resume_pending.discard(engine.name)
-        self._tokens[engine.name] += 1
+    def _finish(self, engine: SubsystemEngine, time: int, *, timed_out: bool) -> int:
+        """Receive and decide; the time of the engine's next START."""
+        if engine.waiting:
+            engine.waiting = False
+            self._resume_pending.discard(engine.name)
+            self._tokens[engine.name] += 1
         engine.receive(time, timed_out)
         engine.decide(time)
-        if engine.name in self.record_memory:
+        if self.record_memory and engine.name in self.record_memory:
             self.recorder.memory_snapshot(time, engine.name, engine.memory)
         period = engine.period
-        following = engine.iteration_start + period if period is not None else time
-        self._push(max(following, time), engine, _START)
+        if period is None:
+            return time
+        following = engine.iteration_start + period
+        return following if following > time else time
 
     def _wait_until(self, time: int, engine: SubsystemEngine, kind: int) -> None:
         due = self._wall_start + time

@@ -15,7 +15,7 @@ double is declared) into that form, or says exactly what does not fit the type.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from typing import Any, NoReturn
 
 from earl.model.elements import System
@@ -36,6 +36,7 @@ _INTEGER_RANGES: dict[str, tuple[int, int]] = {
     "uint64": (0, 2**64 - 1),
 }
 _REAL_TYPES = ("double", "float32", "float64")
+_FLOAT_ONLY = {float}
 
 
 class Record(dict[str, Any]):
@@ -147,6 +148,46 @@ class TypeSystem:
                 raise ValueTypeError(f"{where}: the field `{name}` of `{resolved.name}` is missing")
             result[name] = self.coerce(value[name], declared.data_type, f"{where}.{name}")
         return Record(result)
+
+    def coercer(self, data_type: DataType, where: str) -> Callable[[Any], Value]:
+        """`coerce` for one type, with a fast path for the values user code writes most (floats, ints, Booleans)."""
+        resolved = self.resolve(data_type)
+        if isinstance(resolved, PrimitiveType):
+            name = resolved.name
+            if name in _REAL_TYPES:
+                return lambda value: (
+                    value if type(value) is float and value == value else _coerce_primitive(value, name, where)
+                )
+            if name == "boolean":
+                return lambda value: value if type(value) is bool else _coerce_primitive(value, name, where)
+            if name in _INTEGER_RANGES:
+                low, high = _INTEGER_RANGES[name]
+                return lambda value: (
+                    value if type(value) is int and low <= value <= high else _coerce_primitive(value, name, where)
+                )
+        if isinstance(resolved, ArrayType):
+            element = self.resolve(resolved.element)
+            size = _fixed_size(resolved)
+            if isinstance(element, PrimitiveType) and element.name in _REAL_TYPES:
+                # the common case of robot data (positions, currents): a tuple of floats, checked in one pass
+                def real_array(value: Any) -> Value:
+                    if type(value) is tuple:
+                        items = value
+                    elif type(value) is list:
+                        items = tuple(value)
+                    elif hasattr(value, "tolist") and getattr(value, "ndim", 0) == 1:
+                        items = tuple(value.tolist())
+                    else:
+                        return self.coerce(value, data_type, where)
+                    # all floats (checked in C) and no NaN (a NaN makes the sum NaN); else the slow, precise path
+                    if (size is None or len(items) == size) and set(map(type, items)) <= _FLOAT_ONLY:
+                        total = sum(items)
+                        if total == total:
+                            return items
+                    return self.coerce(value, data_type, where)
+
+                return real_array
+        return lambda value: self.coerce(value, data_type, where)
 
     def constant(self, expression: Any, data_type: DataType, where: str) -> Value:
         """The value of an expanded constant expression (a memory's initial value)."""
@@ -292,7 +333,3 @@ def iter_leaves(value: Value, prefix: str = "") -> Iterator[tuple[str, Any]]:
             yield from iter_leaves(inner, f"{prefix}[{index}]")
     elif isinstance(value, (bool, int, float)):
         yield prefix, value
-
-
-def freeze_all(values: Iterable[tuple[str, Any]]) -> dict[str, Any]:
-    return dict(values)

@@ -64,43 +64,62 @@ class FamilyInputs:
 
 
 class Inputs:
-    """The declared reads of one function, read where they live (a snapshot for the whole stage)."""
+    """The declared reads of one function, as they were when its stage began.
 
-    __slots__ = ("_fields", "_function")
+    Before each call the runtime copies the current value of every declared single
+    read into this object's attributes (`refresh`), so `inputs.x` is a plain attribute
+    read; families are live views over the same snapshot.
+    """
 
-    def __init__(self, function: str, fields: dict[str, tuple[dict[str, Any], str] | FamilyInputs]) -> None:
+    __slots__ = ("__dict__", "_full", "_function", "_singles")
+
+    def __init__(
+        self,
+        function: str,
+        singles: list[tuple[str, dict[str, Any], str]],
+        families: dict[str, FamilyInputs],
+        full: dict[str, tuple[dict[str, Any], str]],
+    ) -> None:
         self._function = function
-        self._fields = fields
+        self._singles = singles
+        self._full = full
+        self.__dict__.update(families)
 
-    def __getattr__(self, name: str) -> Any:
-        try:
-            entry = self._fields[name]
-        except KeyError:
-            raise UndeclaredAccess(
-                f"`{self._function}` does not declare that it reads `{name}`; it reads: "
-                f"{', '.join(n for n in self._fields if '/' not in n) or 'nothing'}"
-            ) from None
-        if isinstance(entry, FamilyInputs):
-            return entry
-        store, key = entry
-        return store[key]
+    def refresh(self) -> None:
+        values = self.__dict__
+        for name, store, key in self._singles:
+            values[name] = store[key]
+
+    def __getattr__(self, name: str) -> Any:  # only for names that are not declared reads
+        declared = sorted({n for n, _, _ in self._singles} | {n for n in self.__dict__})
+        raise UndeclaredAccess(
+            f"`{self._function}` does not declare that it reads `{name}`; it reads: {', '.join(declared) or 'nothing'}"
+        )
 
     def __getitem__(self, name: str) -> Any:
-        return self.__getattr__(name)
+        entry = self._full.get(name)
+        if entry is not None:
+            store, key = entry
+            return store[key]
+        return getattr(self, name)
 
     def __dir__(self) -> list[str]:
-        return [n for n in self._fields if "/" not in n]
+        return sorted({n for n, _, _ in self._singles} | set(self.__dict__))
 
 
 class _Target:
-    """One declared write: where it goes, its key and its type."""
+    """One declared write: its key, its type, and the dictionary of the call's writes it goes to."""
 
-    __slots__ = ("data_type", "is_memory", "key")
+    __slots__ = ("coerce", "data_type", "is_memory", "key", "store")
 
-    def __init__(self, key: str, is_memory: bool, data_type: DataType) -> None:
+    def __init__(
+        self, key: str, is_memory: bool, data_type: DataType, coerce: Callable[[Any], Value], store: dict[str, Any]
+    ) -> None:
         self.key = key
         self.is_memory = is_memory
         self.data_type = data_type
+        self.coerce = coerce
+        self.store = store
 
 
 class FamilyOutputs:
@@ -136,31 +155,35 @@ class FamilyOutputs:
 
 
 class Outputs:
-    """The declared writes of one function; values are checked against their types as they are written."""
+    """The declared writes of one function; values are checked against their types as they are written.
 
-    __slots__ = ("_fields", "_function", "_memory", "_types", "written")
+    A call's writes are collected in `memory_written` (`/mo`) and `sent` (`/ob`); the engine
+    applies them when the stage ends, and discards them when the function failed.
+    """
 
-    def __init__(self, function: str, types: TypeSystem, memory: dict[str, Any]) -> None:
+    __slots__ = ("_fields", "_function", "_memory", "memory_written", "sent")
+
+    def __init__(self, function: str, memory: dict[str, Any]) -> None:
         object.__setattr__(self, "_function", function)
-        object.__setattr__(self, "_types", types)
         object.__setattr__(self, "_memory", memory)
         object.__setattr__(self, "_fields", {})
-        #: (is_memory, key) -> value written in the current call
-        object.__setattr__(self, "written", {})
+        object.__setattr__(self, "memory_written", {})
+        object.__setattr__(self, "sent", {})
 
     def _declare(self, name: str, entry: _Target | FamilyOutputs) -> None:
         self._fields[name] = entry
 
+    def clear(self) -> None:
+        self.memory_written.clear()
+        self.sent.clear()
+
     def _write(self, target: _Target, value: Any) -> None:
-        kind = "mo" if target.is_memory else "ob"
-        self.written[(target.is_memory, target.key)] = self._types.coerce(
-            value, target.data_type, f"{target.key}/{kind}"
-        )
+        target.store[target.key] = target.coerce(value)
 
     def _current(self, target: _Target) -> Value:
-        marker = (target.is_memory, target.key)
-        if marker in self.written:
-            return self.written[marker]
+        """What the function wrote so far in this call; else memory's value before the stage."""
+        if target.key in target.store:
+            return target.store[target.key]
         return self._memory.get(target.key) if target.is_memory else None
 
     def _entry(self, name: str) -> _Target | FamilyOutputs:
@@ -173,10 +196,13 @@ class Outputs:
             ) from None
 
     def __setattr__(self, name: str, value: Any) -> None:
-        entry = self._entry(name)
-        if isinstance(entry, FamilyOutputs):
-            raise UndeclaredAccess(f"`{name}` is a family: write one member, e.g. `outputs.{name}[1] = …`")
-        self._write(entry, value)
+        entry = self._fields.get(name)
+        if type(entry) is _Target:
+            entry.store[entry.key] = entry.coerce(value)
+            return
+        if entry is None:
+            self._entry(name)  # raises, naming what the function does write
+        raise UndeclaredAccess(f"`{name}` is a family: write one member, e.g. `outputs.{name}[1] = …`")
 
     def __getattr__(self, name: str) -> Any:
         entry = self._entry(name)
@@ -195,19 +221,13 @@ class Outputs:
 
 
 class Context:
-    """About the run, for the function being called: time, iteration, parameters, the environment."""
+    """About the run, for the function being called: time, iteration, parameters, the environment.
 
-    __slots__ = (
-        "behaviour",
-        "environment",
-        "iteration",
-        "parameters",
-        "period",
-        "random",
-        "state",
-        "subsystem",
-        "time",
-    )
+    `time`, `iteration`, `state` and `behaviour` are read from the running subsystem when
+    asked for, so that keeping them current costs nothing per iteration.
+    """
+
+    __slots__ = ("_engine", "environment", "parameters", "period", "random", "subsystem")
 
     def __init__(
         self,
@@ -222,10 +242,27 @@ class Context:
         self.period = period
         self.environment = environment
         self.random = random
-        self.time = 0.0
-        self.iteration = 0
-        self.state = ""
-        self.behaviour = ""
+        self._engine: Any = None
+
+    @property
+    def time(self) -> float:
+        """Seconds of run time at the start of this iteration."""
+        return float(self._engine.iteration_start * 1e-9) if self._engine is not None else 0.0
+
+    @property
+    def iteration(self) -> int:
+        """The behaviour's iterationNumber: 0 in the first iteration after its state was entered."""
+        return int(self._engine.iteration) if self._engine is not None else 0
+
+    @property
+    def state(self) -> str:
+        state = self._engine.state if self._engine is not None else None
+        return str(state.name) if state is not None else ""
+
+    @property
+    def behaviour(self) -> str:
+        state = self._engine.state if self._engine is not None else None
+        return str(state.behaviour.name) if state is not None else ""
 
     def __repr__(self) -> str:
         return f"<context of {self.subsystem} at t={self.time:.6f} s, {self.state}, iteration {self.iteration}>"
@@ -237,22 +274,22 @@ def build_inputs(
     input_values: dict[str, Any],
     memory_values: dict[str, Any],
 ) -> Inputs:
-    fields: dict[str, Any] = {}
+    singles: dict[str, tuple[str, dict[str, Any], str] | None] = {}
     families: dict[str, dict[int, tuple[dict[str, Any], str]]] = {}
+    full: dict[str, tuple[dict[str, Any], str]] = {}
     for reference in reads:
         store = input_values if reference.kind is Kind.INPUT_BUFFER else memory_values
         key = reference_key(reference)
         index = reference_index(reference)
         suffix = "ib" if reference.kind is Kind.INPUT_BUFFER else "mi"
-        fields[f"{key}/{suffix}"] = (store, key)
+        full[f"{key}/{suffix}"] = (store, key)
         if index is None:
-            _add_unique(fields, reference.name, (store, key), function)
+            # an input buffer and a memory may share a name: then only `inputs["x/ib"]` tells them apart
+            singles[reference.name] = None if reference.name in singles else (reference.name, store, key)
         else:
             families.setdefault(reference.name, {})[index] = (store, key)
-    for name, members in families.items():
-        family = FamilyInputs(name, dict(sorted(members.items())))
-        _add_unique(fields, name, family, function)
-    return Inputs(function, fields)
+    family_views = {name: FamilyInputs(name, dict(sorted(members.items()))) for name, members in families.items()}
+    return Inputs(function, [entry for entry in singles.values() if entry is not None], family_views, full)
 
 
 def build_outputs(
@@ -262,12 +299,19 @@ def build_outputs(
     memory_values: dict[str, Any],
     data_type_of: Callable[[ElementReference], DataType],
 ) -> Outputs:
-    outputs = Outputs(function, types, memory_values)
+    outputs = Outputs(function, memory_values)
     families: dict[str, dict[int, _Target]] = {}
     for reference in writes:
         is_memory = reference.kind is not Kind.OUTPUT_BUFFER
         key = reference_key(reference)
-        target = _Target(key, is_memory, data_type_of(reference))
+        data_type = data_type_of(reference)
+        target = _Target(
+            key,
+            is_memory,
+            data_type,
+            types.coercer(data_type, f"{key}/{'mo' if is_memory else 'ob'}"),
+            outputs.memory_written if is_memory else outputs.sent,
+        )
         outputs._declare(f"{key}/{'mo' if is_memory else 'ob'}", target)
         index = reference_index(reference)
         if index is None:
@@ -278,14 +322,3 @@ def build_outputs(
     for name, members in families.items():
         outputs._declare(name, FamilyOutputs(name, outputs, dict(sorted(members.items()))))
     return outputs
-
-
-_AMBIGUOUS = object()
-
-
-def _add_unique(fields: dict[str, Any], name: str, entry: Any, function: str) -> None:
-    """An input buffer and a memory may share a name; then only `inputs["name/ib"]` tells them apart."""
-    if name in fields and fields[name] is not entry:
-        del fields[name]
-        return
-    fields[name] = entry
