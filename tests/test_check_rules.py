@@ -958,3 +958,52 @@ def test_members_that_name_no_index_are_one_subsystem_to_the_rules() -> None:
         ("a3", 1, "m", 2),
         ("a3", 1, "d", 1),
     ]
+
+
+# ---------------------------------------------------------------- EARL-W041 beyond the initial state
+
+
+def position_of(text: str, line_text: str, token: str) -> tuple[int, int]:
+    """(line, column) of `token` on the only line that contains `line_text`."""
+    (number,) = [n for n, line in enumerate(text.splitlines(), start=1) if line_text in line]
+    return number, text.splitlines()[number - 1].index(token) + 1
+
+
+UNWRITTEN = edit(
+    TWO_STATES,
+    ("state other: run/bb", "state other: other/bb"),
+    ("        x/m: double = 0.0\n", "        x/m: double = 0.0\n        z/m: double\n"),
+    (
+        "        emit/pf(x/mi -> out/ob)\n",
+        "        emit/pf(x/mi -> out/ob)\n        fill/pf(x/mi -> z/mo)\n        useZ/pf(z/mi -> x/mo)\n"
+        "        other/bb {\n            tf = {useZ/pf} then {emit/pf}\n            tc = go/pp\n        }\n",
+    ),
+)
+
+
+def test_memory_unwritten_on_the_way_to_a_state_is_reported_there() -> None:
+    (finding,) = findings(UNWRITTEN, "EARL-W041")
+    assert finding.location is not None
+    assert (finding.location.line, finding.location.column) == position_of(UNWRITTEN, "tf = {useZ/pf}", "useZ")
+    assert finding.message == (
+        "`useZ/pf` reads `z/mi` in the first iteration of `other/bb` (state `other` of a1/a.cs, entered by "
+        "run → other where nothing writes it) before anything wrote it"
+    )
+    # written by the behaviour of the state before: nothing to report
+    written = edit(("tf = {compute/pf} then {emit/pf}", "tf = {compute/pf, fill/pf} then {emit/pf}"), text=UNWRITTEN)
+    assert findings(written, "EARL-W041") == []
+
+
+def test_a_condition_reading_unwritten_memory_is_reported() -> None:
+    text = edit(
+        ("        x/m: double = 0.0\n", "        x/m: double = 0.0\n        z/m: double\n"),
+        ("        go/pp = x/mi > 1.0\n", "        go/pp = x/mi > 1.0\n        zset/pp = z/mi > 0.0\n"),
+        ("tc = go/pp\n", "tc = go/pp or zset/pp\n"),
+    )
+    (finding,) = findings(text, "EARL-W041")
+    assert finding.location is not None
+    assert (finding.location.line, finding.location.column) == position_of(text, "tc = go/pp or zset/pp", "zset")
+    assert "the condition of `run/bb` reads `z/mi` (through `zset/pp`)" in finding.message
+    assert "(the initial state of a1/a.cs)" in finding.message
+    fixed = edit(("z/m: double\n", "z/m: double = 0.0\n"), text=text)
+    assert findings(fixed, "EARL-W041") == []

@@ -9,7 +9,7 @@ from earl.check.expression_types import BOOLEAN, ExpressionTyper
 from earl.check.registry import Finding, rule
 from earl.diagnostics import Severity
 from earl.model.elements import BasicBehaviour, Subsystem
-from earl.model.expressions import ElementReference, Expression, reads
+from earl.model.expressions import ElementReference, Expression, Read, reads
 from earl.model.kinds import Kind
 from earl.model.location import SourceLocation
 from earl.model.text import expression_text, reference_text
@@ -244,39 +244,115 @@ def output_buffers_written(context: CheckContext) -> Iterator[Finding]:
                     )
 
 
+def _memory_written(subsystem: Subsystem, behaviour: BasicBehaviour) -> set[str]:
+    """Memory some function of the behaviour's transition function writes (every iteration runs them all)."""
+    written: set[str] = set()
+    for function_reference in behaviour.transition_function.partial_transition_functions:
+        function = subsystem.partial_transition_function(function_reference.name)
+        if function is not None:
+            written.update(reference_key(w) for w in function.writes if w.kind is Kind.MEMORY_OUTPUT)
+    return written
+
+
+def _unwritten_on_entry(subsystem: Subsystem, memory: str) -> dict[str, list[str]]:
+    """The states that can be entered while `memory` was never written, each with the path of states from
+    the initial one that gets there; a state whose behaviour writes it hands it on written."""
+    fsm = subsystem.fsm
+    assert fsm is not None
+    paths = {fsm.initial: [fsm.initial]}
+    frontier = [fsm.initial]
+    while frontier:
+        name = frontier.pop(0)
+        state = fsm.state_named(name)
+        behaviour = subsystem.basic_behaviour(state.behaviour) if state else None
+        if behaviour is None or memory in _memory_written(subsystem, behaviour):
+            continue
+        for transition in fsm.transitions:
+            if transition.source == name and transition.destination not in paths:
+                paths[transition.destination] = [*paths[name], transition.destination]
+                frontier.append(transition.destination)
+    return paths
+
+
+def _memory_read(subsystem: Subsystem, expression: Expression) -> Iterator[tuple[str, Read]]:
+    """Memory a condition reads, directly (`x/mi`) or through a primitive predicate, with the read in the
+    condition that leads to it."""
+    for node in reads(expression):
+        if node.target.kind is Kind.MEMORY_INPUT:
+            yield reference_key(node.target), node
+        elif node.target.kind is Kind.PRIMITIVE_PREDICATE:
+            predicate = subsystem.primitive_predicate(node.target.name)
+            if predicate is not None:
+                for inner in reads(predicate.expression):
+                    if inner.target.kind is Kind.MEMORY_INPUT:
+                        yield reference_key(inner.target), node
+
+
 @rule("EARL-W041", Severity.WARNING, "memory is written or initialised before it is read", "§2.2, Table 3")
 def memory_read_before_written(context: CheckContext) -> Iterator[Finding]:
-    """In the first iteration of the initial state's behaviour, memory without an initial value that a
-    function reads before an earlier stage wrote it holds only its type's zero value."""
+    """Memory without an initial value holds only its type's zero value until a function writes it. A
+    state can be entered with such memory unwritten when a chain of transitions leads to it from the
+    initial state through states whose behaviours never write it; there, a function that reads it before
+    an earlier stage wrote it, or a terminal or error condition the behaviour's functions do not write it
+    for, reads a value nobody computed."""
 
     def findings() -> Iterator[Finding]:
         for agent, subsystem in context.distinct_subsystems():
             if subsystem.fsm is None:
                 continue
-            state = subsystem.fsm.state_named(subsystem.fsm.initial)
-            behaviour = subsystem.basic_behaviour(state.behaviour) if state else None
-            if behaviour is None:
-                continue
-            initialised = {instance_name(m.name, m.index) for m in subsystem.memories if m.initial_value is not None}
-            written: set[str] = set()
-            for stage in behaviour.transition_function.stages:
-                stage_writes: set[str] = set()
-                for function_reference in stage:
-                    function = subsystem.partial_transition_function(function_reference.name)
-                    if function is None:
+            owner = subsystem_name(agent, subsystem)
+            for memory in subsystem.memories:
+                if memory.initial_value is not None:
+                    continue
+                key = instance_name(memory.name, memory.index)
+                for name, path in _unwritten_on_entry(subsystem, key).items():
+                    state = subsystem.fsm.state_named(name)
+                    behaviour = subsystem.basic_behaviour(state.behaviour) if state else None
+                    if behaviour is None:
                         continue
-                    for element in function.reads:
-                        key = reference_key(element)
-                        if element.kind is Kind.MEMORY_INPUT and key not in initialised and key not in written:
-                            yield Finding(
-                                f"`{function.name}/pf` reads `{key}/mi` in the first iteration of `{behaviour.name}/bb` (the initial state of {subsystem_name(agent, subsystem)}) before anything wrote it",
-                                function_reference.location,
-                                f"give `{element.name}/m` an initial value, or write it in an earlier stage",
-                            )
-                    stage_writes.update(reference_key(w) for w in function.writes if w.kind is Kind.MEMORY_OUTPUT)
-                written |= stage_writes
+                    where = (
+                        f"(the initial state of {owner})"
+                        if len(path) == 1
+                        else f"(state `{name}` of {owner}, entered by {' → '.join(path)} where nothing writes it)"
+                    )
+                    hint = f"give `{memory.name}/m` an initial value, or write it in an earlier stage or state"
+                    yield from _early_function_reads(subsystem, behaviour, key, where, hint)
+                    if key in _memory_written(subsystem, behaviour):
+                        continue
+                    conditions = [behaviour.terminal_condition, behaviour.error_condition]
+                    for condition in conditions:
+                        if condition is None:
+                            continue
+                        for read_key, read in _memory_read(subsystem, condition.expression):
+                            if read_key == key:
+                                yield Finding(
+                                    f"the condition of `{behaviour.name}/bb` reads `{key}/mi` (through `{reference_text(read.target)}`) after the first iteration {where}, before anything wrote it",
+                                    read.location or condition.location,
+                                    hint,
+                                )
 
     yield from _once(findings())
+
+
+def _early_function_reads(
+    subsystem: Subsystem, behaviour: BasicBehaviour, key: str, where: str, hint: str
+) -> Iterator[Finding]:
+    """Functions of the behaviour that read `key` before an earlier stage of it wrote the memory."""
+    for stage in behaviour.transition_function.stages:
+        stage_writes = False
+        for function_reference in stage:
+            function = subsystem.partial_transition_function(function_reference.name)
+            if function is None:
+                continue
+            if any(r.kind is Kind.MEMORY_INPUT and reference_key(r) == key for r in function.reads):
+                yield Finding(
+                    f"`{function.name}/pf` reads `{key}/mi` in the first iteration of `{behaviour.name}/bb` {where} before anything wrote it",
+                    function_reference.location,
+                    hint,
+                )
+            stage_writes |= any(w.kind is Kind.MEMORY_OUTPUT and reference_key(w) == key for w in function.writes)
+        if stage_writes:
+            return
 
 
 @rule("EARL-W042", Severity.WARNING, "every partial transition function is used", "§2.2, Table 6")

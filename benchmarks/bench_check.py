@@ -1,0 +1,394 @@
+"""Benchmark of `earl check` against the figures of issue 3.
+
+(a) A generated spec of 10,000 agents / 100,000 subsystems is read and checked in under 15 s.
+(b) Doubling the spec costs less than 2.2x the time.
+(c) The FSM analysis of one subsystem with 20 primitive predicates and 50 transitions takes
+    under 1 s.
+
+The spec of (a) and (b) comes from benchmarks/generate_families.py: agent and subsystem
+families, so the text is short and the cost is reading it, expanding it into 100,000 concrete
+subsystems and applying every rule.  The run is split into its phases; the named peer is
+*reading alone* (`earl.loads`: parse and resolve), so the table says what checking adds to it.
+The peer of (c) is an exhaustive truth table: all 2^20 assignments of the primitive predicates
+at once, as the bits of Python integers.  It also cross-checks the BDD analysis: both must find
+the same overlaps, dead transitions, stuck, never-ending and unreachable states.
+
+Every figure is the median of several runs, as wall-clock time and as the process's CPU time
+(the machine may be shared with other work; CPU time is what an idle machine shows as wall time).
+
+    .venv/bin/python benchmarks/bench_check.py              # the issue's sizes, 3 runs each
+    .venv/bin/python benchmarks/bench_check.py --quick      # small sizes, one run: a smoke test
+"""
+
+from __future__ import annotations
+
+import argparse
+import gc
+import itertools
+import json
+import os
+import platform
+import random
+import re
+import statistics
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+
+import earl  # noqa: E402
+from earl.check import check_context, collector_paused, context_for  # noqa: E402
+from earl.check.fsm_analysis import analyse  # noqa: E402
+from earl.diagnostics import Severity  # noqa: E402
+from earl.model.elements import FSM, Subsystem  # noqa: E402
+from earl.model.expressions import BooleanOperation, Expression, Literal, Not, Read  # noqa: E402
+from earl.model.kinds import Kind  # noqa: E402
+from generate_families import SUBSYSTEMS_PER_AGENT, generate  # noqa: E402
+
+RESULTS = HERE / "results" / "check.json"
+
+TARGET_SECONDS = 15.0
+TARGET_AGENTS = 10_000
+TARGET_DOUBLING = 2.2
+TARGET_FSM_SECONDS = 1.0
+
+
+@dataclass(frozen=True)
+class Timing:
+    wall: float
+    cpu: float
+
+
+def timed(function: Callable[[], Any]) -> tuple[Any, Timing]:
+    wall, cpu = time.perf_counter(), time.process_time()
+    result = function()
+    return result, Timing(time.perf_counter() - wall, time.process_time() - cpu)
+
+
+def median(timings: list[Timing]) -> Timing:
+    return Timing(statistics.median(t.wall for t in timings), statistics.median(t.cpu for t in timings))
+
+
+# ---------------------------------------------------------------------- (a) and (b): a large spec
+
+
+@dataclass(frozen=True)
+class SpecRun:
+    read: Timing  # the peer: parse and resolve
+    expand: Timing
+    rules: Timing
+
+    @property
+    def total(self) -> Timing:
+        return Timing(
+            self.read.wall + self.expand.wall + self.rules.wall, self.read.cpu + self.expand.cpu + self.rules.cpu
+        )
+
+
+def check_once(text: str) -> tuple[SpecRun, int, int, int]:
+    """Read and check `text` as `earl check` does; returns the timings, agents, subsystems and errors."""
+    with collector_paused():
+        system, read = timed(lambda: earl.loads(text, "fleet.earl"))
+        context, expand = timed(lambda: context_for(system))
+        diagnostics, rules = timed(lambda: check_context(context))
+        agents = len(context.system.agents)
+        subsystems = sum(len(agent.subsystems) for agent in context.system.agents)
+        problems = sum(1 for d in diagnostics if d.severity is not Severity.NOTE)
+    return SpecRun(read, expand, rules), agents, subsystems, problems
+
+
+def bench_sizes(sizes: list[int], runs: int) -> list[dict[str, Any]]:
+    rows = []
+    for workers in sizes:
+        text = generate(workers)
+        timings: list[SpecRun] = []
+        for _ in range(runs):
+            run, agents, subsystems, problems = check_once(text)
+            gc.collect()  # the previous run's model, before the next is built
+            if problems:
+                raise SystemExit(f"the generated spec of {workers} agents has {problems} errors or warnings")
+            timings.append(run)
+            print(f"  {workers} agents: {run.total.wall:.2f} s wall, {run.total.cpu:.2f} s CPU", flush=True)
+        rows.append(
+            {
+                "agents": agents,
+                "subsystems": subsystems,
+                "text_bytes": len(text.encode()),
+                "runs": runs,
+                "read": asdict(median([t.read for t in timings])),
+                "expand": asdict(median([t.expand for t in timings])),
+                "rules": asdict(median([t.rules for t in timings])),
+                "total": asdict(median([t.total for t in timings])),
+            }
+        )
+    return rows
+
+
+# ---------------------------------------------------------------------- (c): one FSM
+
+
+def fsm_spec(predicates: int, transitions: int, seed: int = 3) -> str:
+    """One control subsystem whose FSM has `transitions` transitions over `predicates` primitive
+    predicates: ten states, each left by transitions to distinct states, conditions of two or
+    three literals, some priorities, a few `assume`s; overlaps, dead and stuck cases included."""
+    chooser = random.Random(seed)
+    states = max(2, transitions // 5)
+    names = [f"p{i}" for i in range(1, predicates + 1)]
+
+    def literal() -> str:
+        name = chooser.choice(names)
+        return f"{name}/pp" if chooser.random() < 0.6 else f"not {name}/pp"
+
+    lines = [f"system fsm{predicates}x{transitions}", "", "r/r { a/a }", "", "a/a {", "    cs {"]
+    lines += [f"        x{i}/ib: boolean" for i in range(1, predicates + 1)]
+    lines += [f"        p{i}/pp = x{i}/ib" for i in range(1, predicates + 1)]
+    for state in range(1, states + 1):
+        stop = " or ".join(f"{chooser.choice(names)}/pp" for _ in range(2))
+        lines += [f"        b{state}/bb {{", "            tf = {}", f"            tc = {stop}", "        }"]
+    lines += ["        fsm {", "            initial s1"]
+    lines += [f"            state s{state}: b{state}/bb" for state in range(1, states + 1)]
+    written = 0
+    for state in range(1, states + 1):
+        share = transitions // states + (1 if state <= transitions % states else 0)
+        destinations = chooser.sample(range(1, states + 1), min(share, states))
+        for position, destination in enumerate(destinations, start=1):
+            condition = " and ".join(literal() for _ in range(chooser.choice((2, 3))))
+            priority = f" priority {position}" if chooser.random() < 0.5 else ""
+            lines.append(f"            s{state} -> s{destination} when {condition}{priority}")
+            written += 1
+    for _ in range(3):
+        first, second = chooser.sample(names, 2)
+        lines.append(f"            assume not ({first}/pp and {second}/pp)")
+    lines += ["        }", "    }", "}", ""]
+    assert written == transitions
+    return "\n".join(lines)
+
+
+class TruthTables:
+    """Every formula over n variables as one integer of 2^n bits: bit k is its value under assignment k."""
+
+    def __init__(self, variables: list[str]) -> None:
+        size = 1 << len(variables)
+        self.all = (1 << size) - 1
+        self.tables: dict[str, int] = {}
+        for position, name in enumerate(variables):
+            block = 1 << position  # the variable is false for `block` assignments, then true for `block`
+            unit = ((1 << block) - 1) << block
+            self.tables[name] = unit * (self.all // ((1 << (2 * block)) - 1))
+
+    def table(self, expression: Expression) -> int:
+        if isinstance(expression, Literal) and isinstance(expression.value, bool):
+            return self.all if expression.value else 0
+        if isinstance(expression, Not):
+            return self.all ^ self.table(expression.operand)
+        if isinstance(expression, BooleanOperation):
+            result = self.all if expression.operator == "and" else 0
+            for operand in expression.operands:
+                value = self.table(operand)
+                result = (result & value) if expression.operator == "and" else (result | value)
+            return result
+        if isinstance(expression, Read) and expression.target.kind is Kind.PRIMITIVE_PREDICATE:
+            return self.tables[expression.target.name]
+        raise ValueError(f"the benchmark's FSM has only primitive predicates, not {expression!r}")
+
+
+def enumerate_findings(subsystem: Subsystem, fsm: FSM) -> dict[str, set[str]]:
+    """What the FSM analysis must find, by brute force over every assignment."""
+    tables = TruthTables([p.name for p in subsystem.primitive_predicates])
+    assumed = tables.all
+    for assumption in fsm.assumptions:
+        assumed &= tables.table(assumption.expression)
+    condition = {id(t): tables.table(t.condition.expression) & assumed for t in fsm.transitions}
+    found: dict[str, set[str]] = {"overlap": set(), "dead": set(), "stuck": set(), "endless": set(), "lost": set()}
+    ending = {}
+    for state in fsm.states:
+        behaviour = subsystem.basic_behaviour(state.behaviour)
+        assert behaviour is not None
+        stop = tables.table(behaviour.terminal_condition.expression) & assumed
+        ending[state.name] = stop != 0
+        if not stop:
+            found["endless"].add(state.name)
+            continue
+        leaving = [t for t in fsm.transitions if t.source == state.name]
+        none_holds = stop
+        for position, first in enumerate(leaving):
+            if not condition[id(first)]:
+                found["dead"].add(first.name)
+            none_holds &= tables.all ^ condition[id(first)]
+            for second in leaving[position + 1 :]:
+                distinct = (first.priority is not None or second.priority is not None) and (
+                    first.priority != second.priority
+                )
+                if not distinct and condition[id(first)] & condition[id(second)]:
+                    found["overlap"].add(f"{first.name}|{second.name}")
+        if none_holds:
+            found["stuck"].add(state.name)
+    reachable, frontier = {fsm.initial}, [fsm.initial]
+    while frontier:
+        source = frontier.pop()
+        if ending.get(source):
+            for t in fsm.transitions:
+                if t.source == source and condition[id(t)] and t.destination not in reachable:
+                    reachable.add(t.destination)
+                    frontier.append(t.destination)
+    found["lost"] = {s.name for s in fsm.states} - reachable
+    return found
+
+
+_PATTERNS = {
+    "EARL-E060": ("overlap", re.compile(r"transitions `([^`]+)/t` and `([^`]+)/t`")),
+    "EARL-W062": ("dead", re.compile(r"transition `([^`]+)/t`")),
+    "EARL-W061": ("stuck", re.compile(r"no transition out of `([^`]+)`")),
+    "EARL-I063": ("endless", re.compile(r"so state `([^`]+)`")),
+    "EARL-W020": ("lost", re.compile(r"state `([^`]+)`")),
+}
+
+
+def bdd_findings(subsystem: Subsystem, fsm: FSM) -> dict[str, set[str]]:
+    found: dict[str, set[str]] = {kind: set() for kind, _ in _PATTERNS.values()}
+    for code, findings in analyse(subsystem, fsm, "a/a.cs").findings.items():
+        if code not in _PATTERNS:
+            continue
+        kind, pattern = _PATTERNS[code]
+        for finding in findings:
+            match = pattern.search(finding.message)
+            assert match is not None, finding.message
+            found[kind].add("|".join(match.groups()))
+    return found
+
+
+def bench_fsm(predicates: int, transitions: int, runs: int, peer: bool) -> dict[str, Any]:
+    system = earl.loads(fsm_spec(predicates, transitions), "fsm.earl")
+    subsystem = next(s for _, s in context_for(system).subsystems())
+    fsm = subsystem.fsm
+    assert fsm is not None and len(fsm.transitions) == transitions
+    assert len(subsystem.primitive_predicates) == predicates
+    bdd: list[Timing] = []
+    for _ in range(runs):
+        found, timing = timed(lambda: bdd_findings(subsystem, fsm))
+        bdd.append(timing)
+    row: dict[str, Any] = {
+        "predicates": predicates,
+        "transitions": transitions,
+        "states": len(fsm.states),
+        "runs": runs,
+        "bdd": asdict(median(bdd)),
+        "findings": {kind: len(names) for kind, names in found.items()},
+    }
+    if peer:
+        enumeration: list[Timing] = []
+        for _ in range(runs):
+            expected, timing = timed(lambda: enumerate_findings(subsystem, fsm))
+            enumeration.append(timing)
+        if expected != found:
+            raise SystemExit(f"the BDD analysis and the truth table disagree:\n{found}\n{expected}")
+        row["truth_table"] = asdict(median(enumeration))
+        row["agrees_with_truth_table"] = True
+    return row
+
+
+# ---------------------------------------------------------------------- report
+
+
+def report(sizes: list[dict[str, Any]], fsms: list[dict[str, Any]]) -> dict[str, Any]:
+    print()
+    print(f"{'agents':>8} {'subsystems':>10} | {'read (peer)':>13} {'expand':>13} {'rules':>13} {'total':>13}")
+    print(f"{'':>8} {'':>10} | {'wall / CPU s':>13} {'wall / CPU s':>13} {'wall / CPU s':>13} {'wall / CPU s':>13}")
+    for row in sizes:
+        cells = [f"{row[p]['wall']:5.2f} / {row[p]['cpu']:5.2f}" for p in ("read", "expand", "rules", "total")]
+        print(f"{row['agents']:>8} {row['subsystems']:>10} | " + " ".join(f"{c:>13}" for c in cells))
+    doubling = []
+    for smaller, larger in itertools.pairwise(sizes):
+        if larger["agents"] == 2 * smaller["agents"]:
+            doubling.append(
+                {
+                    "from_agents": smaller["agents"],
+                    "to_agents": larger["agents"],
+                    "wall_ratio": larger["total"]["wall"] / smaller["total"]["wall"],
+                    "cpu_ratio": larger["total"]["cpu"] / smaller["total"]["cpu"],
+                }
+            )
+    print()
+    for d in doubling:
+        print(
+            f"doubling {d['from_agents']} -> {d['to_agents']} agents: {d['wall_ratio']:.2f}x wall, {d['cpu_ratio']:.2f}x CPU"
+        )
+    print()
+    print(f"{'predicates':>10} {'transitions':>11} | {'BDD (earl) s':>13} {'truth table (peer) s':>21} | findings")
+    for row in fsms:
+        peer = f"{row['truth_table']['wall']:.3f}" if "truth_table" in row else "infeasible"
+        print(
+            f"{row['predicates']:>10} {row['transitions']:>11} | {row['bdd']['wall']:>13.3f} {peer:>21} | "
+            + ", ".join(f"{k} {v}" for k, v in row["findings"].items())
+        )
+    target = next((row for row in sizes if row["agents"] == TARGET_AGENTS), None)
+    fsm = next((row for row in fsms if (row["predicates"], row["transitions"]) == (20, 50)), None)
+    targets = {
+        "a_10000_agents_under_15_s": None
+        if target is None
+        else {
+            "wall": target["total"]["wall"] < TARGET_SECONDS,
+            "cpu": target["total"]["cpu"] < TARGET_SECONDS,
+        },
+        "b_doubling_under_2_2x": None
+        if not doubling
+        else {
+            "wall": all(d["wall_ratio"] < TARGET_DOUBLING for d in doubling),
+            "cpu": all(d["cpu_ratio"] < TARGET_DOUBLING for d in doubling),
+        },
+        "c_fsm_20_predicates_50_transitions_under_1_s": None
+        if fsm is None
+        else fsm["bdd"]["wall"] < TARGET_FSM_SECONDS,
+    }
+    print()
+    for name, held in targets.items():
+        print(f"{name}: {held}")
+    return {"doubling": doubling, "targets": targets}
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--runs", type=int, default=3, help="runs per size (the median is reported)")
+    parser.add_argument("--sizes", type=int, nargs="+", default=[2500, 5000, 10000], help="agents per spec")
+    parser.add_argument("--quick", action="store_true", help="small sizes and one run: a smoke test")
+    parser.add_argument("--output", type=Path, default=RESULTS, help="where to write the JSON results")
+    arguments = parser.parse_args(argv)
+    if arguments.quick:
+        arguments.sizes, arguments.runs = [250, 500], 1
+    load_before = os.getloadavg()
+    print(f"check: specs of {', '.join(map(str, arguments.sizes))} agents, {arguments.runs} runs each", flush=True)
+    check_once(generate(2))  # warm up: the first read builds the parser's tables
+    sizes = bench_sizes(arguments.sizes, arguments.runs)
+    fsm_runs = max(3, arguments.runs)
+    fsms = [bench_fsm(20, 50, fsm_runs, peer=True), bench_fsm(40, 100, fsm_runs, peer=False)]
+    summary = report(sizes, fsms)
+    results = {
+        "benchmark": "check",
+        "issue": 3,
+        "generator": "benchmarks/generate_families.py",
+        "subsystems_per_agent": SUBSYSTEMS_PER_AGENT,
+        "peer": "read alone (earl.loads: parse and resolve) for the spec; an exhaustive truth table for the FSM",
+        "machine": {
+            "python": platform.python_version(),
+            "platform": platform.platform(),
+            "cpus": os.cpu_count(),
+            "load_average_before": load_before,
+            "load_average_after": os.getloadavg(),
+        },
+        "sizes": sizes,
+        "fsm": fsms,
+        **summary,
+    }
+    arguments.output.parent.mkdir(parents=True, exist_ok=True)
+    arguments.output.write_text(json.dumps(results, indent=2) + "\n", encoding="utf-8")
+    print(f"\nwrote {arguments.output}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
