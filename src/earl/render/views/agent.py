@@ -27,7 +27,7 @@ from earl.render.names import (
     slug,
     subsystem_name,
 )
-from earl.render.views.common import Port, block, node_id
+from earl.render.views.common import Port, block, link_statements, node_id
 from earl.render.views.system import inter_agent_links
 
 
@@ -58,6 +58,16 @@ def agent_links(agent: Agent) -> list[SubsystemLink]:
         if output is not None and input_ is not None:
             result.append(SubsystemLink(link, source, output, destination, input_))
     return result
+
+
+#: Left to right, the way data flows from receptors through the Control Subsystem to effectors (§2.3).
+_ORDER = {
+    Kind.REAL_RECEPTOR: 0,
+    Kind.VIRTUAL_RECEPTOR: 1,
+    Kind.CONTROL_SUBSYSTEM: 2,
+    Kind.VIRTUAL_EFFECTOR: 3,
+    Kind.REAL_EFFECTOR: 4,
+}
 
 
 def link_label(link: Link) -> str:
@@ -106,16 +116,17 @@ def agent_view(agent: Agent, system: System | None = None) -> Diagram:
         tooltip = html(f"{name}.{subsystem_name(subsystem)}")
         graph.add(f'{node} [shape="plain", label={subsystem_block(subsystem)}, tooltip="{tooltip}"];')
 
-    for link in agent_links(agent):
+    for number, link in enumerate(agent_links(agent)):
         source_node = nodes[element_key(link.source, link.source.kind)][0]
         destination_node = nodes[element_key(link.destination, link.destination.kind)][0]
         label = link_label(link.link)
         names.append(label)
-        graph.add(
-            f"{source_node}:{port_name('ob', indexed_name(link.output))}:e -> "
-            f"{destination_node}:{port_name('ib', indexed_name(link.input))}:w "
-            f'[label=<{html(label)}<br/><i>{html(type_text(link.output.data_type))}</i>>, tooltip="{html(label)}"];'
-        )
+        source = f"{source_node}:{port_name('ob', indexed_name(link.output))}:e"
+        destination = f"{destination_node}:{port_name('ib', indexed_name(link.input))}:w"
+        backward = _ORDER[link.destination.kind] < _ORDER[link.source.kind]
+        data_type = type_text(link.output.data_type)
+        for statement in link_statements(number, source, destination, label, data_type, backward):
+            graph.add(statement)
 
     if system is not None:
         _external_links(agent, system, graph, names)
@@ -123,31 +134,39 @@ def agent_view(agent: Agent, system: System | None = None) -> Diagram:
 
 
 def _external_links(agent: Agent, system: System, graph: Graph, names: list[str]) -> None:
-    """The agents this one talks to, dashed and outside the frame, linked to its Control Subsystem's buffers."""
+    """The agents this one talks to, dashed and outside the frame, linked to its Control Subsystem's buffers.
+
+    An agent that sends to this one is drawn on the left, one that receives on the
+    right (an agent that does both appears twice), so every link runs left to right.
+    """
     cs = agent.control_subsystem
     if cs is None:
         return
     cs_node = node_id("ss", "cs")
-    others: set[str] = set()
-    for link in inter_agent_links(system):
-        label = f"<{html(link.link.name_text)}<br/><i>{html(link.data_type)}</i>>"
+    drawn: set[str] = set()
+    for number, link in enumerate(inter_agent_links(system)):
         if link.source is agent and link.destination is not agent:
             other = agent_name(link.destination)
-            node = node_id("ext", other)
-            statement = f"{cs_node}:{port_name('ob', link.source_buffer)}:e -> {node} [label={label}, style=dashed];"
+            node = node_id("ext_out", other)
+            source = f"{cs_node}:{port_name('ob', link.source_buffer)}:e"
+            destination = node
         elif link.destination is agent and link.source is not agent:
             other = agent_name(link.source)
-            node = node_id("ext", other)
-            statement = (
-                f"{node} -> {cs_node}:{port_name('ib', link.destination_buffer)}:w [label={label}, style=dashed];"
-            )
+            node = node_id("ext_in", other)
+            source = node
+            destination = f"{cs_node}:{port_name('ib', link.destination_buffer)}:w"
         else:
             continue
-        if other not in others:
-            others.add(other)
-            names.append(other)
+        if node not in drawn:
+            drawn.add(node)
+            if other not in names:
+                names.append(other)
             graph.outside.append(
                 f'{node} [shape="box", style="dashed,rounded", color="#777777", fontcolor="#555555", '
                 f"label=<<i>«Agent»</i><br/>{html(other)}>];"
             )
-        graph.outside.append(statement)
+        statements = link_statements(number + 10_000, source, destination, link.link.name_text, link.data_type, False)
+        graph.outside += [
+            statement.replace("];", ', style="dashed"];') if "->" in statement else statement
+            for statement in statements
+        ]

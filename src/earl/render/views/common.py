@@ -71,3 +71,21 @@ def node_id(*parts: str) -> str:
     """A DOT identifier: letters, digits and underscores only."""
     text = "_".join(parts)
     return "n_" + "".join(c if c.isalnum() else "_" for c in text)
+
+
+def link_statements(number: int, source: str, destination: str, name: str, data_type: str, backward: bool) -> list[str]:
+    """A link drawn through a small label node, so its name and data type sit on its own path.
+
+    A `backward` link runs against the layout's direction (a state going back to
+    the Control Subsystem) and loops around the blocks; its first half does not
+    constrain the layout, so its label lands just before the Input Buffer it feeds
+    instead of far beyond its source.
+    """
+    node = f"link_{number}"
+    label = f"<{html(name)}<br/><i>{html(data_type)}</i>>"
+    constraint = ', constraint="false"' if backward else ""
+    return [
+        f'{node} [shape="plain", fontsize="9", label={label}, tooltip="{html(name)}"];',
+        f'{source} -> {node} [arrowhead="none", tooltip="{html(name)}"{constraint}];',
+        f'{node} -> {destination} [tooltip="{html(name)}"];',
+    ]

@@ -17,7 +17,7 @@ from earl.model.types import type_text
 from earl.render.diagram import Diagram
 from earl.render.dot import FILL, Graph, html
 from earl.render.names import Key, agent_name, element_key, family_note, indexed_name, lookup
-from earl.render.views.common import Port, block, node_id
+from earl.render.views.common import Port, block, link_statements, node_id
 
 AgentTypeOf = Callable[[Agent], AgentType | None]
 
@@ -91,6 +91,7 @@ def system_view(system: System, agent_type: AgentTypeOf = lambda agent: None) ->
         label = block(title, ports_in[id(agent)], ports_out[id(agent)], middle, FILL["a"], notes)
         statements[id(agent)] = f'{nodes[id(agent)]} [shape="plain", label={label}, tooltip="{html(name)}"];'
 
+    positions = {id(agent): position for position, agent in enumerate(system.agents)}
     placed: set[int] = set()
     agents_by_key = {element_key(a, Kind.AGENT): a for a in system.agents}
     for number, robot in enumerate(system.robots):
@@ -111,13 +112,14 @@ def system_view(system: System, agent_type: AgentTypeOf = lambda agent: None) ->
         if id(agent) not in placed:
             graph.add(statements[id(agent)])
 
-    for link in links:
+    for number, link in enumerate(links):
         name = link.link.name_text
         names.append(name)
         source = f"{nodes[id(link.source)]}:{_port('ob', link.source_buffer)}:e"
         destination = f"{nodes[id(link.destination)]}:{_port('ib', link.destination_buffer)}:w"
-        label = f"<{html(name)}<br/><i>{html(link.data_type)}</i>>"
-        graph.add(f'{source} -> {destination} [label={label}, tooltip="{html(name)}"];')
+        backward = positions[id(link.destination)] < positions[id(link.source)]
+        for statement in link_statements(number, source, destination, name, link.data_type, backward):
+            graph.add(statement)
     return Diagram("system", graph.header, graph.source(), "system", tuple(names))
 
 
