@@ -84,6 +84,7 @@ def types_view(definitions: Sequence[TypeDefinition], owner: str, subject: str =
     graph.graph_attributes.update(nodesep="0.25", ranksep="0.8")
     shown = {definition.name for definition in definitions}
     names = []
+    connected: set[str] = set()
     for definition in definitions:
         names.append(definition.name)
         graph.add(f'{node_id("type", definition.name)} [shape="plain", label={_block(definition)}];')
@@ -96,10 +97,17 @@ def types_view(definitions: Sequence[TypeDefinition], owner: str, subject: str =
             parts += [("", target) for target in referenced_type_names(definition.data_type)]
         for label, target in parts:
             if target in shown:
+                connected |= {definition.name, target}
                 if label:
                     names.append(label)
                 graph.add(
                     f"{node_id('type', definition.name)} -> {node_id('type', target)} "
                     f'[dir="both", arrowtail="diamond", arrowhead="open", label="{html(label)}"];'
                 )
+    # Types that stand alone would stack in one tall column; invisible edges set them in rows of three.
+    alone = [node_id("type", d.name) for d in definitions if d.name not in connected]
+    for start in range(0, len(alone), 3):
+        row = alone[start : start + 3]
+        if len(row) > 1:
+            graph.add(" -> ".join(row) + ' [style="invis"];')
     return Diagram("types", graph.header, graph.source(), slug("types", owner), tuple(names))
