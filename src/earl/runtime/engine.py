@@ -136,18 +136,23 @@ class SubsystemEngine:
             stage_memory: dict[str, Any] = {}
             for function in stage:
                 outputs = function.outputs
-                outputs.clear()
-                function.inputs.refresh()
+                inputs = function.inputs
+                inputs.refresh()
                 try:
-                    function.function(function.inputs, outputs, context)
+                    function.function(inputs, outputs, context)
                 except Exception as error:
                     outputs.clear()  # a function that failed writes nothing
                     self._function_fault(time, function.name, error)
                     continue
-                if outputs.memory_written:
-                    stage_memory.update(outputs.memory_written)
-                if outputs.sent:
-                    sent.update(outputs.sent)
+                # the writes are taken and the call's dictionaries left empty for the next call
+                written = outputs.memory_written
+                if written:
+                    stage_memory.update(written)
+                    written.clear()
+                written = outputs.sent
+                if written:
+                    sent.update(written)
+                    written.clear()
             # the stage's writes become visible only now: no function saw another's (Eq. 7-8)
             if stage_memory:
                 memory.update(stage_memory)

@@ -68,6 +68,13 @@ class Recorders(Recorder):
 
     def __init__(self, recorders: list[Recorder]) -> None:
         self.recorders = recorders
+        # messages are the most frequent event: call only the recorders that look at them
+        self._message_recorders = [r for r in recorders if type(r).message_sent is not Recorder.message_sent]
+
+    def add(self, recorder: Recorder) -> None:
+        self.recorders.append(recorder)
+        if type(recorder).message_sent is not Recorder.message_sent:
+            self._message_recorders.append(recorder)
 
     def state_changed(self, time: int, subsystem: str, source: str | None, destination: str, transition: str) -> None:
         for recorder in self.recorders:
@@ -84,7 +91,7 @@ class Recorders(Recorder):
             recorder.behaviour_stopped(time, subsystem, state, behaviour, iterations, reason)
 
     def message_sent(self, time: int, link: str, value: Any) -> None:
-        for recorder in self.recorders:
+        for recorder in self._message_recorders:
             recorder.message_sent(time, link, value)
 
     def memory_snapshot(self, time: int, subsystem: str, memory: dict[str, Any]) -> None:
@@ -102,7 +109,6 @@ class StatisticsRecorder(Recorder):
     def __init__(self) -> None:
         self.subsystems: dict[str, SubsystemStatistics] = {}
         self.faults: list[Fault] = []
-        self.messages = 0
 
     def _of(self, subsystem: str) -> SubsystemStatistics:
         found = self.subsystems.get(subsystem)
@@ -122,9 +128,6 @@ class StatisticsRecorder(Recorder):
         self, time: int, subsystem: str, state: str, behaviour: str, iterations: int, reason: str
     ) -> None:
         self._of(subsystem).iterations += iterations
-
-    def message_sent(self, time: int, link: str, value: Any) -> None:
-        self.messages += 1
 
     def fault(self, fault: Fault) -> None:
         self._of(fault.subsystem).faults += 1

@@ -112,7 +112,7 @@ class Simulation:
                 record_links,
                 self.network.link_sources,
             )
-            own.append(self.trace)
+            self.recorder.add(self.trace)
             self.trace.run_started(
                 {"system": system.name, "seed": seed, "parameters": parameters, "realtime": realtime}
             )

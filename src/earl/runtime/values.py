@@ -46,7 +46,14 @@ class Record(dict[str, Any]):
     mutating method is refused, which is what lets one snapshot serve a whole stage.
     """
 
-    __slots__ = ()
+    #: the struct this value was checked against; a value of that struct is accepted again at once
+    __slots__ = ("_struct",)
+
+    @classmethod
+    def of(cls, struct: str, fields: dict[str, Any]) -> Record:
+        record = cls(fields)
+        object.__setattr__(record, "_struct", struct)
+        return record
 
     def __getattr__(self, name: str) -> Any:
         try:
@@ -68,7 +75,7 @@ class Record(dict[str, Any]):
             raise AttributeError(f"this struct has no field {', '.join(f'`{u}`' for u in sorted(unknown))}")
         merged = dict(self)
         merged.update(changes)
-        return Record(merged)
+        return Record(merged)  # unchecked: the runtime checks it when it is written
 
     def __repr__(self) -> str:
         return "Record(" + ", ".join(f"{k}={v!r}" for k, v in self.items()) + ")"
@@ -147,7 +154,7 @@ class TypeSystem:
                     continue
                 raise ValueTypeError(f"{where}: the field `{name}` of `{resolved.name}` is missing")
             result[name] = self.coerce(value[name], declared.data_type, f"{where}.{name}")
-        return Record(result)
+        return Record.of(resolved.name, result)
 
     def coercer(self, data_type: DataType, where: str) -> Callable[[Any], Value]:
         """`coerce` for one type, with a fast path for the values user code writes most (floats, ints, Booleans)."""
@@ -187,7 +194,36 @@ class TypeSystem:
                     return self.coerce(value, data_type, where)
 
                 return real_array
-        return lambda value: self.coerce(value, data_type, where)
+            return lambda value: self.coerce(value, data_type, where)
+        return self._struct_coercer(resolved, data_type, where)
+
+    def _struct_coercer(self, struct: StructType, data_type: DataType, where: str) -> Callable[[Any], Value]:
+        """A checked Record from a dict or Record; a Record already checked as this struct passes at once."""
+        name = struct.name
+        fields = [(f.name, f.optional, self.coercer(f.data_type, f"{where}.{f.name}")) for f in struct.fields]
+        count = len(fields)
+
+        def coerce_struct(value: Any) -> Value:
+            if type(value) is Record and getattr(value, "_struct", None) == name:
+                return value
+            if isinstance(value, Mapping) and len(value) <= count:
+                try:
+                    result = {}
+                    for field, optional, coerce_field in fields:
+                        item = value.get(field)
+                        if item is None:
+                            if not optional:
+                                raise ValueTypeError(field)
+                            result[field] = None
+                        else:
+                            result[field] = coerce_field(item)
+                    if len(value) == count or all(key in result for key in value):
+                        return Record.of(name, result)
+                except ValueTypeError:
+                    pass
+            return self.coerce(value, data_type, where)  # the precise message
+
+        return coerce_struct
 
     def constant(self, expression: Any, data_type: DataType, where: str) -> Value:
         """The value of an expanded constant expression (a memory's initial value)."""
