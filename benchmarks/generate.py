@@ -2,12 +2,13 @@
 
 Every agent is written out in full (no agent families), because the cost being
 measured is reading text: a family of a thousand agents would be one short block.
-Each agent has a control subsystem with a period, buffers, memory, primitive
-predicates, partial transition functions, two basic behaviours and an FSM; two
-virtual/real effector pairs; and one virtual/real receptor pair.  Its links run
-cs -> ve -> re -> ve -> cs and rr -> vr -> cs; the control subsystems of
-neighbouring agents are linked in two rings (commands forward, peer messages
-back); every ten agents form a robot.
+Each agent is complete and valid without being verbose: a control subsystem, two
+virtual/real effector pairs and one virtual/real receptor pair, each subsystem with
+its period, buffers, memory, primitive predicates, a two-stage transition function
+(Eq. 4-6: input buffers to memory, then memory to output buffers), basic behaviours
+and an FSM.  Its links run cs -> ve -> re -> ve -> cs and rr -> vr -> cs; the control
+subsystems of neighbouring agents form a ring (each delegates its goals to the
+next); every ten agents form a robot.  `earl check` finds no errors in it.
 
     .venv/bin/python benchmarks/generate.py 1000 -o /tmp/agents-1000.earl
 """
@@ -18,7 +19,7 @@ import argparse
 import sys
 from pathlib import Path
 
-#: Effector pairs per agent (`joint1/ve` + `motor1/re`, …), as the benchmark's issue asks.
+#: Effector pairs per agent (`joint1/ve` + `motor1/re`, ...), as the benchmark's issue asks.
 EFFECTORS = 2
 
 #: Agents per robot declaration.
@@ -29,49 +30,16 @@ _HEADER = """\
 // {effectors} effector pairs and one receptor pair.
 system benchmark{agents}
 
-param JOINTS: int = {effectors}
-param FIFO: int = 4
+param LIMIT: double = 3.14
 
-type Vector3 = double[3]
-
-struct AgentCommand {{
-    goal: Vector3
-    speed: double
+struct Goal {{
+    position: double[3]
     stop: boolean
-}}
-
-struct AgentStatus {{
-    position: Vector3
-    busy: boolean
-    fault: boolean
-}}
-
-struct PeerMessage {{
-    sender: int
-    position: Vector3
-    urgent: boolean
-}}
-
-struct MotorCommand {{
-    current: double
-    enable: boolean
-}}
-
-struct EncoderReading {{
-    position: double
-    fault: boolean
 }}
 
 struct Image {{
     width: int
-    height: int
     pixels: uint8[]
-}}
-
-struct Detection {{
-    found: boolean
-    position: Vector3
-    confidence: double
 }}
 """
 
@@ -81,64 +49,48 @@ def _agent_name(index: int) -> str:
 
 
 def _control_subsystem(index: int) -> str:
-    effector_inputs = "\n".join(f"        position{j}/ib: double" for j in range(1, EFFECTORS + 1))
-    effector_outputs = "\n".join(f"        setpoint{j}/ob: double" for j in range(1, EFFECTORS + 1))
-    position_reads = ", ".join(f"position{j}/ib" for j in range(1, EFFECTORS + 1))
-    setpoint_writes = ", ".join(f"setpoint{j}/ob" for j in range(1, EFFECTORS + 1))
+    joints = range(1, EFFECTORS + 1)
+    positions = "\n".join(f"        position{j}/ib: double" for j in joints)
+    setpoints = "\n".join(f"        setpoint{j}/ob: double" for j in joints)
+    reads = ", ".join(f"position{j}/ib" for j in joints)
+    writes = ", ".join(f"setpoint{j}/ob" for j in joints)
     module = f"robots.agent{index % 7}"
     return f"""\
     cs {{
         period {10 + index % 5} ms
 
-        command/ib: AgentCommand fifo FIFO overflow dropOldest
-        peerIn/ib: PeerMessage fifo 2 overflow dropNewest
-        detection/ib: Detection
-{effector_inputs}
-        status/ob: AgentStatus
-        delegate/ob: AgentCommand
-        peerOut/ob: PeerMessage
-{effector_outputs}
+        goal/ib: Goal
+        target/ib: double
+{positions}
+        delegate/ob: Goal
+{setpoints}
 
-        goal/m: Vector3
-        speed/m: double = 0.5
+        goal/m: double = 0.0
         busy/m: boolean = false
-        fault/m: boolean = false
-        gain[K in 1..JOINTS]/m: double = 1.0
 
-        stop/pp = command/ib.stop or fault/mi
-        newGoal/pp = newData(command/ib) and not command/ib.stop
-        reached/pp = not busy/mi
-        urgent/pp = peerIn/ib.urgent and detection/ib.confidence > 0.8
-        false/pp = false
+        newGoal/pp = newData(goal/ib) and not goal/ib.stop
+        busy/pp = busy/mi and target/ib > 0.0
 
-        plan/pf(command/ib, detection/ib, {position_reads} -> goal/mo, speed/mo, busy/mo) = python "{module}:plan"
-        track/pf(goal/mi, speed/mi, gain[*]/mi, {position_reads} -> busy/mo, fault/mo) = python "{module}:track"
-        drive/pf(goal/mi, gain[*]/mi -> {setpoint_writes}) = python "{module}:drive"
-        report/pf(goal/mi, busy/mi, fault/mi -> status/ob, peerOut/ob) = python "{module}:report"
-        pass/pf(command/ib -> delegate/ob) = python "{module}:delegate"
-        halt/pf(command/ib -> busy/mo) = python "{module}:halt"
-
-        stage compute = {{plan/pf, track/pf, halt/pf}}
-        stage output = {{drive/pf, report/pf, pass/pf}}
+        plan/pf(goal/ib, target/ib, {reads} -> goal/mo, busy/mo) = python "{module}:plan"
+        drive/pf(goal/mi, busy/mi -> {writes}, delegate/ob) = python "{module}:drive"
 
         move/bb {{
-            tf = {{plan/pf, track/pf}} then {{drive/pf, report/pf}}
-            tc = reached/pp or stop/pp or urgent/pp
-            ec = fault/mi and not stop/pp
+            tf = {{plan/pf}} then {{drive/pf}}
+            tc = not busy/pp
         }}
+
         idle/bb {{
-            tf = {{halt/pf}} then {{report/pf, pass/pf}}
+            tf = {{plan/pf}} then {{drive/pf}}
             tc = newGoal/pp
         }}
 
         fsm {{
             initial idle
-            state idle: idle/bb {{ optional peerIn/ib, detection/ib }}
-            state move: move/bb {{ obligatory {position_reads} optional command/ib timeout 5 ms }}
-            idle -> move when newGoal/pp and not stop/pp priority 1
-            move -> idle when reached/pp priority 2
-            * -> idle when stop/pp
-            assume not (newGoal/pp and stop/pp)
+            state idle: idle/bb
+            state move: move/bb {{ obligatory {reads}  timeout 20 ms }}
+
+            idle -> move when newGoal/pp
+            move -> idle when not busy/pp
         }}
     }}
 """
@@ -148,33 +100,51 @@ def _effector_pair(j: int) -> str:
     return f"""\
     joint{j}/ve {{
         period 1 ms
+
         setpoint/ib: double
-        encoder/ib: EncoderReading
+        encoder/ib: double
         position/ob: double
-        motor/ob: MotorCommand
-        target/m: double = 0.0
-        limit/pp = encoder/ib.fault or target/mi > 3.14
-        control/pf(setpoint/ib, encoder/ib, target/mi -> target/mo, motor/ob, position/ob) = python "robots.joint:control"
-        brake/pf(encoder/ib -> motor/ob, position/ob) = python "robots.joint:brake"
-        follow/bb {{ tf = {{control/pf}} tc = limit/pp }}
-        hold/bb {{ tf = {{brake/pf}} tc = not limit/pp }}
+        current/ob: double
+
+        current/m: double = 0.0
+
+        limit/pp = encoder/ib > LIMIT
+
+        regulate/pf(setpoint/ib, encoder/ib -> current/mo) = python "robots.joint:regulate"
+        output/pf(current/mi -> current/ob, position/ob) = python "robots.joint:output"
+
+        follow/bb {{
+            tf = {{regulate/pf}} then {{output/pf}}
+            tc = limit/pp
+        }}
+
         fsm {{
             initial follow
-            state follow: follow/bb {{ obligatory encoder/ib }}
-            state hold: hold/bb {{ obligatory encoder/ib timeout 2 ms }}
-            follow -> hold when limit/pp
-            hold -> follow when not limit/pp
+            state follow: follow/bb {{ obligatory encoder/ib  timeout 2 ms }}
+
+            follow -> follow when limit/pp
         }}
     }}
+
     motor{j}/re {{
         period 1 ms
-        command/ib: MotorCommand
-        reading/ob: EncoderReading
-        apply/pf(command/ib -> reading/ob) = python "robots.hardware:motor"
-        run/bb {{ tf = {{apply/pf}} tc = false }}
+
+        current/ib: double
+        encoder/ob: double
+
+        angle/m: double = 0.0
+
+        apply/pf(current/ib -> angle/mo) = python "robots.motor:apply"
+        read/pf(angle/mi -> encoder/ob) = python "robots.motor:read"
+
+        run/bb {{
+            tf = {{apply/pf}} then {{read/pf}}
+            tc = false
+        }}
+
         fsm {{
             initial run
-            state run: run/bb {{ obligatory command/ib }}
+            state run: run/bb
         }}
     }}
 """
@@ -184,26 +154,45 @@ def _receptor_pair() -> str:
     return """\
     camera/vr {
         period 33 ms
+
         image/ib: Image
-        detection/ob: Detection
-        lastWidth/m: int = 0
-        valid/pp = image/ib.width > 0 and image/ib.height > 0
-        detect/pf(image/ib, lastWidth/mi -> detection/ob, lastWidth/mo) = python "robots.vision:detect"
-        watch/bb { tf = {detect/pf} tc = not valid/pp }
-        wait/bb { tf = {} tc = valid/pp }
+        target/ob: double
+
+        target/m: double = 0.0
+
+        valid/pp = image/ib.width > 0
+
+        detect/pf(image/ib -> target/mo) = python "robots.vision:detect"
+        report/pf(target/mi -> target/ob) = python "robots.vision:report"
+
+        watch/bb {
+            tf = {detect/pf} then {report/pf}
+            tc = not valid/pp
+        }
+
         fsm {
-            initial wait
-            state wait: wait/bb { optional image/ib }
-            state watch: watch/bb { obligatory image/ib timeout 40 ms }
-            wait -> watch when valid/pp
-            watch -> wait when not valid/pp
+            initial watch
+            state watch: watch/bb { obligatory image/ib  timeout 40 ms }
+
+            watch -> watch when not valid/pp
         }
     }
+
     imager/rr {
         period 33 ms
+
         image/ob: Image
-        capture/pf( -> image/ob) = python "robots.hardware:capture"
-        stream/bb { tf = {capture/pf} tc = false }
+
+        frame/m: Image
+
+        capture/pf(-> frame/mo) = python "robots.imager:capture"
+        send/pf(frame/mi -> image/ob) = python "robots.imager:send"
+
+        stream/bb {
+            tf = {capture/pf} then {send/pf}
+            tc = false
+        }
+
         fsm {
             initial stream
             state stream: stream/bb
@@ -216,22 +205,25 @@ def _links(index: int) -> str:
     lines = []
     for j in range(1, EFFECTORS + 1):
         lines.append(f"    link cs,joint{j}: cs.setpoint{j} -> joint{j}/ve.setpoint")
-        lines.append(f"    link joint{j},motor{j}: joint{j}/ve.motor -> motor{j}/re.command")
-        lines.append(f"    link motor{j},joint{j}: motor{j}/re.reading -> joint{j}/ve.encoder")
+        lines.append(f"    link joint{j},motor{j}: joint{j}/ve.current -> motor{j}/re.current")
+        lines.append(f"    link motor{j},joint{j}: motor{j}/re.encoder -> joint{j}/ve.encoder")
         lines.append(f"    link joint{j},cs: joint{j}/ve.position -> cs.position{j}")
     lines.append("    link imager,camera: imager/rr.image -> camera/vr.image")
-    lines.append("    link camera,cs: camera/vr.detection -> cs.detection")
+    lines.append("    link camera,cs: camera/vr.target -> cs.target")
     return "\n".join(lines) + "\n"
 
 
 def agent_text(index: int) -> str:
     """One agent written out in full."""
-    parts = [f"// Agent {index}: one arm with {EFFECTORS} joints and a camera.\n"]
+    parts = [f"// Agent {index}: an arm with {EFFECTORS} joints and a camera.\n"]
     parts.append(f"{_agent_name(index)}/a {{\n")
     parts.append(_control_subsystem(index))
     for j in range(1, EFFECTORS + 1):
+        parts.append("\n")
         parts.append(_effector_pair(j))
+    parts.append("\n")
     parts.append(_receptor_pair())
+    parts.append("\n")
     parts.append(_links(index))
     parts.append("}\n\n")
     return "".join(parts)
@@ -243,11 +235,10 @@ def generate(agents: int) -> str:
         raise ValueError("the benchmark spec needs at least two agents for its ring of links")
     parts = [_HEADER.format(agents=agents, effectors=EFFECTORS), "\n"]
     parts.extend(agent_text(i) for i in range(1, agents + 1))
-    # Two rings between the control subsystems: commands pass forward, peer messages back.
+    # A ring between the control subsystems: each agent delegates goals to the next.
     for i in range(1, agents + 1):
         this, following = _agent_name(i), _agent_name(i % agents + 1)
-        parts.append(f"link {this},{following}: {this}/a.cs.delegate -> {following}/a.cs.command\n")
-        parts.append(f"link {following},{this}: {following}/a.cs.peerOut -> {this}/a.cs.peerIn\n")
+        parts.append(f"link {this},{following}: {this}/a.cs.delegate -> {following}/a.cs.goal\n")
     parts.append("\n")
     for first in range(1, agents + 1, AGENTS_PER_ROBOT):
         members = range(first, min(first + AGENTS_PER_ROBOT, agents + 1))

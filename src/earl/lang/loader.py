@@ -6,7 +6,7 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from earl.diagnostics import Diagnostic, EarlError, Severity, SourceMap
-from earl.lang.parser import decode, parse_text
+from earl.lang.parser import collection_paused, decode, parse_text
 from earl.lang.transformer import ParsedFile
 from earl.model.elements import Agent, Import, Link, Parameter, Robot, System
 from earl.model.location import SourceLocation
@@ -163,10 +163,11 @@ def load(path: str | Path, parameters: Mapping[str, ParameterValue] | None = Non
 
     sources = SourceMap()
     spec = locate_spec(Path(path))
-    root, imported = load_files(spec, sources)
-    system = merge(root, imported, sources)
-    system.source_file = root.path
-    diagnostics = resolve(system, parameters or {})
+    with collection_paused():
+        root, imported = load_files(spec, sources)
+        system = merge(root, imported, sources)
+        system.source_file = root.path
+        diagnostics = resolve(system, parameters or {})
     errors = [d for d in diagnostics if d.severity is Severity.ERROR]
     if errors:
         raise EarlError(errors, sources)

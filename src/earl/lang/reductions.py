@@ -20,6 +20,7 @@ from operator import itemgetter
 from typing import Any
 
 from lark import Token
+from lark.grammar import Rule
 
 #: (line, column, end line, end column) of the text a rule covered; None for an empty rule.
 Span = tuple[int, int, int, int]
@@ -67,6 +68,15 @@ class SpanTable:
         return None  # pragma: no cover - a start was found, so an end is too
 
 
+class _IdentityRule(Rule):
+    """A rule of this parser's own table, equal only to itself."""
+
+    __slots__ = ()
+    __hash__ = object.__hash__
+    __eq__ = object.__eq__
+    __ne__ = object.__ne__
+
+
 def install(parser: Any, builder: Any, table: SpanTable) -> None:
     """Replace Lark's tree-building callback of every rule by one that calls `builder`.
 
@@ -79,8 +89,12 @@ def install(parser: Any, builder: Any, table: SpanTable) -> None:
     callbacks: dict[Any, Callable[[list[Any]], Any]] = {k: v for k, v in old.items() if isinstance(k, str)}
     for actions in parser.parse_table.states.values():
         for _action, argument in actions.values():
-            if hasattr(argument, "expansion"):
-                callbacks.setdefault(argument, old[argument])
+            if isinstance(argument, Rule) and not isinstance(argument, _IdentityRule):
+                original = old[argument]
+                # The parser looks its rule up at every reduction; Lark's Rule hashes and
+                # compares in Python, an identity rule in C.  The layout is the same.
+                argument.__class__ = _IdentityRule
+                callbacks.setdefault(argument, original)
     missing: list[str] = []
     for rule in list(callbacks):
         if isinstance(rule, str):
