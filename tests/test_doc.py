@@ -298,3 +298,83 @@ def test_document_opens_in_headless_chromium_without_errors(site: Path, tmp_path
     assert table_6_bullets == 16 * 7
     assert screenshot.read_bytes()[:4] == b"\x89PNG"
     print(f"screenshot: {screenshot}")
+
+
+AGENT_FAMILY = """\
+system swarm
+
+param M: int = 3
+
+struct Order {
+    x: double
+}
+
+swarmRobot/r {
+    coord/a
+    worker[1]/a
+    worker[2]/a
+    worker[3]/a
+}
+
+coord/a {
+    cs {
+        period 10 ms
+        order[K in 1..M]/ob: Order
+        report[K in 1..M]/ib: Order
+        o/m: Order
+        got/pp = newData(report[1]/ib)
+        send/pf(report[*]/ib -> o/mo)
+        emit/pf(o/mi -> order[*]/ob)
+        run/bb {
+            tf = {send/pf} then {emit/pf}
+            tc = got/pp
+        }
+        fsm {
+            initial run
+            state run: run/bb
+            run -> run when got/pp
+        }
+    }
+}
+
+worker[K in 1..M]/a {
+    cs {
+        period 10 ms
+        order/ib: Order
+        report/ob: Order
+        o/m: Order
+        got/pp = newData(order/ib)
+        take/pf(order/ib -> o/mo)
+        back/pf(o/mi -> report/ob)
+        run/bb {
+            tf = {take/pf} then {back/pf}
+            tc = got/pp
+        }
+        fsm {
+            initial run
+            state run: run/bb
+            run -> run when got/pp
+        }
+    }
+}
+
+link coord,worker[K in 1..M]: coord/a.cs.order[K] -> worker[K]/a.cs.order
+link worker[K in 1..M],coord: worker[K]/a.cs.report -> coord/a.cs.report[K]
+"""
+
+
+@pytest.mark.parametrize("expand", [False, True], ids=["declared", "expanded"])
+def test_a_family_of_agents_is_documented_with_every_link_resolving(tmp_path: Path, expand: bool) -> None:
+    system = earl.loads(AGENT_FAMILY, "swarm.earl")
+    diagnostics = check(system)
+    assert [d for d in diagnostics if d.severity.value == "error"] == []
+    html = write_site(Subject(system, expand), diagnostics, tmp_path).html.read_text(encoding="utf-8")
+    page = _Page()
+    page.feed(html)  # also refuses duplicate ids
+    assert sorted(set(page.links) - page.ids) == []
+    if expand:
+        assert all(f"worker[{k}]/a" in html for k in (1, 2, 3)) and "worker[K]/a" not in html
+    else:
+        assert "worker[K]/a" in html and "worker[1]/a" not in html
+    # Table 1 counts every member of the family: the coordinator talks to three workers, in both directions
+    assert "<strong>CT</strong>" in html

@@ -11,7 +11,7 @@ from earl.model.elements import FSM, Subsystem
 from earl.model.kinds import Kind
 from earl.model.text import expression_text
 from earl.render.build import Subject
-from earl.render.names import agent_name, element_key, lookup, qualified_subsystem_name
+from earl.render.names import agent_name, element_key, link_label, lookup, qualified_subsystem_name
 from earl.render.targets import TargetError, find_subsystem
 from earl.render.views.system import inter_agent_links
 
@@ -54,7 +54,7 @@ def system_mermaid(subject: Subject) -> str:
         if id(agent) not in placed:
             lines.append(agent_line("    ", positions[id(agent)]))
     for link in inter_agent_links(system):
-        label = f"{link.link.name_text}: {link.source_buffer}/ob → {link.destination_buffer}/ib : {link.data_type}"
+        label = f"{link_label(link.link)}: {link.source_buffer}/ob → {link.destination_buffer}/ib : {link.data_type}"
         source = _identifier("a", agent_name(link.source))
         destination = _identifier("a", agent_name(link.destination))
         lines.append(f'    {source} -->|"{text(label)}"| {destination}')

@@ -11,7 +11,7 @@ from __future__ import annotations
 import re
 from typing import Protocol, TypeVar
 
-from earl.model.elements import Agent, Family, Subsystem
+from earl.model.elements import Agent, Family, Link, Subsystem
 from earl.model.expressions import ElementReference, Literal
 from earl.model.kinds import Kind
 from earl.model.text import expression_text
@@ -65,6 +65,13 @@ def qualified_subsystem_name(agent: Agent, subsystem: Subsystem) -> str:
 
 def element_name(element: Indexed, kind: Kind) -> str:
     return f"{indexed_name(element)}/{kind.value}"
+
+
+def link_label(link: Link) -> str:
+    """`cs,motorController[K]`: the link's name with its index, without the family's range."""
+    return ",".join(
+        part.name if part.index is None else f"{part.name}[{expression_text(part.index)}]" for part in link.name
+    )
 
 
 # ---------------------------------------------------------------------- finding elements by reference

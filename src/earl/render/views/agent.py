@@ -12,7 +12,6 @@ from dataclasses import dataclass
 
 from earl.model.elements import Agent, InputBuffer, Link, OutputBuffer, Subsystem, System
 from earl.model.kinds import KIND_TITLES, Kind
-from earl.model.text import expression_text
 from earl.model.types import type_text
 from earl.render.diagram import Diagram
 from earl.render.dot import FILL, Graph, html
@@ -23,6 +22,7 @@ from earl.render.names import (
     element_name,
     family_note,
     indexed_name,
+    link_label,
     lookup,
     slug,
     subsystem_name,
@@ -68,13 +68,6 @@ _ORDER = {
     Kind.VIRTUAL_EFFECTOR: 3,
     Kind.REAL_EFFECTOR: 4,
 }
-
-
-def link_label(link: Link) -> str:
-    """`cs,motorController[K]`: the link's name with its index, without the family's range."""
-    return ",".join(
-        part.name if part.index is None else f"{part.name}[{expression_text(part.index)}]" for part in link.name
-    )
 
 
 def port_name(direction: str, element_key_text: str) -> str:
@@ -165,7 +158,7 @@ def _external_links(agent: Agent, system: System, graph: Graph, names: list[str]
                 f'{node} [shape="box", style="dashed,rounded", color="#777777", fontcolor="#555555", '
                 f"label=<<i>«Agent»</i><br/>{html(other)}>];"
             )
-        statements = link_statements(number + 10_000, source, destination, link.link.name_text, link.data_type, False)
+        statements = link_statements(number + 10_000, source, destination, link_label(link.link), link.data_type, False)
         graph.outside += [
             statement.replace("];", ', style="dashed"];') if "->" in statement else statement
             for statement in statements

@@ -16,7 +16,7 @@ from earl.model.tables import AgentType
 from earl.model.types import type_text
 from earl.render.diagram import Diagram
 from earl.render.dot import FILL, Graph, html
-from earl.render.names import Key, agent_name, element_key, family_note, indexed_name, lookup
+from earl.render.names import Key, agent_name, element_key, family_note, indexed_name, link_label, lookup
 from earl.render.views.common import Port, block, link_statements, node_id
 
 AgentTypeOf = Callable[[Agent], AgentType | None]
@@ -113,7 +113,7 @@ def system_view(system: System, agent_type: AgentTypeOf = lambda agent: None) ->
             graph.add(statements[id(agent)])
 
     for number, link in enumerate(links):
-        name = link.link.name_text
+        name = link_label(link.link)
         names.append(name)
         source = f"{nodes[id(link.source)]}:{_port('ob', link.source_buffer)}:e"
         destination = f"{nodes[id(link.destination)]}:{_port('ib', link.destination_buffer)}:w"
