@@ -86,6 +86,7 @@ _BLOCK_FORMS: list[tuple[str, str]] = [
 
 _CLOSING = {"LBRACE": "}", "LPAR": ")", "LSQB": "]"}
 _OPENING = {"RBRACE": "LBRACE", "RPAR": "LPAR", "RSQB": "LSQB"}
+_CLOSING_TO_OPENING = {"RBRACE": "{", "RPAR": "(", "RSQB": "["}
 
 #: Keywords that only the top level of a file holds: meeting one inside a block hints at a missing `}`.
 _TOP_LEVEL_ONLY = {"system", "import", "struct", "type"}
@@ -256,7 +257,7 @@ def _unexpected_token(
             path, token.line, column, token.end_line or token.line, token.end_column or column + 1
         )
 
-    for special in (_misplaced_keyword, _missing_arrow, _end_of_file, _bad_kind, _duration):
+    for special in (_stray_closing, _misplaced_keyword, _missing_arrow, _end_of_file, _bad_kind, _duration, _line_ends_early):
         diagnostic = special(token, context, location, path)
         if diagnostic is not None:
             return diagnostic
@@ -267,6 +268,70 @@ def _token_location(path: str, token: Token) -> SourceLocation:
     line = token.line or 1
     column = token.column or 1
     return SourceLocation(path, line, column, token.end_line or line, token.end_column or column + 1)
+
+
+def _stray_closing(token: Token, context: _Context, location: SourceLocation, path: str) -> Diagnostic | None:
+    """A `}` (or `)`, `]`) when no bracket is open: one too many, or one `{` missing above."""
+    if token.type not in _OPENING or context.open_brackets():
+        return None
+    return Diagnostic(
+        Severity.ERROR,
+        f"this `{token}` closes nothing: every bracket before it is already closed",
+        _token_location(path, token),
+        code="EARL-S006",
+        hint=f"remove it, or add the `{_CLOSING_TO_OPENING[token.type]}` it was meant to close",
+    )
+
+
+#: After these tokens something must follow; a statement that stops after one at the end of a
+#: line swallows the next line as its continuation, and the parser only stops later.
+_NEEDS_CONTINUATION = {
+    "COLON": "a data type",
+    "EQUAL": "a value",
+    "OR": "an expression",
+    "AND": "an expression",
+    "NOT": "an expression",
+    "PLUS": "an expression",
+    "MINUS": "an expression",
+    "STAR": "an expression",
+    "COMPARISON_OPERATOR": "an expression",
+    "COMMA": "another element",
+    "WHEN": "a condition",
+}
+
+
+def _line_ends_early(token: Token, context: _Context, location: SourceLocation, path: str) -> Diagnostic | None:
+    """`x/pp = a or` with nothing after `or`: the next line was read as the rest of it."""
+    if token.type == "$END" or not token.line:
+        return None
+    tokens = [v for v in context.values if isinstance(v, Token) and v.line]
+    earlier = [t for t in tokens if t.line < token.line]
+    if not earlier:
+        return None
+    dangling = earlier[-1]
+    wanted = _NEEDS_CONTINUATION.get(dangling.type)
+    if wanted is None or dangling is context.previous:
+        return None
+    # Everything read after the dangling token must sit on later lines: it is the next statement.
+    after = context.values[context.values.index(dangling) + 1 :]
+    starts = [_start_line(v) for v in after]
+    if not starts or any(line is None or line <= dangling.line for line in starts):
+        return None
+    return Diagnostic(
+        Severity.ERROR,
+        f"expected {wanted} after `{dangling}` at the end of line {dangling.line}",
+        _token_location(path, dangling),
+        code="EARL-S006",
+        hint=f"line {dangling.line} stops after `{dangling}`, so line {starts[0]} was read as its continuation",
+    )
+
+
+def _start_line(value: Any) -> int | None:
+    if isinstance(value, Token):
+        return value.line
+    if isinstance(value, Tree) and not value.meta.empty:
+        return int(value.meta.line)
+    return None
 
 
 def _misplaced_keyword(token: Token, context: _Context, location: SourceLocation, path: str) -> Diagnostic | None:
@@ -323,6 +388,14 @@ def _missing_arrow(token: Token, context: _Context, location: SourceLocation, pa
             hint="a link runs from an Output Buffer to an Input Buffer: `link a,b: a/a.cs.out -> b/a.cs.in`",
         )
     if any(isinstance(v, Token) and v.type == "PF" for v in context.values):
+        if "COMMA" in context.expected and token.type == "NAME":
+            return Diagnostic(
+                Severity.ERROR,
+                f"expected `,` or `->` before `{token}`",
+                location,
+                code="EARL-S003",
+                hint="separate what `/pf` reads with `,` and end the list with `->`: `move/pf(a/ib, b/mi -> c/mo)`",
+            )
         return Diagnostic(
             Severity.ERROR,
             f"expected `->` between what `/pf` reads and what it writes, found {_found(token)}",
@@ -360,7 +433,7 @@ def _end_of_file(token: Token, context: _Context, location: SourceLocation, path
     previous = context.previous
     after = f" after `{previous}`" if previous is not None and str(previous).strip() else ""
     described = context.describe(context.expected)
-    hint = next((HINTS[t] for t in context.expected if t in HINTS), None)
+    hint = next((HINTS[t] for t in context.expected if t in HINTS), None) or _after_keyword_hint(context)
     return Diagnostic(
         Severity.ERROR,
         f"the file ends{after} but {_join(described[:6], 'or')} was expected",
@@ -447,6 +520,10 @@ def _expected_message(token: Token, context: _Context, location: SourceLocation)
         hint = _unclosed_hint(context.open_brackets())
     if hint is None and any(t in _OPENING for t in expected) and token.type in _OPENING:
         hint = _unclosed_hint(context.open_brackets())
+    if hint is None and any(t in _OPENING for t in expected) and context.open_brackets():
+        innermost = context.open_brackets()[-1]
+        if _OPENING.get(next(t for t in expected if t in _OPENING)) == innermost.type:
+            hint = _unclosed_hint([innermost])
     if hint is None and previous is not None and previous.type == "CS" and token.type == "SLASH":
         hint = "the Control Subsystem is written `cs { … }`, without a kind"
     top = context.value(1)
@@ -497,6 +574,11 @@ _KEYWORD_FORMS: dict[str, str] = {
     "TYPE": "a type alias is written `type Name = double[6]`",
     "LINK": "a link is written `link NAME: FROM -> TO`, e.g. `link task,manip: task/a.cs.cmd -> manip/a.cs.cmd`",
     "PRIORITY": "a priority is a whole number, e.g. `priority 1`",
+    "ANY": "a quantifier is written `any(K in 1..N: CONDITION)`",
+    "ALL": "a quantifier is written `all(K in 1..N: CONDITION)`",
+    "TF": "a transition function is written `tf = {first/pf, …} then {second/pf, …}`",
+    "TIMEOUT": "a timeout is a duration, e.g. `timeout 5 ms`",
+    "PERIOD": "a period is a duration, e.g. `period 2 ms`",
 }
 
 
