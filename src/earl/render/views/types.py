@@ -61,12 +61,12 @@ def _block(definition: TypeDefinition) -> str:
     if isinstance(definition, StructType):
         stereotype = "dataType"
         rows = [
-            f'<tr><td align="left">{html(f.name)}: {html(type_text(f.data_type))}{" [0..1]" if f.optional else ""}</td></tr>'
+            f'<tr><td align="left">{html(f.name)}: {html(type_text(f.data_type))}{" [0..1]" if f.optional else ""}&#160;&#160;</td></tr>'
             for f in definition.fields
         ]
     else:
         stereotype = "valueType"
-        rows = [f'<tr><td align="left">= {html(type_text(definition.data_type))}</td></tr>']
+        rows = [f'<tr><td align="left">= {html(type_text(definition.data_type))}&#160;&#160;</td></tr>']
     head = f"<tr><td><i>«{stereotype}»</i><br/><b>{html(definition.name)}</b></td></tr>"
     separator = "<hr/>" if rows else ""
     return (
