@@ -378,3 +378,12 @@ def test_a_family_of_agents_is_documented_with_every_link_resolving(tmp_path: Pa
         assert "worker[K]/a" in html and "worker[1]/a" not in html
     # Table 1 counts every member of the family: the coordinator talks to three workers, in both directions
     assert "<strong>CT</strong>" in html
+
+
+def test_a_second_run_leaves_no_stale_diagram(tmp_path: Path) -> None:
+    system = earl.loads(AGENT_FAMILY, "swarm.earl")
+    write_site(Subject(system), [], tmp_path)
+    renamed = earl.loads(AGENT_FAMILY.replace("worker", "helper"), "swarm.earl")
+    result = write_site(Subject(renamed), [], tmp_path)
+    assert sorted((tmp_path / "diagrams").glob("*.svg")) == sorted(result.diagrams)
+    assert not any("worker" in path.name for path in result.diagrams)

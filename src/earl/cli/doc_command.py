@@ -16,7 +16,7 @@ from earl.render.document import write_site
 from earl.render.graphviz import GraphvizError, dot_program
 
 EPILOG = """\
-writes:
+writes (SVG files in SITE/diagrams/ left by an earlier run and not drawn again are removed):
   SITE/index.html       one static page: inline CSS, no script, works offline
   SITE/index.md         the same document in Markdown
   SITE/diagrams/*.svg   every diagram, referenced by both

@@ -24,7 +24,7 @@ class DocumentResult:
 
 
 def write_site(subject: Subject, diagnostics: Sequence[Diagnostic], directory: Path) -> DocumentResult:
-    """Build the document and write it to `directory` (created if needed; earl's own files are replaced)."""
+    """Build the document and write it to `directory` (created if needed; earl's files there are replaced)."""
     builder = DocumentBuilder(subject, diagnostics)
     document = builder.build()
     folder = directory / "diagrams"
@@ -38,6 +38,9 @@ def write_site(subject: Subject, diagnostics: Sequence[Diagnostic], directory: P
         path = folder / f"{diagram.slug}.svg"
         path.write_bytes(svg)
         paths.append(path)
+    # diagrams/ is earl's: an element renamed since the last run must not leave its old picture behind
+    for stale in set(folder.glob("*.svg")) - set(paths):
+        stale.unlink()
     html = directory / "index.html"
     markdown = directory / "index.md"
     html.write_text(render_html(document), encoding="utf-8")
