@@ -31,7 +31,7 @@ from pick_and_place import scene
 from pick_and_place.task import park_configuration
 
 OUTPUT_VARIABLE = "EARL_SIM_OUTPUT"
-VIDEO_FPS = 20.0
+VIDEO_FPS = 12.5
 VIDEO_SIZE = (480, 360)
 PICTURE_SIZE = (960, 720)
 #: when the staged emergency stops happen, seconds of simulated time
@@ -121,7 +121,7 @@ class PickAndPlaceEnvironment:
         from earl.sim.render import PlantCamera, RenderUnavailable, VideoRecorder
 
         try:
-            self._camera = PlantCamera(self.plant, *VIDEO_SIZE, camera="overview")
+            self._camera = PlantCamera(self.plant, *VIDEO_SIZE, camera="overview", shadows=False)
             self._video = VideoRecorder(self._camera, self.plant, VIDEO_FPS)
         except RenderUnavailable as error:
             self.render_messages.append(f"no pictures: {error}")

@@ -32,6 +32,8 @@ JOINT_SPEED = 0.8
 #: peak speed of the grasp point in an operational-space move, m/s
 CARTESIAN_SPEED = 0.3
 ANGULAR_SPEED = 1.0
+#: damped-least-squares steps per iteration: the reference moves little in 2 ms, so one step keeps up
+IK_STEPS = 1
 #: a move is finished when every joint is this close to its goal (rad) ...
 JOINT_TOLERANCE = 0.004
 #: ... or this long after its trajectory ended, whatever the error (s)
@@ -164,7 +166,7 @@ def operational_move(inputs: Any, outputs: Any, context: Any) -> None:
     elapsed = context.time - controller.move_start
     position, orientation = trajectory.sample(elapsed)
     previous = controller.reference
-    reference = model.inverse_kinematics(Pose(position, orientation), previous, iterations=2)
+    reference = model.inverse_kinematics(Pose(position, orientation), previous, iterations=IK_STEPS)
     controller.reference = reference
     controller.reference_velocity = (reference - previous) / context.period
     # the goal, for `finished`, is where the reference ends up once the line is done

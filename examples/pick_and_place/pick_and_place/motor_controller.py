@@ -9,6 +9,7 @@ stop reported upwards, for good.
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import Any
 
@@ -18,8 +19,13 @@ from earl.sim import arm
 def _limit(context: Any) -> float:
     parameters = context.parameters
     if "joint" in parameters:
-        return arm.drive(int(parameters["N"]), int(parameters["joint"])).current_limit
+        return _joint_limit(int(parameters["N"]), int(parameters["joint"]))
     return arm.FINGER_DRIVE.current_limit
+
+
+@functools.cache
+def _joint_limit(n: int, joint: int) -> float:
+    return arm.drive(n, joint).current_limit
 
 
 def _forward(command: Any, reading: Any, outputs: Any, context: Any) -> None:

@@ -396,6 +396,37 @@ def robot_mjcf(n: int, timestep: float = 0.0005) -> str:
     )
 
 
+_LOOKS = (
+    '  <visual><headlight ambient="0.3 0.3 0.3" diffuse="0.35 0.35 0.35"/></visual>\n'
+    "  <asset>\n"
+    '    <texture name="sky" type="skybox" builtin="gradient" rgb1="0.62 0.72 0.85" rgb2="0.18 0.2 0.26"'
+    ' width="128" height="128"/>\n'
+    '    <texture name="floor" type="2d" builtin="checker" rgb1="0.5 0.53 0.56" rgb2="0.42 0.45 0.48"'
+    ' width="128" height="128"/>\n'
+    '    <material name="floor" texture="floor" texrepeat="6 6"/>\n'
+    "  </asset>\n"
+)
+#: The overview camera: in front, between the box and the place target, looking at the work area.
+_CAMERA = (1.25, 0.95, 0.85)
+_CAMERA_TARGET = (0.22, 0.12, 0.05)
+
+
+def _look_at(eye: tuple[float, float, float], target: tuple[float, float, float]) -> tuple[float, ...]:
+    """MJCF `xyaxes` of a camera at `eye` looking at `target` with the world's z up."""
+    forward = [t - e for t, e in zip(target, eye, strict=True)]
+    norm = math.sqrt(sum(f * f for f in forward))
+    forward = [f / norm for f in forward]
+    right = [forward[1], -forward[0], 0.0]  # forward × z
+    norm = math.hypot(right[0], right[1])
+    right = [r / norm for r in right]
+    up = [
+        right[1] * forward[2] - right[2] * forward[1],
+        right[2] * forward[0] - right[0] * forward[2],
+        right[0] * forward[1] - right[1] * forward[0],
+    ]
+    return (*right, *up)
+
+
 #: The box to pick: a 4 cm cube of 100 g.
 BOX_HALF_SIZE = 0.02
 BOX_MASS = 0.1
@@ -417,8 +448,8 @@ def workcell_mjcf(
     scene = [
         '    <light pos="0.3 -0.6 1.8" dir="-0.2 0.4 -1" diffuse="0.8 0.8 0.8"/>',
         '    <light pos="-0.5 0.5 2.0" dir="0.3 -0.2 -1" diffuse="0.4 0.4 0.4"/>',
-        '    <camera name="overview" pos="1.35 -0.95 0.95" xyaxes="0.6 0.8 0 -0.35 0.26 0.9"/>',
-        '    <geom name="floor" type="plane" pos="0 0 -0.75" size="2 2 0.1" rgba="0.55 0.6 0.65 1" contype="0" conaffinity="0"/>',
+        f'    <camera name="overview" pos="{_vec(*_CAMERA)}" xyaxes="{_vec(*_look_at(_CAMERA, _CAMERA_TARGET))}"/>',
+        '    <geom name="floor" type="plane" pos="0 0 -0.75" size="3 3 0.1" material="floor" contype="0" conaffinity="0"/>',
         '    <geom name="table" type="box" pos="0.25 0.15 -0.02" size="0.55 0.55 0.02" rgba="0.75 0.65 0.5 1"'
         ' friction="0.8 0.02 0.001" solref="0.004 1"/>',
         f'    <site name="{TARGET_SITE}" type="cylinder" pos="{_vec(tx, ty, 0.0005)}" size="0.03 0.0005"'
@@ -436,6 +467,7 @@ def workcell_mjcf(
     return "".join(
         [
             head,
+            _LOOKS,
             "  <worldbody>\n",
             body,
             "\n".join(scene),

@@ -70,6 +70,11 @@ class MujocoPlant:
         self.model = model
         self.data = mujoco.MjData(model)
         self._actuators = {model.actuator(i).name: i for i in range(model.nu)}
+        # per actuator (low, high) as Python floats: set_input runs every millisecond for every drive
+        self._ranges = [
+            (float(low), float(high)) if model.actuator_ctrllimited[i] else (-math.inf, math.inf)
+            for i, (low, high) in enumerate(model.actuator_ctrlrange)
+        ]
         self.seed = seed
         #: for whatever the environment randomises; the physics itself is deterministic
         self.random = np.random.default_rng(seed)
@@ -149,11 +154,10 @@ class MujocoPlant:
         """
         index = self._actuator(actuator)
         applied = float(value)
-        if not math.isfinite(applied) or self.driver_fault(actuator):
+        if not math.isfinite(applied) or (self._faults and self.driver_fault(actuator)):
             applied = 0.0
-        if self.model.actuator_ctrllimited[index]:
-            low, high = self.model.actuator_ctrlrange[index]
-            applied = min(max(applied, float(low)), float(high))
+        low, high = self._ranges[index]
+        applied = min(max(applied, low), high)
         self.data.ctrl[index] = applied
         return applied
 

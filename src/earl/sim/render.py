@@ -32,7 +32,14 @@ class RenderUnavailable(RuntimeError):
 
 
 def _advice() -> str:
+    import earl.sim
+
     backend = os.environ.get("MUJOCO_GL", "(unset)")
+    if earl.sim.MUJOCO_IMPORTED_FIRST and backend == "(unset)":
+        return (
+            "MuJoCo cannot render offscreen here: it was imported before earl.sim and chose a windowed "
+            "backend; set MUJOCO_GL=egl (or osmesa) in the environment, or import earl.sim first"
+        )
     return (
         f"MuJoCo cannot render offscreen here (MUJOCO_GL={backend}); install the EGL or OSMesa "
         "libraries (Debian: libegl1 libgl1, or libosmesa6) and set MUJOCO_GL=egl or MUJOCO_GL=osmesa"
@@ -42,7 +49,9 @@ def _advice() -> str:
 class PlantCamera:
     """Renders one plant from one of its cameras (or a free view) at a fixed size."""
 
-    def __init__(self, plant: MujocoPlant, width: int = 640, height: int = 480, camera: str | None = None) -> None:
+    def __init__(
+        self, plant: MujocoPlant, width: int = 640, height: int = 480, camera: str | None = None, shadows: bool = True
+    ) -> None:
         model = plant.model
         # MuJoCo's offscreen buffer must hold the image; grow it rather than fail.
         model.vis.global_.offwidth = max(int(model.vis.global_.offwidth), width)
@@ -51,6 +60,8 @@ class PlantCamera:
             self._renderer = mujoco.Renderer(model, height, width)
         except Exception as error:  # the GL backends raise many kinds: all mean "no context"
             raise RenderUnavailable(f"{_advice()} ({type(error).__name__}: {error})") from None
+        # Software OpenGL (llvmpipe) spends most of a frame on shadows: a video can do without.
+        self._renderer.scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = shadows
         self._plant = plant
         self._camera = camera if camera is not None else -1
         if camera is not None and mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, camera) < 0:
