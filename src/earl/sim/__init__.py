@@ -21,6 +21,6 @@ MUJOCO_IMPORTED_FIRST = "mujoco" in sys.modules
 if "MUJOCO_GL" not in os.environ and not os.environ.get("DISPLAY") and not MUJOCO_IMPORTED_FIRST:
     os.environ["MUJOCO_GL"] = "egl"
 
-from earl.sim.plant import Encoder, MujocoPlant, PlantError, Pose
+from earl.sim.plant import Encoder, MujocoPlant, PlantError, Pose  # noqa: E402  (after choosing the GL backend)
 
 __all__ = ["Encoder", "MujocoPlant", "PlantError", "Pose"]
