@@ -497,3 +497,51 @@ def test_every_function_the_spec_names_exists_with_three_parameters() -> None:
     for module_name, function_name in names:
         function = getattr(importlib.import_module(module_name), function_name)
         assert list(inspect.signature(function).parameters) == ["inputs", "outputs", "context"], function_name
+
+
+# ---------------------------------------------------------------- the environment and the report
+
+
+def test_the_environment_takes_n_from_the_expanded_spec_and_the_box_from_the_seed() -> None:
+    from pick_and_place.environment import PickAndPlaceEnvironment, joints_of, make_environment
+
+    import earl
+    from earl.model.expand import expand
+
+    system = earl.load(Path(__file__).resolve().parent.parent / "examples" / "pick_and_place" / "system.earl")
+    environment = make_environment(expand(system, {"N": 3}), 5)
+    assert environment.n == 3 and environment.plant.model.nu == 4
+    assert joints_of(expand(system, {})) == 6
+    same = PickAndPlaceEnvironment(3, 5)
+    other = PickAndPlaceEnvironment(3, 6)
+    assert environment.box_start == same.box_start != other.box_start
+    assert max(abs(a - b) for a, b in zip(environment.box_start, scene.BOX_XY, strict=True)) <= scene.BOX_JITTER
+    with pytest.raises(ValueError, match="no integer parameter `N`"):
+        joints_of(SimpleNamespace(parameters=[]))
+
+
+def test_placement_measures_the_box_against_the_target() -> None:
+    from pick_and_place.environment import PickAndPlaceEnvironment
+
+    environment = PickAndPlaceEnvironment(6, 0)
+    placement = environment.placement()
+    expected = math.dist(environment.box_start, scene.TARGET_XY) * 1000.0
+    assert placement.error_mm == pytest.approx(expected, abs=0.5)
+    assert placement.resting and placement.released and not placement.placed
+
+
+def test_the_report_ends_with_the_pick_and_place_line() -> None:
+    import re
+
+    from pick_and_place.environment import PickAndPlaceEnvironment
+    from pick_and_place.report import summary
+
+    environment = PickAndPlaceEnvironment(6, 0)
+    environment.plant.advance(0.01)
+    environment.close()
+    text = summary(SimpleNamespace(environment=environment, time=0.01))
+    last = text.splitlines()[-1]
+    assert re.fullmatch(
+        r"pick-and-place: placed=(true|false) error_mm=\d+\.\d+ sim_time_s=\d+\.\d+ wall_time_s=\d+\.\d+", last
+    ), last
+    assert "placed=false" in last
