@@ -1,0 +1,228 @@
+"""Bad input: each gets one clear, located error and exit code 1 — never a traceback, a hang or a crash.
+
+Empty files, binary garbage, text that is not UTF-8, a 10 MB file, expressions and types
+nested 10,000 deep, unknown and duplicate names, import cycles and families with a negative
+or huge range (issue 2, "Bad input").
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+import earl
+from earl.cli.main import main
+from earl.diagnostics import Diagnostic, EarlError
+from earl.lang.parser import MAX_FILE_BYTES
+
+_HEAD = "system s\n\nr/r {\n    a/a\n}\n\n"
+
+
+def _in_cs(body: str) -> str:
+    return _HEAD + "a/a {\n    cs {\n" + body + "    }\n}\n"
+
+
+def _errors(path: Path) -> list[Diagnostic]:
+    with pytest.raises(EarlError) as caught:
+        earl.load(path)
+    return caught.value.diagnostics
+
+
+def _check_exits_1(path: Path, capsys: pytest.CaptureFixture[str]) -> str:
+    assert main(["check", str(path)]) == 1
+    output = capsys.readouterr()
+    printed = output.out + output.err
+    assert "Traceback" not in printed
+    return printed
+
+
+@pytest.mark.parametrize(
+    ("content", "code", "fragment", "where"),
+    [
+        (b"", "EARL-S033", "a specification starts with `system NAME`", (1, 1)),
+        (b"   \n\n// only a comment\n", "EARL-S033", "a specification starts with `system NAME`", (1, 1)),
+        (bytes(range(256)) * 16, "EARL-S021", "this is a binary file", (1, 1)),
+        (b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR", "EARL-S021", "this is a binary file", (1, 1)),
+        (b"system s\n// caf\xe9\n", "EARL-S022", "byte 0xe9 cannot be decoded", (2, 7)),
+        (b"\xff\xfes\x00y\x00s\x00", "EARL-S021", "this is a binary file", (1, 1)),  # UTF-16 is not UTF-8
+    ],
+    ids=["empty", "blank and comments", "binary", "a PNG", "latin-1", "UTF-16"],
+)
+def test_a_file_that_is_no_specification_is_refused_plainly(
+    content: bytes,
+    code: str,
+    fragment: str,
+    where: tuple[int, int],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    path = tmp_path / "bad.earl"
+    path.write_bytes(content)
+    [error] = _errors(path)
+    assert error.code == code
+    assert fragment in error.message
+    assert error.location is not None and (error.location.line, error.location.column) == where
+    assert code in _check_exits_1(path, capsys)
+
+
+def test_a_byte_order_mark_and_windows_line_ends_are_fine(tmp_path: Path) -> None:
+    path = tmp_path / "windows.earl"
+    path.write_bytes(
+        b"\xef\xbb\xbf" + _in_cs("        period 1 ms\n        x/m: int\n").encode().replace(b"\n", b"\r\n")
+    )
+    system = earl.load(path)
+    assert system.agent("a").control_subsystem.memories[0].location.line == 10
+
+
+def test_a_10_mb_file_is_refused_before_it_is_read(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path = tmp_path / "huge.earl"
+    line = b"        x/pp = true or false and not true\n"
+    path.write_bytes(_in_cs("").encode() + line * (10_000_000 // len(line)))
+    assert path.stat().st_size > MAX_FILE_BYTES
+    [error] = _errors(path)
+    assert error.code == "EARL-S020"
+    assert "MiB" in error.message and "refused" in error.message
+    assert error.hint is not None and "import" in error.hint
+    _check_exits_1(path, capsys)
+
+
+DEEP = 10_000
+
+
+@pytest.mark.parametrize(
+    ("expression", "code"),
+    [
+        ("not " * DEEP + "true", "EARL-S015"),
+        ("-(" * DEEP + "1" + ")" * DEEP + " > 0", "EARL-S015"),
+        ("1" + " + 1" * DEEP + " > 0", "EARL-S015"),
+        ("x/mi" + " and x/mi" * DEEP, None),  # a flat chain is one level, however long
+        ("(" * DEEP + "x/mi" + ")" * DEEP, None),  # parentheses nest no expression
+        ("f(" * DEEP + "1" + ")" * DEEP, "EARL-S015"),
+        ("[" * DEEP + "]" * DEEP, "EARL-S015"),
+    ],
+    ids=["not", "negation", "sum", "flat and", "parentheses", "calls", "lists"],
+)
+def test_an_expression_nested_10000_deep_is_refused_or_read_without_recursion(
+    expression: str, code: str | None, tmp_path: Path
+) -> None:
+    path = tmp_path / "deep.earl"
+    path.write_text(_in_cs(f"        x/m: boolean\n        p/pp = {expression}\n"))
+    if code is None:
+        system = earl.load(path)
+        assert system.agent("a").control_subsystem.primitive_predicates[0].name == "p"
+        return
+    [error] = _errors(path)
+    assert error.code == code
+    assert "nested more than" in error.message
+    assert error.location is not None and error.location.line == 10
+
+
+def test_a_type_nested_10000_deep_is_refused(tmp_path: Path) -> None:
+    path = tmp_path / "deep.earl"
+    path.write_text("system s\n\ntype T = int" + "[1]" * DEEP + "\n")
+    [error] = _errors(path)
+    assert error.code == "EARL-S017"
+    assert error.location is not None and (error.location.line, error.location.column) == (3, 10)
+
+
+def test_unknown_and_duplicate_names_are_all_reported(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path = tmp_path / "names.earl"
+    path.write_text(
+        _in_cs(
+            "        count/m: int\n"
+            "        count/m: double\n"
+            "        ready/pp = cuont/mi > 0\n"
+            "        other/pp = missing/ib\n"
+            "        go/pf(-> count/mo)\n"
+            "        go/pf(-> count/mo)\n"
+        )
+    )
+    errors = _errors(path)
+    found = {(e.code, e.location.line if e.location else 0) for e in errors}
+    assert {("EARL-R002", 10), ("EARL-R022", 11), ("EARL-R022", 12), ("EARL-R002", 14)} <= found
+    misspelt = next(e for e in errors if e.location is not None and e.location.line == 11)
+    assert misspelt.hint == "did you mean `count`?"
+    printed = _check_exits_1(path, capsys)
+    assert "errors" in printed
+
+
+@pytest.mark.parametrize(
+    ("files", "cycle"),
+    [
+        (
+            {
+                "system.earl": 'system s\nimport "a.earl"\n',
+                "a.earl": 'import "b.earl"\n',
+                "b.earl": 'import "a.earl"\n',
+            },
+            3,
+        ),
+        ({"system.earl": 'system s\nimport "a.earl"\n', "a.earl": 'import "a.earl"\n'}, 2),
+        ({"system.earl": 'system s\nimport "system.earl"\n'}, 2),
+    ],
+    ids=["two files", "a file importing itself", "the root importing itself"],
+)
+def test_an_import_cycle_is_reported_with_its_files(
+    files: dict[str, str], cycle: int, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    for name, text in files.items():
+        (tmp_path / name).write_text(text)
+    [error] = _errors(tmp_path / "system.earl")
+    assert error.code == "EARL-S031"
+    assert error.message.startswith("import cycle: ")
+    assert error.message.count(" -> ") == cycle - 1
+    assert error.location is not None and error.location.column == 1
+    _check_exits_1(tmp_path / "system.earl", capsys)
+
+
+def test_importing_a_missing_file_points_at_the_import(tmp_path: Path) -> None:
+    (tmp_path / "system.earl").write_text('system s\n\nimport "types.earl"\n')
+    [error] = _errors(tmp_path / "system.earl")
+    assert error.code == "EARL-S030"
+    assert "types.earl" in error.message
+    assert error.location is not None and (error.location.line, error.location.column) == (3, 1)
+
+
+@pytest.mark.parametrize(
+    ("family", "code", "fragment"),
+    [
+        ("K in 1..-5", "EARL-R016", "the family range 1..-5 is empty"),
+        ("K in 3..1", "EARL-R016", "the family range 3..1 is empty"),
+        ("K in 1..1000000000", "EARL-R017", "1,000,000,000 members"),
+        ("K in -1000000000000000000000..1", "EARL-R016", "starts at 0 or more"),
+        ("K in 0..1000000000000000000000", "EARL-R017", "at most 100,000"),
+        ("K in 1..BIG", "EARL-R017", "at most 100,000"),
+        ("K in 1..2.5", "EARL-R014", "whole number"),
+    ],
+    ids=[
+        "negative last",
+        "backwards",
+        "a billion",
+        "negative first",
+        "beyond 64 bits",
+        "through a parameter",
+        "fractional",
+    ],
+)
+def test_a_family_with_a_negative_or_huge_range_is_refused_before_expanding(
+    family: str, code: str, fragment: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path = tmp_path / "family.earl"
+    path.write_text(
+        "system s\n\nparam BIG: int = 2000000000\n\nr/r {\n    a/a\n}\n\n"
+        f"a/a {{\n    cs {{\n    }}\n\n    motor[{family}]/re {{\n        current/ib: double\n    }}\n}}\n"
+    )
+    errors = _errors(path)
+    assert errors[0].code == code
+    assert fragment in errors[0].message
+    assert errors[0].location is not None and errors[0].location.line == 13
+    _check_exits_1(path, capsys)
+
+
+def test_a_huge_family_of_buffers_is_refused_too(tmp_path: Path) -> None:
+    path = tmp_path / "family.earl"
+    path.write_text(_in_cs("        reading[K in 0..99999999999]/ib: double\n"))
+    [error] = _errors(path)
+    assert error.code == "EARL-R017"
+    assert error.location is not None and error.location.line == 9
