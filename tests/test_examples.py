@@ -65,6 +65,22 @@ def test_example_file_is_canonical(path: Path, capsys: pytest.CaptureFixture[str
     assert status == 0, capsys.readouterr().err
 
 
+def test_the_benchmark_spec_generator_writes_a_valid_canonical_spec() -> None:
+    # benchmarks/bench_parse.py times this text; it must be a spec `earl check` accepts.
+    import sys
+
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    try:
+        from generate import generate
+    finally:
+        sys.path.remove(str(ROOT / "benchmarks"))
+    text = generate(3)
+    system = earl.loads(text, "generated.earl")
+    assert [len(agent.subsystems) for agent in system.agents] == [7, 7, 7]
+    assert _problems(check(system), Severity.ERROR, Severity.WARNING) == []
+    assert system.to_earl() == text
+
+
 def test_a_non_canonical_file_fails_fmt_check(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     # The canonical-form test above means something only if `fmt --check` can fail.
     source = (EXAMPLES / "mobile_robot" / "types.earl").read_text(encoding="utf-8")
