@@ -13,7 +13,16 @@ import sys
 from collections.abc import Sequence
 
 from earl import __version__
-from earl.cli import check_command, diagram_command, doc_command, fmt_command, rules_command, run_command, trace_command
+from earl.cli import (
+    check_command,
+    diagram_command,
+    doc_command,
+    export_command,
+    fmt_command,
+    rules_command,
+    run_command,
+    trace_command,
+)
 
 EXIT_OK = 0
 EXIT_INVALID = 1
@@ -57,6 +66,7 @@ def build_parser() -> argparse.ArgumentParser:
     check_command.register(commands)
     diagram_command.register(commands)
     doc_command.register(commands)
+    export_command.register(commands)
     fmt_command.register(commands)
     rules_command.register(commands)
     run_command.register(commands)

@@ -1,0 +1,150 @@
+"""EARL expressions (predicates, conditions, initial values) as SysML v2 expressions.
+
+The two notations differ in three places that matter:
+
+- `not` is a unary operator in SysML v2 and binds tighter than any binary one,
+  where EARL's `not a == b` means `not (a == b)`: operands are parenthesised by
+  SysML's own precedence, never copied from the EARL text;
+- a read of a buffer or memory goes through the library's `msg` and `data`
+  features (`manipulatorCommand_ib.msg.emergencyStopCommand`, manual §2.2);
+- EARL indexes arrays from 0 and SysML's `#(i)` from 1.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+from earl.export.sysml_names import name_text
+from earl.model.expressions import (
+    Arithmetic,
+    BooleanOperation,
+    Call,
+    Comparison,
+    ConstantError,
+    ElementReference,
+    Expression,
+    FieldAccess,
+    IndexAccess,
+    ListLiteral,
+    Literal,
+    Name,
+    Negate,
+    Not,
+    Quantifier,
+    Read,
+    evaluate_integer,
+)
+from earl.model.kinds import Kind
+from earl.model.text import expression_text
+
+#: How a reference to a buffer, memory or primitive predicate is written: the SysML name of its target.
+Resolver = Callable[[ElementReference], str]
+
+# SysML v2 operator precedence, loosest first (KerML 8.2.5.8): or, and, equality, relational,
+# additive, multiplicative, unary, then primary expressions.
+_OR, _AND, _EQUALITY, _RELATIONAL, _ADDITIVE, _MULTIPLICATIVE, _UNARY, _PRIMARY = range(8)
+
+
+def literal(value: bool | int | float | str) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        if math.isnan(value):
+            raise ValueError("nan has no SysML literal")
+        if math.isinf(value):
+            # SysML has no infinity literal; a decimal too large for any real type reads as one.
+            return "1e999" if value > 0 else "-1e999"
+        return repr(value)
+    escaped = value.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n").replace("\t", "\\t")
+    escaped = escaped.replace("\r", "\\r").replace("\b", "\\b").replace("\f", "\\f")
+    return f'"{escaped}"'
+
+
+class ExpressionWriter:
+    """Writes the expressions of one subsystem, whose element names `resolve` knows."""
+
+    def __init__(self, resolve: Resolver) -> None:
+        self.resolve = resolve
+
+    def text(self, expression: Expression) -> str:
+        return self._write(expression)[0]
+
+    # Each case returns the text and its precedence, so that a parent can parenthesise it.
+    def _write(self, expression: Expression) -> tuple[str, int]:
+        if isinstance(expression, Literal):
+            text = literal(expression.value)
+            return text, _UNARY if text.startswith("-") else _PRIMARY
+        if isinstance(expression, ListLiteral):
+            return "(" + ", ".join(self.text(item) for item in expression.items) + ")", _PRIMARY
+        if isinstance(expression, Name):
+            # Expansion replaces parameters and indices by their values; a name left over is kept as written.
+            return name_text(expression.name), _PRIMARY
+        if isinstance(expression, Read):
+            return self._read(expression), _PRIMARY
+        if isinstance(expression, Call):
+            return self._call(expression), _PRIMARY
+        if isinstance(expression, Not):
+            return "not " + self._operand(expression.operand, _UNARY), _UNARY
+        if isinstance(expression, Negate):
+            return "-" + self._operand(expression.operand, _UNARY), _UNARY
+        if isinstance(expression, BooleanOperation):
+            own = _OR if expression.operator == "or" else _AND
+            parts = [self._operand(operand, own, strict=True) for operand in expression.operands]
+            return f" {expression.operator} ".join(parts), own
+        if isinstance(expression, Comparison):
+            own = _EQUALITY if expression.operator in ("==", "!=") else _RELATIONAL
+            left = self._operand(expression.left, own, strict=True)
+            right = self._operand(expression.right, own, strict=True)
+            return f"{left} {expression.operator} {right}", own
+        if isinstance(expression, Arithmetic):
+            own = _MULTIPLICATIVE if expression.operator == "*" else _ADDITIVE
+            left = self._operand(expression.left, own)
+            right = self._operand(expression.right, own, strict=True)
+            return f"{left} {expression.operator} {right}", own
+        if isinstance(expression, Quantifier):
+            # `expand` unrolls every quantifier; one met here belongs to a system that was not expanded.
+            raise ValueError(f"quantifier `{expression_text(expression)}` must be expanded before export")
+        raise TypeError(f"not an expression: {expression!r}")
+
+    def _operand(self, expression: Expression, parent: int, *, strict: bool = False) -> str:
+        text, own = self._write(expression)
+        needed = own < parent or (strict and own == parent)
+        # Clearer than the bare precedence: `a or (b and c)`, `(a < b) == c`; `x > 1 and y < 2` stays bare.
+        nested_logic = isinstance(expression, BooleanOperation) or (
+            isinstance(expression, Comparison) and parent in (_EQUALITY, _RELATIONAL)
+        )
+        return f"({text})" if needed or nested_logic else text
+
+    def _read(self, read: Read) -> str:
+        target = read.target
+        text = self.resolve(target)
+        if target.kind is Kind.INPUT_BUFFER:
+            text += ".msg"
+        elif target.kind in (Kind.MEMORY, Kind.MEMORY_INPUT, Kind.MEMORY_OUTPUT):
+            text += ".data"
+        for accessor in read.path:
+            if isinstance(accessor, FieldAccess):
+                text += "." + name_text(accessor.name)
+            elif isinstance(accessor, IndexAccess):
+                text += f"#({self._position(accessor.index)})"
+        return text
+
+    def _position(self, index: Expression) -> str:
+        """EARL's 0-based index as SysML's 1-based position."""
+        try:
+            return str(evaluate_integer(index, {}) + 1)
+        except ConstantError:
+            return f"{self._operand(index, _ADDITIVE)} + 1"
+
+    def _call(self, call: Call) -> str:
+        arguments = []
+        for argument in call.arguments:
+            if call.function == "timeout" and isinstance(argument, Read) and not argument.path:
+                # timeout() is about the buffer itself, not its message.
+                arguments.append(self.resolve(argument.target))
+            else:
+                arguments.append(self.text(argument))
+        return f"EARL::{call.function}(" + ", ".join(arguments) + ")"
