@@ -257,7 +257,15 @@ def _unexpected_token(
             path, token.line, column, token.end_line or token.line, token.end_column or column + 1
         )
 
-    for special in (_stray_closing, _misplaced_keyword, _missing_arrow, _end_of_file, _bad_kind, _duration, _line_ends_early):
+    for special in (
+        _stray_closing,
+        _misplaced_keyword,
+        _missing_arrow,
+        _end_of_file,
+        _bad_kind,
+        _duration,
+        _line_ends_early,
+    ):
         diagnostic = special(token, context, location, path)
         if diagnostic is not None:
             return diagnostic
@@ -304,18 +312,19 @@ def _line_ends_early(token: Token, context: _Context, location: SourceLocation, 
     """`x/pp = a or` with nothing after `or`: the next line was read as the rest of it."""
     if token.type == "$END" or not token.line:
         return None
-    tokens = [v for v in context.values if isinstance(v, Token) and v.line]
-    earlier = [t for t in tokens if t.line < token.line]
+    line = token.line
+    earlier = [v for v in context.values if isinstance(v, Token) and v.line and v.line < line]
     if not earlier:
         return None
     dangling = earlier[-1]
     wanted = _NEEDS_CONTINUATION.get(dangling.type)
+    dangling_line = dangling.line or 0
     if wanted is None or dangling is context.previous:
         return None
     # Everything read after the dangling token must sit on later lines: it is the next statement.
     after = context.values[context.values.index(dangling) + 1 :]
     starts = [_start_line(v) for v in after]
-    if not starts or any(line is None or line <= dangling.line for line in starts):
+    if not starts or any(start is None or start <= dangling_line for start in starts):
         return None
     return Diagnostic(
         Severity.ERROR,
