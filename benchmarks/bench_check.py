@@ -13,8 +13,8 @@ The peer of (c) is an exhaustive truth table: all 2^20 assignments of the primit
 at once, as the bits of Python integers.  It also cross-checks the BDD analysis: both must find
 the same overlaps, dead transitions, stuck, never-ending and unreachable states.
 
-Every figure is the median of several runs, as wall-clock time and as the process's CPU time
-(the machine may be shared with other work; CPU time is what an idle machine shows as wall time).
+Every figure is the median of several runs, each in a fresh interpreter, as wall-clock time and as
+the process's CPU time (the machine may be shared; CPU time is what an idle machine shows as wall).
 
     .venv/bin/python benchmarks/bench_check.py              # the issue's sizes, 3 runs each
     .venv/bin/python benchmarks/bench_check.py --quick      # small sizes, one run: a smoke test
@@ -23,7 +23,6 @@ Every figure is the median of several runs, as wall-clock time and as the proces
 from __future__ import annotations
 
 import argparse
-import gc
 import itertools
 import json
 import os
@@ -31,6 +30,7 @@ import platform
 import random
 import re
 import statistics
+import subprocess
 import sys
 import time
 from collections.abc import Callable
@@ -102,30 +102,49 @@ def check_once(text: str) -> tuple[SpecRun, int, int, int]:
     return SpecRun(read, expand, rules), agents, subsystems, problems
 
 
+def measure_in_fresh_interpreter(workers: int) -> dict[str, Any]:
+    """One run in a new interpreter, so that no run inherits the heap an earlier (larger) one left."""
+    output = subprocess.run(
+        [sys.executable, str(Path(__file__).resolve()), "--measure-once", str(workers)],
+        check=True,
+        capture_output=True,
+        text=True,
+    ).stdout
+    result: dict[str, Any] = json.loads(output)
+    return result
+
+
+def measure_once(workers: int) -> dict[str, Any]:
+    text = generate(workers)
+    check_once(generate(2))  # warm up: the first read builds the parser's tables
+    run, agents, subsystems, problems = check_once(text)
+    return {
+        "agents": agents,
+        "subsystems": subsystems,
+        "problems": problems,
+        "text_bytes": len(text.encode()),
+        "read": asdict(run.read),
+        "expand": asdict(run.expand),
+        "rules": asdict(run.rules),
+        "total": asdict(run.total),
+    }
+
+
 def bench_sizes(sizes: list[int], runs: int) -> list[dict[str, Any]]:
     rows = []
     for workers in sizes:
-        text = generate(workers)
-        timings: list[SpecRun] = []
+        measured = []
         for _ in range(runs):
-            run, agents, subsystems, problems = check_once(text)
-            gc.collect()  # the previous run's model, before the next is built
-            if problems:
-                raise SystemExit(f"the generated spec of {workers} agents has {problems} errors or warnings")
-            timings.append(run)
-            print(f"  {workers} agents: {run.total.wall:.2f} s wall, {run.total.cpu:.2f} s CPU", flush=True)
-        rows.append(
-            {
-                "agents": agents,
-                "subsystems": subsystems,
-                "text_bytes": len(text.encode()),
-                "runs": runs,
-                "read": asdict(median([t.read for t in timings])),
-                "expand": asdict(median([t.expand for t in timings])),
-                "rules": asdict(median([t.rules for t in timings])),
-                "total": asdict(median([t.total for t in timings])),
-            }
-        )
+            one = measure_in_fresh_interpreter(workers)
+            if one["problems"]:
+                raise SystemExit(f"the generated spec of {workers} agents has {one['problems']} errors or warnings")
+            measured.append(one)
+            print(f"  {workers} agents: {one['total']['wall']:.2f} s wall, {one['total']['cpu']:.2f} s CPU", flush=True)
+        row: dict[str, Any] = {key: measured[0][key] for key in ("agents", "subsystems", "text_bytes")}
+        row["runs"] = runs
+        for phase in ("read", "expand", "rules", "total"):
+            row[phase] = asdict(median([Timing(**one[phase]) for one in measured]))
+        rows.append(row)
     return rows
 
 
@@ -357,12 +376,15 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--sizes", type=int, nargs="+", default=[2500, 5000, 10000], help="agents per spec")
     parser.add_argument("--quick", action="store_true", help="small sizes and one run: a smoke test")
     parser.add_argument("--output", type=Path, default=RESULTS, help="where to write the JSON results")
+    parser.add_argument("--measure-once", type=int, metavar="AGENTS", help=argparse.SUPPRESS)
     arguments = parser.parse_args(argv)
+    if arguments.measure_once is not None:
+        print(json.dumps(measure_once(arguments.measure_once)))
+        return 0
     if arguments.quick:
         arguments.sizes, arguments.runs = [250, 500], 1
     load_before = os.getloadavg()
     print(f"check: specs of {', '.join(map(str, arguments.sizes))} agents, {arguments.runs} runs each", flush=True)
-    check_once(generate(2))  # warm up: the first read builds the parser's tables
     sizes = bench_sizes(arguments.sizes, arguments.runs)
     fsm_runs = max(3, arguments.runs)
     fsms = [bench_fsm(20, 50, fsm_runs, peer=True), bench_fsm(40, 100, fsm_runs, peer=False)]
