@@ -297,11 +297,11 @@ class ElementBuilder:
         return ElementReference(str(children[0]), Kind(str(children[-1])), tuple(children[1:-1]), self._loc(meta))
 
     # ------------------------------------------------------------------ subsystems
-    def control_subsystem(self, meta: Meta, children: list[Any]) -> Subsystem:
-        return self._fill(ControlSubsystem(location=self._loc(meta)), children[1:])
-
-    def other_subsystem(self, meta: Meta, children: list[Any]) -> Subsystem:
-        declared: _DeclaredName = children[0]
+    def subsystem(self, meta: Meta, children: list[Any]) -> Subsystem:
+        head = children[0]
+        if isinstance(head, Token) and head.type == "CS":
+            return self._fill(ControlSubsystem(location=self._loc(meta)), children[1:])
+        declared: _DeclaredName = head
         cls = SUBSYSTEM_CLASSES[Kind(str(children[1]))]
         subsystem = cls(declared.name, declared.family, location=self._loc(meta))
         return self._fill(subsystem, children[2:])
@@ -405,9 +405,6 @@ class ElementBuilder:
 
     def primitive_predicate(self, meta: Meta, children: list[Any]) -> PrimitivePredicate:
         return PrimitivePredicate(self._single(children[0], "Primitive Predicate"), children[2], self._loc(meta))
-
-    def ref_name(self, meta: Meta, children: list[Token]) -> Token:
-        return children[0]
 
     def partial_transition_function(self, meta: Meta, children: list[Any]) -> PartialTransitionFunction:
         name, _kind, reads, writes, *implementation = children
@@ -549,7 +546,7 @@ class ElementBuilder:
         self._depth[id(node)] = depth
         return node
 
-    def or_expression(self, meta: Meta, children: list[Any]) -> Expression:
+    def expression(self, meta: Meta, children: list[Any]) -> Expression:
         return self._expression(BooleanOperation("or", tuple(children), self._loc(meta)), children)
 
     def and_expression(self, meta: Meta, children: list[Any]) -> Expression:
