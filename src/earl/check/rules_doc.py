@@ -33,6 +33,7 @@ ENFORCED_BY_THE_LANGUAGE: tuple[tuple[str, str], ...] = (
         "a Subsystem has one FSM, and every FSM State one Basic Behaviour (§2.2)",
         "the grammar: one `fsm { … }` per subsystem (EARL-S011), `state s: b/bb` names exactly one behaviour",
     ),
+    ("an Agent has exactly one Control Subsystem (§2.1)", "EARL-E005 when it has none; a second `cs` is EARL-R002"),
     ("the initial state exists (Figure 5a)", "EARL-R031"),
     ("transitions name existing states (§2.2)", "EARL-R032"),
     ("a state's behaviour exists (§2.2)", "EARL-R030"),
@@ -47,7 +48,8 @@ ENFORCED_BY_THE_LANGUAGE: tuple[tuple[str, str], ...] = (
     ("`newData` applies only to Input Buffers (Table 4)", "EARL-R042"),
     (
         "kind suffixes match the element (§3: `manip/a`, `jointMove/bb`)",
-        "the grammar: every declaration and reference carries its kind",
+        "the grammar: every declaration and reference carries its kind; a suffix that names no kind allowed "
+        "there is EARL-S005, a reference whose suffix is not the kind of the element it names EARL-R022",
     ),
     ("links run from an Output Buffer to an Input Buffer (§2.3)", "EARL-R054"),
 )
