@@ -50,6 +50,8 @@ TOOL = 0.13
 FINGER_LENGTH = 0.04
 #: Widest opening between the finger pads, metres.
 MAX_OPENING = 0.09
+#: MuJoCo's step, s: one step per 1 ms drive period (implicitfast with armature and stiff contacts is stable here)
+TIMESTEP = 0.001
 #: The opening in the workcell's initial keyframe, metres.
 INITIAL_OPENING = 0.08
 
@@ -374,7 +376,7 @@ _OPTIONS = (
 )
 
 
-def robot_mjcf(n: int, timestep: float = 0.0005) -> str:
+def robot_mjcf(n: int, timestep: float = TIMESTEP) -> str:
     """The robot alone: arm, gripper and drives, mounted at the origin."""
     check_joint_count(n)
     return "\n".join(
@@ -437,7 +439,7 @@ def workcell_mjcf(
     box_position: tuple[float, float],
     target_position: tuple[float, float],
     initial_configuration: list[float] | None = None,
-    timestep: float = 0.0005,
+    timestep: float = TIMESTEP,
 ) -> str:
     """The robot on a table, a box to pick at `box_position` and a place target (x, y on the table)."""
     robot = robot_mjcf(n, timestep)

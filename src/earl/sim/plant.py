@@ -70,6 +70,7 @@ class MujocoPlant:
         self.model = model
         self.data = mujoco.MjData(model)
         self._actuators = {model.actuator(i).name: i for i in range(model.nu)}
+        self._timestep = float(model.opt.timestep)
         # per actuator (low, high) as Python floats: set_input runs every millisecond for every drive
         self._ranges = [
             (float(low), float(high)) if model.actuator_ctrllimited[i] else (-math.inf, math.inf)
@@ -117,7 +118,7 @@ class MujocoPlant:
 
     @property
     def timestep(self) -> float:
-        return float(self.model.opt.timestep)
+        return self._timestep
 
     def advance(self, time: float) -> None:
         """Step the physics until simulated time reaches `time` (to within half a step).
