@@ -545,3 +545,32 @@ def test_the_report_ends_with_the_pick_and_place_line() -> None:
         r"pick-and-place: placed=(true|false) error_mm=\d+\.\d+ sim_time_s=\d+\.\d+ wall_time_s=\d+\.\d+", last
     ), last
     assert "placed=false" in last
+
+
+def test_pictures_of_a_run_or_the_reason_why_not(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from pick_and_place import environment as environment_module
+
+    from earl.sim import render
+
+    monkeypatch.setattr(environment_module, "VIDEO_SIZE", (64, 48))
+    monkeypatch.setattr(environment_module, "PICTURE_SIZE", (64, 48))
+    monkeypatch.setattr(environment_module, "VIDEO_FPS", 100.0)
+    environment = environment_module.PickAndPlaceEnvironment(3, 0, output=tmp_path)
+    environment.advance(0.03)
+    environment.close()
+    if environment.render_messages:  # no OpenGL here: the reason is given, the run went on
+        assert "MuJoCo cannot render offscreen" in environment.render_messages[0]
+    else:
+        assert {p.name for p in environment.pictures} >= {"final.png"}
+        assert any(p.suffix in {".gif", ".mp4"} for p in environment.pictures)
+
+    def no_context(*args: object, **kwargs: object) -> None:
+        raise RuntimeError("no EGL display")
+
+    monkeypatch.setattr(render.mujoco, "Renderer", no_context)
+    blind = environment_module.PickAndPlaceEnvironment(3, 0, output=tmp_path / "blind")
+    blind.advance(0.01)
+    blind.close()
+    assert blind.pictures == []
+    assert blind.render_messages[0].startswith("no pictures: MuJoCo cannot render offscreen here")
+    assert "no EGL display" in blind.render_messages[0]
