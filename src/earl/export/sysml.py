@@ -211,9 +211,16 @@ class _Writer:
                 "EARL name.",
             )
             self.emit("private import EARL::*;")
+            # Array-of-array definitions are found while writing the rest, and go before it.
+            head, self.lines = self.lines, []
             self.types()
             self.emit()
             self.system_part()
+            body, self.lines = self.lines, head
+            for helper, array in sorted(self.helper_types.values(), key=lambda entry: entry[0]):
+                self.emit()
+                self.array_definition(helper, array)
+            self.lines.extend(body)
         return "\n".join(self.lines) + "\n"
 
     # ------------------------------------------------------------------ data types (§2.2, Figures 9 and 11)
@@ -221,9 +228,6 @@ class _Writer:
         namespace = Namespace((self.system.name,))
         for definition in self.system.types:
             self.type_names[definition.name] = namespace.claim(definition.name)
-        self.helper_namespace = namespace
-        body: list[str] = []
-        saved, self.lines = self.lines, body
         for definition in self.system.types:
             self.emit()
             name = name_text(self.type_names[definition.name])
@@ -231,49 +235,48 @@ class _Writer:
                 with self.block(f"attribute def {name}"):
                     self.element_doc(definition.location)
                     for field in definition.fields:
-                        self.emit(
-                            f"attribute {name_text(field.name)} : {self.field_type(field.data_type, field.optional)};"
-                        )
+                        self.emit(f"attribute {name_text(field.name)} : {self.typed(field.data_type, field.optional)};")
             else:
                 self.alias(name, definition)
-        self.lines = saved
-        for helper, (_, element) in sorted(self.helper_types.items()):
-            self.emit()
-            self.array_definition(helper, element)
-        self.lines.extend(body)
 
     def alias(self, name: str, definition: TypeAlias) -> None:
-        target = definition.data_type
-        if isinstance(target, ArrayType):
-            with self.block(f"attribute def {name}"):
-                self.element_doc(definition.location, f"EARL: type {definition.name} = {type_text(target)}.")
-                self.emit(f"attribute elements : {self.field_type(target, False)};")
-        else:
-            with self.block(f"attribute def {name} :> {self.scalar_type(target)}"):
-                self.element_doc(definition.location)
+        element, size = self.shape(definition.data_type)
+        note = f"EARL: type {definition.name} = {type_text(definition.data_type)}" + (
+            f"; a usage of it holds {size} values (multiplicity [{size}], ordered)." if size is not None else "."
+        )
+        with self.block(f"attribute def {name} :> {element}"):
+            self.element_doc(definition.location, note)
 
     def array_definition(self, helper: str, array: DataType) -> None:
         with self.block(f"attribute def {helper}"):
-            self.doc(f"The EARL array type {type_text(array)}.")
-            self.emit(f"attribute elements : {self.field_type(array, False)};")
+            self.doc(
+                f"The EARL array type {type_text(array)}, as a value: an array of arrays cannot be a multiplicity."
+            )
+            self.emit(f"attribute elements : {self.typed(array)};")
 
-    def scalar_type(self, data_type: DataType) -> str:
-        """A type written as one SysML definition: arrays get a helper definition named after them."""
+    def shape(self, data_type: DataType) -> tuple[str, str | None]:
+        """The SysML type of a value and, for an array, its size: SysML v2 has multiplicities, not array types."""
         if isinstance(data_type, PrimitiveType):
-            return f"EARL::{data_type.name}"
+            return f"EARL::{data_type.name}", None
         if isinstance(data_type, TypeReference):
-            return name_text(self.type_names.get(data_type.name, data_type.name))
-        text = type_text(data_type)
-        if text not in self.helper_types:
-            self.helper_types[text] = (quoted(text), data_type)
-        return self.helper_types[text][0]
+            definition = self.system.type_named(data_type.name)
+            name = name_text(self.type_names.get(data_type.name, data_type.name))
+            return name, self.shape(definition.data_type)[1] if isinstance(definition, TypeAlias) else None
+        element, inner = self.shape(data_type.element)
+        if inner is not None:
+            # An array of arrays: the inner array becomes a definition of its own (`'double[3]'`).
+            text = type_text(data_type.element)
+            self.helper_types.setdefault(text, (quoted(text), data_type.element))
+            element = self.helper_types[text][0]
+        return element, "*" if data_type.size is None else _size_text(data_type)
 
-    def field_type(self, data_type: DataType, optional: bool) -> str:
-        """A type with its multiplicity: `EARL::double[3] ordered nonunique`, `JointPosition[0..1]`."""
-        if isinstance(data_type, ArrayType) and not optional and not isinstance(data_type.element, ArrayType):
-            size = "*" if data_type.size is None else _size_text(data_type)
-            return f"{self.scalar_type(data_type.element)}[{size}] ordered nonunique"
-        return self.scalar_type(data_type) + ("[0..1]" if optional else "")
+    def typed(self, data_type: DataType, optional: bool = False) -> str:
+        """A type with its multiplicity: `EARL::double[3] ordered nonunique`, `OperPosition[0..1]`."""
+        element, size = self.shape(data_type)
+        if size is None:
+            return element + ("[0..1]" if optional else "")
+        multiplicity = f"[0..{size}]" if optional and size != "*" else f"[{size}]"
+        return f"{element}{multiplicity} ordered nonunique"
 
     # ------------------------------------------------------------------ the system (§2.1, Figure 2)
     def system_part(self) -> None:
@@ -304,7 +307,7 @@ class _Writer:
             value = literal(_parameter_value(parameter))
             where = _where(parameter.location)
             note = f" // parameter, {where}" if where else " // parameter"
-            self.emit(f"attribute {name.declaration} : {self.scalar_type(parameter.data_type)} = {value};{note}")
+            self.emit(f"attribute {name.declaration} : {self.typed(parameter.data_type)} = {value};{note}")
 
     def robot(self, robot: Robot, namespace: Namespace) -> None:
         name = self.named(namespace, f"{robot.name}/r")
@@ -424,7 +427,7 @@ class _Writer:
         names.add(buffer.name, buffer.index, Kind.INPUT_BUFFER, named.name)
         with self.block(f"port {named.declaration} : EARL::InputBuffer :> ib"):
             self.element_doc(buffer.location, *self.member_note(buffer.family is not None, buffer.index))
-            self.emit(f"in item :>> msg : {self.scalar_type(buffer.data_type)};")
+            self.emit(f"in item :>> msg : {self.typed(buffer.data_type)};")
             if buffer.queue is not None:
                 capacity = buffer.queue.capacity
                 if isinstance(capacity, Literal):
@@ -436,7 +439,7 @@ class _Writer:
         names.add(buffer.name, buffer.index, Kind.OUTPUT_BUFFER, named.name)
         with self.block(f"port {named.declaration} : EARL::OutputBuffer :> ob"):
             self.element_doc(buffer.location, *self.member_note(buffer.family is not None, buffer.index))
-            self.emit(f"out item :>> msg : {self.scalar_type(buffer.data_type)};")
+            self.emit(f"out item :>> msg : {self.typed(buffer.data_type)};")
 
     def memory(self, memory: Memory, namespace: Namespace, names: _SubsystemNames) -> None:
         named = self.named(namespace, _earl_name(memory.name, memory.index, Kind.MEMORY))
@@ -446,7 +449,7 @@ class _Writer:
             initial = ""
             if memory.initial_value is not None:
                 initial = " := " + ExpressionWriter(names.resolve).text(memory.initial_value)
-            self.emit(f"attribute :>> data : {self.field_type(memory.data_type, False)}{initial};")
+            self.emit(f"attribute :>> data : {self.typed(memory.data_type)}{initial};")
 
     # ------------------------------------------------------------------ behaviour (§2.2, Table 4, Figures 5 and 6)
     def primitive_predicate(
@@ -622,7 +625,7 @@ class _Writer:
         )
         payload = ""
         if resolved is not None:
-            payload = f" of {self.scalar_type(resolved.source_buffer.data_type)}"
+            payload = f" of {self.shape(resolved.source_buffer.data_type)[0]}"
         self.emit(f"flow {declaration} : {definition}{payload}")
         self.depth += 1
         self.emit(f"from {source}")

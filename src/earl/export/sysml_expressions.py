@@ -125,11 +125,16 @@ class ExpressionWriter:
             text += ".msg"
         elif target.kind in (Kind.MEMORY, Kind.MEMORY_INPUT, Kind.MEMORY_OUTPUT):
             text += ".data"
+        previous: object = None
         for accessor in read.path:
             if isinstance(accessor, FieldAccess):
                 text += "." + name_text(accessor.name)
             elif isinstance(accessor, IndexAccess):
-                text += f"#({self._position(accessor.index)})"
+                # An array of arrays is exported as values holding `elements` (docs/sysml.md).
+                text += (
+                    ".elements" if isinstance(previous, IndexAccess) else ""
+                ) + f"#({self._position(accessor.index)})"
+            previous = accessor
         return text
 
     def _position(self, index: Expression) -> str:
