@@ -8,9 +8,14 @@ export VENV
 setup:
 	@bash scripts/setup.sh
 
+# The manual's §3 example, end to end: check it, run it against MuJoCo in virtual time, write a
+# trace (Foxglove), a plot, a picture and the document; the last line says whether the box was placed.
+DEMO_OUT ?= demo-output
 demo: setup
-	$(BIN)/earl check --verbose examples/pick_and_place/system.earl
-	$(BIN)/earl fmt examples/pick_and_place/system.earl
+	$(BIN)/earl check --verbose examples/pick_and_place
+	$(BIN)/earl doc examples/pick_and_place -o $(DEMO_OUT)/site
+	EARL_SIM_OUTPUT=$(DEMO_OUT) $(BIN)/earl run examples/pick_and_place --no-progress \
+		--trace $(DEMO_OUT)/pick_and_place.mcap --plot $(DEMO_OUT)/pick_and_place.png
 
 test: setup
 	$(BIN)/ruff check src tests benchmarks

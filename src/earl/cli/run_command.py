@@ -72,6 +72,18 @@ def register(commands: Any) -> None:
         metavar="PATTERN",
         help="record only messages on links matching a glob, e.g. 'task,*' (repeatable; default: all)",
     )
+    parser.add_argument(
+        "--plot",
+        metavar="FILE.png",
+        help="after the run, plot the signals named by --signal (or `plot` in run.toml) from the trace",
+    )
+    parser.add_argument(
+        "--signal",
+        action="append",
+        default=None,
+        metavar="SIGNAL",
+        help="a signal for --plot, e.g. 'manip/a.cs.windingCurrent[*]' (repeatable; see `earl plot --help`)",
+    )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.set_defaults(run=run)
 
@@ -89,6 +101,12 @@ def run(arguments: argparse.Namespace) -> int:
     except (UsageError, ValueError) as error:
         return usage_error(str(error))
     seed = arguments.seed if arguments.seed is not None else (settings.seed or 0)
+    signals = arguments.signal if arguments.signal is not None else settings.plot
+    if arguments.plot and not signals:
+        return usage_error("--plot needs signals: name them with --signal, or `plot = [...]` in run.toml")
+    arguments.signal = signals
+    if arguments.plot and not arguments.trace:
+        arguments.trace = str(Path(arguments.plot).with_suffix(".mcap"))
     environment = arguments.environment or settings.environment
     record_memory = arguments.record_memory if arguments.record_memory is not None else settings.record_memory
     try:
@@ -100,7 +118,7 @@ def run(arguments: argparse.Namespace) -> int:
             environment=environment,
             trace=arguments.trace,
             record_memory=record_memory,
-            record_links=arguments.record_links,
+            record_links=arguments.record_links if arguments.record_links is not None else settings.record_links,
             realtime=arguments.realtime,
         )
     except EarlError as error:
@@ -152,6 +170,8 @@ def _execute(simulation: Any, duration: float, arguments: argparse.Namespace, re
         simulation.close()
         signal.signal(signal.SIGTERM, previous)
     _summary(simulation, wall, arguments)
+    if arguments.plot:
+        _plot(arguments, console)
     if report:
         _report(simulation, report, path, console)
     if interrupted:
@@ -197,6 +217,18 @@ def _summary(simulation: Any, wall: float, arguments: argparse.Namespace) -> Non
     console.print(f"ran {simulation.time:.3f} s of {mode} in {wall:.2f} s of wall time ({ratio:.1f}x real time)")
     if arguments.trace:
         console.print(f"trace: {arguments.trace} (earl trace summary {arguments.trace}; opens in Foxglove)")
+
+
+def _plot(arguments: argparse.Namespace, console: Console) -> None:
+    from earl.runtime.plot import plot_signals
+    from earl.runtime.trace_reader import TraceError
+
+    try:
+        plot_signals(Path(arguments.trace), arguments.signal, Path(arguments.plot))
+    except TraceError as error:
+        console.print(f"earl run: no plot: {error}")
+        return
+    console.print(f"plot: {arguments.plot}")
 
 
 def _report(simulation: Any, report: str, path: Path, console: Console) -> None:

@@ -2,39 +2,49 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
-from earl.runtime.trace_reader import signal, state_bands, summarise
+from earl.runtime.trace_reader import read_signals
 
 
 def plot_signals(trace: Path, signals: list[str], output: Path, title: str | None = None) -> None:
-    """Write a PNG (or SVG/PDF, by the suffix) with one panel per subsystem of the signals."""
+    """Write a PNG (or SVG/PDF, by the suffix): one panel per element of a subsystem, its FSM states behind."""
     import matplotlib
 
     matplotlib.use("Agg")  # files only: no display needed, none opened
     import matplotlib.pyplot as plt
 
-    summary = summarise(trace)
-    end = summary.end_time * 1e-9
-    series = [(name, *signal(trace, name)) for name in signals]
-    subsystems = list(dict.fromkeys(subsystem for _, subsystem, _, _ in series))
-    figure, axes = plt.subplots(
-        len(subsystems), 1, figsize=(10, 2.8 * len(subsystems) + 0.6), sharex=True, squeeze=False
-    )
+    data = read_signals(trace, signals)
+    panels = list(dict.fromkeys((s.subsystem, re.split(r"[.\[]", s.name, maxsplit=1)[0]) for s in data.series))
+    figure, axes = plt.subplots(len(panels), 1, figsize=(10, 2.6 * len(panels) + 0.6), sharex=True, squeeze=False)
     palette = plt.get_cmap("Pastel1")
-    for row, subsystem in enumerate(subsystems):
+    for row, (subsystem, element) in enumerate(panels):
         axis = axes[row][0]
         colours: dict[str, object] = {}
-        for start, stop, state in state_bands(trace, subsystem, end):
+        for start, stop, state in data.bands.get(subsystem, []):
             colour = colours.setdefault(state, palette(len(colours) % 9))
             axis.axvspan(start, stop, color=colour, alpha=0.6, linewidth=0, label=f"state {state}")
-        for name, owner, times, values in series:
-            if owner == subsystem:
-                axis.step(times, values, where="post", label=name[len(subsystem) + 1 :], linewidth=1.2)
+        for series in data.series:
+            if series.subsystem == subsystem and re.split(r"[.\[]", series.name, maxsplit=1)[0] == element:
+                # a value holds until the next one: extend the last to the end of the run
+                times = [*series.times, data.end]
+                values = [*series.values, series.values[-1]]
+                sparse = len(series.times) < 50
+                axis.step(
+                    times,
+                    values,
+                    where="post",
+                    label=series.name,
+                    linewidth=1.2,
+                    marker="o" if sparse else None,
+                    markersize=3,
+                    markevery=list(range(len(series.times))) if sparse else None,
+                )
         handles, labels = axis.get_legend_handles_labels()
         unique = dict(zip(labels, handles, strict=False))
         axis.legend(unique.values(), unique.keys(), loc="upper right", fontsize=7, ncol=2)
-        axis.set_title(subsystem, fontsize=9, loc="left")
+        axis.set_title(f"{subsystem} {element}", fontsize=9, loc="left")
         axis.grid(True, alpha=0.3)
     axes[-1][0].set_xlabel("time [s]")
     if title:

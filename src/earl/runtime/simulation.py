@@ -240,6 +240,8 @@ class RunSettings:
     seed: int | None = None
     record_memory: list[str] | None = None
     report: str | None = None
+    plot: list[str] | None = None
+    record_links: list[str] | None = None
 
 
 def read_run_settings(spec: Path) -> RunSettings:
@@ -250,7 +252,7 @@ def read_run_settings(spec: Path) -> RunSettings:
         data = tomllib.loads(path.read_text(encoding="utf-8"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as error:
         raise ValueError(f"{path}: not valid TOML: {error}") from None
-    known = {"environment", "duration", "seed", "record_memory", "report"}
+    known = {"environment", "duration", "seed", "record_memory", "record_links", "report", "plot"}
     unknown = sorted(set(data) - known)
     if unknown:
         raise ValueError(f"{path}: unknown setting `{unknown[0]}` (known: {', '.join(sorted(known))})")
@@ -265,4 +267,6 @@ def read_run_settings(spec: Path) -> RunSettings:
         seed=data.get("seed"),
         record_memory=data.get("record_memory"),
         report=data.get("report"),
+        plot=data.get("plot"),
+        record_links=data.get("record_links"),
     )

@@ -9,6 +9,7 @@ A *signal* is named as a person names the thing it measures:
 from __future__ import annotations
 
 import json
+import re
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -47,7 +48,7 @@ def _messages(path: Path, topics: list[str] | None = None) -> Iterator[tuple[str
     try:
         with open(path, "rb") as stream:
             reader = make_reader(stream)
-            for _, channel, message in reader.iter_messages(topics=topics, log_time_order=True):
+            for _, channel, message in reader.iter_messages(topics=topics, log_time_order=False):
                 yield channel.topic, channel.metadata, message.log_time, json.loads(message.data)
     except FileNotFoundError:
         raise TraceError(f"no such file: {path}") from None
@@ -114,54 +115,94 @@ def topics(path: Path) -> dict[str, dict[str, str]]:
     return {channel.topic: dict(channel.metadata) for channel in summary.channels.values()}
 
 
-def signal(path: Path, name: str) -> tuple[str, list[float], list[float]]:
-    """(subsystem, times in s, values) of a signal; TraceError saying what the trace has otherwise."""
+@dataclass
+class Series:
+    """One signal: its subsystem, its name inside the subsystem, and (time s, value) samples."""
+
+    subsystem: str
+    name: str
+    times: list[float]
+    values: list[float]
+
+
+@dataclass
+class Signals:
+    """What a plot needs from a trace, read in one pass: the series and each subsystem's state stays."""
+
+    series: list[Series]
+    bands: dict[str, list[tuple[float, float, str]]]
+    end: float
+
+
+def read_signals(path: Path, names: list[str]) -> Signals:
+    """The signals `names` (`[*]` stands for every member) and the FSM states of their subsystems.
+
+    The file is read once, whatever the number of signals: a trace of a long run is large.
+    """
     available = topics(path)
     subsystems = sorted({t[: -len("/fsm")] for t in available if t.endswith("/fsm")}, key=len, reverse=True)
-    subsystem = next((s for s in subsystems if name.startswith(s + ".")), None)
-    if subsystem is None:
-        raise TraceError(
-            f"`{name}` does not start with a subsystem of this trace ({', '.join(sorted(subsystems)) or 'none'})"
-        )
-    rest = name[len(subsystem) + 1 :]
-    candidates: list[tuple[str, str]] = []
-    if f"{subsystem}/memory" in available:
-        candidates.append((f"{subsystem}/memory", rest))
-    for topic, metadata in available.items():
-        source = metadata.get("source", "")
-        if topic.startswith("link/") and source.startswith(subsystem + "."):
-            buffer = source[len(subsystem) + 1 :]
-            if rest == buffer or rest.startswith(buffer + ".") or rest.startswith(buffer + "["):
-                leaf = rest[len(buffer) :].lstrip(".")
-                candidates.append((topic, leaf or "value"))
-                break
-    for topic, leaf in candidates:
-        times: list[float] = []
-        values: list[float] = []
-        for _, _, time, data in _messages(path, [topic]):
-            for path_text, value in iter_leaves(data):
-                if path_text == leaf or (leaf and path_text == f"value{leaf}") or path_text == f"value.{leaf}":
-                    times.append(time * 1e-9)
-                    values.append(float(value))
-                    break
-        if times:
-            return subsystem, times, values
-    hint = (
-        f"record its memory with `--record-memory {subsystem}`"
-        if f"{subsystem}/memory" not in available
-        else "check the name against the spec"
-    )
-    raise TraceError(f"the trace has no values for `{name}`; {hint}")
+    wanted: dict[str, tuple[str, str]] = {}  # topic -> (subsystem, prefix of its leaves)
+    owners: list[tuple[str, str, str]] = []  # (name, subsystem, name inside the subsystem)
+    for name in names:
+        subsystem = next((s for s in subsystems if name.startswith(s + ".")), None)
+        if subsystem is None:
+            raise TraceError(
+                f"`{name}` does not start with a subsystem of this trace ({', '.join(sorted(subsystems)) or 'none'})"
+            )
+        owners.append((name, subsystem, name[len(subsystem) + 1 :]))
+        if f"{subsystem}/memory" in available:
+            wanted[f"{subsystem}/memory"] = (subsystem, "")
+        for topic, metadata in available.items():
+            source = metadata.get("source", "")
+            if topic.startswith("link/") and source.startswith(subsystem + "."):
+                wanted.setdefault(topic, (subsystem, source[len(subsystem) + 1 :]))
+        wanted[f"{subsystem}/fsm"] = (subsystem, "")
+    leaves: dict[tuple[str, str], tuple[list[float], list[float]]] = {}
+    stays: dict[str, list[tuple[float, str]]] = {}
+    end = 0.0
+    for topic, _, time, data in _messages(path, [*wanted, "/earl/run"]):
+        seconds = time * 1e-9
+        end = max(end, seconds)
+        if topic == "/earl/run":
+            continue
+        subsystem, buffer = wanted[topic]
+        if topic.endswith("/fsm"):
+            stays.setdefault(subsystem, []).append((seconds, data["to"]))
+            continue
+        for leaf, value in iter_leaves(data):
+            if buffer:
+                leaf = buffer if leaf == "value" else f"{buffer}.{leaf}"
+            found = leaves.get((subsystem, leaf))
+            if found is None:
+                found = leaves[(subsystem, leaf)] = ([], [])
+            found[0].append(seconds)
+            found[1].append(float(value))
+    series: list[Series] = []
+    for name, subsystem, inner in owners:
+        pattern = re.compile(re.escape(inner).replace(r"\[\*\]", r"\[\d+\]") + "$")
+        matched = [
+            Series(subsystem, leaf, times, values)
+            for (owner, leaf), (times, values) in leaves.items()
+            if owner == subsystem and pattern.match(leaf)
+        ]
+        if not matched:
+            hint = (
+                f"record its memory with `--record-memory {subsystem}`"
+                if f"{subsystem}/memory" not in available
+                else "check the name against the spec"
+            )
+            raise TraceError(f"the trace has no values for `{name}`; {hint}")
+        series.extend(sorted(matched, key=lambda item: _natural(item.name)))
+    bands = {
+        subsystem: [
+            (start, changes[i + 1][0] if i + 1 < len(changes) else end, state)
+            for i, (start, state) in enumerate(changes)
+        ]
+        for subsystem, changes in stays.items()
+    }
+    return Signals(series, bands, end)
 
 
-def state_bands(path: Path, subsystem: str, end_time: float) -> list[tuple[float, float, str]]:
-    """(start s, end s, state) for each stay of `subsystem` in an FSM state."""
-    bands: list[tuple[float, float, str]] = []
-    current: tuple[float, str] | None = None
-    for _, _, time, data in _messages(path, [f"{subsystem}/fsm"]):
-        if current is not None:
-            bands.append((current[0], time * 1e-9, current[1]))
-        current = (time * 1e-9, data["to"])
-    if current is not None:
-        bands.append((current[0], end_time, current[1]))
-    return bands
+def _natural(name: str) -> list[object]:
+    """`x[2]` before `x[10]`."""
+    return [int(part) if part.isdigit() else part for part in re.split(r"(\d+)", name)]

@@ -195,7 +195,9 @@ class TypeSystem:
 
                 return real_array
             return lambda value: self.coerce(value, data_type, where)
-        return self._struct_coercer(resolved, data_type, where)
+        if isinstance(resolved, StructType):
+            return self._struct_coercer(resolved, data_type, where)
+        return lambda value: self.coerce(value, data_type, where)
 
     def _struct_coercer(self, struct: StructType, data_type: DataType, where: str) -> Callable[[Any], Value]:
         """A checked Record from a dict or Record; a Record already checked as this struct passes at once."""
@@ -208,7 +210,7 @@ class TypeSystem:
                 return value
             if isinstance(value, Mapping) and len(value) <= count:
                 try:
-                    result = {}
+                    result: dict[str, Value] = {}
                     for field, optional, coerce_field in fields:
                         item = value.get(field)
                         if item is None:
