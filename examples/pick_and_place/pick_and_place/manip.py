@@ -89,11 +89,14 @@ class _Controller:
             model.current_limit,
         )
 
-    def finished(self, measured: Vector, elapsed: float, duration: float) -> bool:
+    def finished(self, measured: Vector, elapsed: float, duration: float, converged: bool = True) -> bool:
+        """The trajectory has ended and the arm is at its goal — or it has had SETTLE_TIMEOUT to get there."""
         if elapsed < duration:
             return False
+        if elapsed >= duration + SETTLE_TIMEOUT:
+            return True
         error = np.max(np.abs(self.goal - self.model.motor_to_joint(measured)))
-        return bool(error < JOINT_TOLERANCE or elapsed >= duration + SETTLE_TIMEOUT)
+        return converged and bool(error < JOINT_TOLERANCE)
 
 
 def _controller(context: Any, measured: Vector) -> _Controller | None:
@@ -172,8 +175,9 @@ def operational_move(inputs: Any, outputs: Any, context: Any) -> None:
     # the goal, for `finished`, is where the reference ends up once the line is done
     controller.goal = reference
     _write_currents(outputs, controller.currents(measured, np.zeros(n), context.period))
-    converged = elapsed >= trajectory.duration and bool(np.max(np.abs(reference - previous)) < 1e-6)
-    outputs.motionFinished = converged and controller.finished(measured, elapsed, trajectory.duration)
+    # the inverse kinematics has converged when its steps have become negligible
+    converged = bool(np.max(np.abs(reference - previous)) < 1e-6)
+    outputs.motionFinished = controller.finished(measured, elapsed, trajectory.duration, converged)
 
 
 def passive_regulation(inputs: Any, outputs: Any, context: Any) -> None:
