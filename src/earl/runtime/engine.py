@@ -126,14 +126,14 @@ class SubsystemEngine:
     def execute_and_send(self, time: int) -> None:
         state = self.state
         assert state is not None
-        behaviour = state.behaviour
         context = self.context
         self.iteration_start = time
         self._error_in_iteration = False
         memory = self.memory
         sent: dict[str, Any] = {}
-        for stage in behaviour.stages:
-            stage_memory: dict[str, Any] = {}
+        for stage in state.behaviour.stages:
+            # one function alone in its stage may write memory at once: there is nobody to isolate
+            stage_memory: dict[str, Any] = memory if len(stage) == 1 else {}
             for function in stage:
                 outputs = function.outputs
                 inputs = function.inputs
@@ -154,7 +154,7 @@ class SubsystemEngine:
                     sent.update(written)
                     written.clear()
             # the stage's writes become visible only now: no function saw another's (Eq. 7-8)
-            if stage_memory:
+            if stage_memory and stage_memory is not memory:
                 memory.update(stage_memory)
         if sent:
             self._send(time, sent)
