@@ -251,11 +251,21 @@ def test_sarif_output(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> Non
         assert rules[result["ruleIndex"]]["id"] == result["ruleId"]
         assert result["message"]["text"]
         physical = result["locations"][0]["physicalLocation"]
-        assert physical["artifactLocation"]["uri"] == str(spec)
+        assert physical["artifactLocation"]["uri"] == spec.as_uri()
     region = results[1]["locations"][0]["physicalLocation"]["region"]
     assert (region["startLine"], region["startColumn"]) == (20, 13)
     # SARIF's endColumn is the column after the region, as earl's end columns are
     assert (region["endLine"], region["endColumn"]) == (20, 13 + len("run -> other when go/pp"))
+
+
+def test_sarif_names_a_relative_file_relative(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    write(tmp_path, ERROR)
+    monkeypatch.chdir(tmp_path)
+    _, log = sarif(capsys, Path("spec.earl"))
+    uris = {r["locations"][0]["physicalLocation"]["artifactLocation"]["uri"] for r in log["runs"][0]["results"]}
+    assert uris == {"spec.earl"}
 
 
 def test_sarif_output_of_a_clean_spec_still_describes_the_rules(

@@ -23,7 +23,7 @@ from earl.model.expressions import ElementReference, Literal, Name
 from earl.model.kinds import Kind
 from earl.model.location import SourceLocation
 from earl.model.tables import AgentType, agent_type
-from earl.model.types import ArrayType, DataType, PrimitiveType, StructType, TypeReference
+from earl.model.types import ArrayType, DataType, PrimitiveType, StructType, TypeDefinition, TypeReference
 
 
 def instance_name(name: str, index: int | None) -> str:
@@ -134,6 +134,7 @@ class CheckContext:
     _output_tables: dict[int, dict[MemberKey, OutputBuffer]] = field(default_factory=dict)
     _input_tables: dict[int, dict[MemberKey, InputBuffer]] = field(default_factory=dict)
     _memory_tables: dict[int, dict[MemberKey, Memory]] = field(default_factory=dict)
+    _same_types: dict[tuple[int, int], tuple[DataType, DataType, bool]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         self._agents = {(a.name, a.index): a for a in reversed(self.system.agents)}
@@ -297,18 +298,31 @@ class CheckContext:
         return agent_type(effectors, receptors, transmission)
 
     # ------------------------------------------------------------------ data types
+    @cached_property
+    def _types(self) -> dict[str, TypeDefinition]:
+        return {t.name: t for t in reversed(self.system.types)}
+
     def structural(self, data_type: DataType) -> DataType | StructType:
         """The type behind aliases (the resolver guarantees the chain ends)."""
         seen = 0
         while isinstance(data_type, TypeReference) and seen < 1000:
             seen += 1
-            definition = self.system.type_named(data_type.name)
+            definition = self._types.get(data_type.name)
             if definition is None or isinstance(definition, StructType):
                 return definition if definition is not None else data_type
             data_type = definition.data_type
         return data_type
 
     def same_type(self, first: DataType, second: DataType) -> bool:
+        # Members of a family share their buffers' type objects: each pair is compared once.
+        # The pair is kept with the answer, so that neither id can be reused by another object.
+        key = (id(first), id(second))
+        known = self._same_types.get(key)
+        if known is None:
+            known = self._same_types[key] = (first, second, self._same_type(first, second))
+        return known[2]
+
+    def _same_type(self, first: DataType, second: DataType) -> bool:
         a, b = self.structural(first), self.structural(second)
         if isinstance(a, StructType) or isinstance(b, StructType):
             return a is b

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 from collections.abc import Sequence
+from pathlib import Path, PurePath
 from typing import Any
 
 from earl import __version__
@@ -34,6 +35,13 @@ def as_json(diagnostics: Sequence[Diagnostic]) -> str:
     )
 
 
+def artifact_uri(file: str) -> str:
+    """SARIF names files by URI: a relative path stays relative (code-scanning tools resolve it against
+    the repository), an absolute one becomes a `file://` URI."""
+    path = PurePath(file)
+    return Path(file).as_uri() if path.is_absolute() else path.as_posix()
+
+
 def as_sarif(diagnostics: Sequence[Diagnostic]) -> str:
     """A SARIF 2.1.0 log with one run; every registered rule is described in the tool's driver."""
     rules = [
@@ -62,7 +70,7 @@ def as_sarif(diagnostics: Sequence[Diagnostic]) -> str:
             result["locations"] = [
                 {
                     "physicalLocation": {
-                        "artifactLocation": {"uri": d.location.file},
+                        "artifactLocation": {"uri": artifact_uri(d.location.file)},
                         "region": {
                             "startLine": d.location.line,
                             "startColumn": d.location.column,
