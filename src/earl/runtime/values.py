@@ -46,14 +46,7 @@ class Record(dict[str, Any]):
     mutating method is refused, which is what lets one snapshot serve a whole stage.
     """
 
-    #: the struct this value was checked against; a value of that struct is accepted again at once
-    __slots__ = ("_struct",)
-
-    @classmethod
-    def of(cls, struct: str, fields: dict[str, Any]) -> Record:
-        record = cls(fields)
-        object.__setattr__(record, "_struct", struct)
-        return record
+    __slots__ = ()
 
     def __getattr__(self, name: str) -> Any:
         try:
@@ -78,7 +71,7 @@ class Record(dict[str, Any]):
         return Record(merged)  # unchecked: the runtime checks it when it is written
 
     def __repr__(self) -> str:
-        return "Record(" + ", ".join(f"{k}={v!r}" for k, v in self.items()) + ")"
+        return f"{type(self).__name__}(" + ", ".join(f"{k}={v!r}" for k, v in self.items()) + ")"
 
 
 class ValueTypeError(TypeError):
@@ -91,6 +84,7 @@ class TypeSystem:
     def __init__(self, system: System) -> None:
         self._definitions: dict[str, StructType | TypeAlias] = {t.name: t for t in system.types}
         self._defaults: dict[str, Value] = {}
+        self._record_classes: dict[str, type[Record]] = {}
 
     def resolve(self, data_type: DataType) -> PrimitiveType | ArrayType | StructType:
         """Follow `type` aliases to a primitive, an array or a struct."""
@@ -154,7 +148,7 @@ class TypeSystem:
                     continue
                 raise ValueTypeError(f"{where}: the field `{name}` of `{resolved.name}` is missing")
             result[name] = self.coerce(value[name], declared.data_type, f"{where}.{name}")
-        return Record.of(resolved.name, result)
+        return self.record_class(resolved.name)(result)
 
     def coercer(self, data_type: DataType, where: str) -> Callable[[Any], Value]:
         """`coerce` for one type, with a fast path for the values user code writes most (floats, ints, Booleans)."""
@@ -199,33 +193,59 @@ class TypeSystem:
             return self._struct_coercer(resolved, data_type, where)
         return lambda value: self.coerce(value, data_type, where)
 
+    def record_class(self, struct: str) -> type[Record]:
+        """The Record subclass of one struct: a value of that class was checked already and passes at once."""
+        found = self._record_classes.get(struct)
+        if found is None:
+            found = self._record_classes[struct] = type(struct, (Record,), {"__slots__": ()})
+        return found
+
     def _struct_coercer(self, struct: StructType, data_type: DataType, where: str) -> Callable[[Any], Value]:
-        """A checked Record from a dict or Record; a Record already checked as this struct passes at once."""
-        name = struct.name
-        fields = [(f.name, f.optional, self.coercer(f.data_type, f"{where}.{f.name}")) for f in struct.fields]
-        count = len(fields)
+        """A checked Record of `struct` from a dict or Record, compiled once per struct and place.
 
-        def coerce_struct(value: Any) -> Value:
-            if type(value) is Record and getattr(value, "_struct", None) == name:
-                return value
-            if isinstance(value, Mapping) and len(value) <= count:
-                try:
-                    result: dict[str, Value] = {}
-                    for field, optional, coerce_field in fields:
-                        item = value.get(field)
-                        if item is None:
-                            if not optional:
-                                raise ValueTypeError(field)
-                            result[field] = None
-                        else:
-                            result[field] = coerce_field(item)
-                    if len(value) == count or all(key in result for key in value):
-                        return Record.of(name, result)
-                except ValueTypeError:
-                    pass
-            return self.coerce(value, data_type, where)  # the precise message
-
-        return coerce_struct
+        The generated function tests each field inline (a float that is not NaN, a bool, an int
+        in range) and calls the field's own checker otherwise; anything unusual goes to `coerce`,
+        which says precisely what is wrong.
+        """
+        cls = self.record_class(struct.name)
+        names: dict[str, Any] = {"cls": cls, "dict": dict, "float": float, "bool": bool, "int": int}
+        names["slow"] = lambda value: self.coerce(value, data_type, where)
+        lines = [
+            "def coerce_struct(value):",
+            "    if type(value) is cls:",
+            "        return value",
+            f"    if type(value) is not dict or len(value) != {len(struct.fields)}:",
+            "        return slow(value)",
+        ]
+        items = []
+        for position, field in enumerate(struct.fields):
+            variable = f"v{position}"
+            lines.append(f"    {variable} = value.get({field.name!r})")
+            resolved = self.resolve(field.data_type)
+            primitive = resolved.name if isinstance(resolved, PrimitiveType) else None
+            test: str
+            if primitive in _REAL_TYPES:
+                test = f"type({variable}) is float and {variable} == {variable}"
+            elif primitive == "boolean":
+                test = f"type({variable}) is bool"
+            elif primitive in _INTEGER_RANGES:
+                low, high = _INTEGER_RANGES[primitive]
+                test = f"type({variable}) is int and {low} <= {variable} <= {high}"
+            else:
+                names[f"c{position}"] = self.coercer(field.data_type, f"{where}.{field.name}")
+                lines.append(f"    if {variable} is not None:")
+                lines.append(f"        try:\n            {variable} = c{position}({variable})")
+                lines.append("        except Exception:\n            return slow(value)")
+                test = "True" if field.optional else f"{variable} is not None"
+            if field.optional:
+                test = f"({variable} is None or ({test}))"
+            lines.append(f"    if not ({test}):")
+            lines.append("        return slow(value)")
+            items.append(f"{field.name!r}: {variable}")
+        lines.append("    return cls({" + ", ".join(items) + "})")
+        exec("\n".join(lines), names)  # the source is generated from the spec's own type definitions
+        function: Callable[[Any], Value] = names["coerce_struct"]
+        return function
 
     def constant(self, expression: Any, data_type: DataType, where: str) -> Value:
         """The value of an expanded constant expression (a memory's initial value)."""
