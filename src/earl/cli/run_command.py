@@ -29,6 +29,12 @@ examples:
 
 Subsystems are named like manip/a.cs or manip/a.motorController[3]/ve. A `run.toml` next
 to the spec may set defaults: environment, duration, seed, record_memory, report.
+`--environment none` runs without it (a process whose agents have no physics).
+
+distributed (docs/distributed.md):
+  earl run examples/pick_and_place --transport zenoh --agents task/a
+                        this process runs task/a; deploy.toml next to the spec says
+                        where the other agents' processes listen (earl launch starts all)
 The spec is checked first; its errors stop the run. Only `earl run` imports the Python
 code a spec names (docs/runtime.md).
 
@@ -84,6 +90,36 @@ def register(commands: Any) -> None:
         metavar="SIGNAL",
         help="a signal for --plot, e.g. 'manip/a.cs.windingCurrent[*]' (repeatable; see `earl plot --help`)",
     )
+    parser.add_argument(
+        "--agents",
+        metavar="A,B",
+        help="run only these agents, e.g. manip/a,grip/a (with --transport zenoh the others run in other processes)",
+    )
+    parser.add_argument(
+        "--transport",
+        choices=["inproc", "zenoh"],
+        default="inproc",
+        help="zenoh: links to agents of other processes go over Eclipse Zenoh (implies --realtime); "
+        "see docs/distributed.md",
+    )
+    parser.add_argument(
+        "--deployment",
+        metavar="deploy.toml",
+        help="with --transport zenoh: the processes and their endpoints (default: deploy.toml next to the spec)",
+    )
+    parser.add_argument(
+        "--zenoh-config",
+        metavar="FILE",
+        help="with --transport zenoh: your own Zenoh configuration (JSON5), used unchanged instead of the endpoints "
+        "of the deployment file (routers, TLS, other hosts)",
+    )
+    parser.add_argument(
+        "--wait-for-peers",
+        metavar="TIME",
+        default="30s",
+        help="with --transport zenoh: wait at most this long for the agents of other processes before starting "
+        "(default 30s); missing ones start out stale",
+    )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.set_defaults(run=run)
 
@@ -108,9 +144,24 @@ def run(arguments: argparse.Namespace) -> int:
     if arguments.plot and not arguments.trace:
         arguments.trace = str(Path(arguments.plot).with_suffix(".mcap"))
     environment = arguments.environment or settings.environment
+    no_environment = environment == "none"
+    if no_environment:
+        environment = None
+    agents = [a.strip() for a in arguments.agents.split(",") if a.strip()] if arguments.agents else None
+    if arguments.transport == "zenoh":
+        if not agents:
+            return usage_error("--transport zenoh needs --agents: the agents this process runs, e.g. task/a")
+        arguments.realtime = True  # distribution runs in real time only (docs/distributed.md)
+    elif arguments.zenoh_config or arguments.deployment:
+        return usage_error("--zenoh-config and --deployment go with --transport zenoh")
     record_memory = arguments.record_memory if arguments.record_memory is not None else settings.record_memory
+    transport: Any = None
     try:
         system = load(path, parameters)
+        if arguments.transport == "zenoh":
+            from earl.transport.process import open_transport
+
+            agents, transport = open_transport(system, parameters, path, agents or [], arguments)
         simulation = Simulation(
             system,
             parameters=parameters,
@@ -120,16 +171,34 @@ def run(arguments: argparse.Namespace) -> int:
             record_memory=record_memory,
             record_links=arguments.record_links if arguments.record_links is not None else settings.record_links,
             realtime=arguments.realtime,
+            agents=agents,
+            transport=transport,
         )
     except EarlError as error:
+        _close(transport)
         print_diagnostics(error.diagnostics, error.sources)
         print("earl run: the specification cannot run; nothing was executed", file=sys.stderr)
         return EXIT_FAILED
     except ValueError as error:
+        _close(transport)
         return usage_error(str(error))
     except OSError as error:
+        _close(transport)
         return usage_error(f"cannot write the trace: {error}")
-    return _execute(simulation, duration, arguments, settings.report, path)
+    except RuntimeError as error:  # the transport could not start
+        _close(transport)
+        print(f"earl run: {error}", file=sys.stderr)
+        return EXIT_FAILED
+    if transport is not None:
+        from earl.transport.process import wait_for_peers
+
+        wait_for_peers(transport, arguments)
+    return _execute(simulation, duration, arguments, None if no_environment else settings.report, path)
+
+
+def _close(transport: Any) -> None:
+    if transport is not None:
+        transport.close()
 
 
 def _execute(simulation: Any, duration: float, arguments: argparse.Namespace, report: str | None, path: Path) -> int:
@@ -170,6 +239,10 @@ def _execute(simulation: Any, duration: float, arguments: argparse.Namespace, re
         simulation.close()
         signal.signal(signal.SIGTERM, previous)
     _summary(simulation, wall, arguments)
+    if simulation.transport is not None:
+        from earl.transport.process import print_link_statistics
+
+        print_link_statistics(simulation.transport)
     if arguments.plot:
         _plot(arguments, console)
     if report:

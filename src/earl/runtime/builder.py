@@ -10,7 +10,7 @@ from __future__ import annotations
 import zlib
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 from earl.diagnostics import Diagnostic, EarlError, Severity
 from earl.model.elements import Agent, Link, LinkEnd, Subsystem, System
@@ -23,6 +23,7 @@ from earl.runtime.engine import (
     BehaviourRuntime,
     Destination,
     FunctionRuntime,
+    Sink,
     StateRuntime,
     SubsystemEngine,
     TransitionRuntime,
@@ -40,6 +41,20 @@ def to_nanoseconds(seconds: float) -> int:
     return round(seconds * NANOSECONDS)
 
 
+class RemoteLinks(Protocol):
+    """A transport that serves the links whose other end runs in another process (docs/distributed.md)."""
+
+    def outgoing(self, link: str, data_type: DataType, types: TypeSystem, source: str, destination_agent: str) -> Sink:
+        """Where the messages of a link to `destination_agent`, a remote agent, go."""
+        ...
+
+    def incoming(
+        self, link: str, data_type: DataType, types: TypeSystem, engine: SubsystemEngine, buffer: str, source_agent: str
+    ) -> None:
+        """Feed `engine`'s input buffer `buffer` from a link whose sender, `source_agent`, is remote."""
+        ...
+
+
 class Network:
     """The engines of a run, in their deterministic order, and how to find them by name."""
 
@@ -53,6 +68,7 @@ class Network:
         self.link_types: dict[str, DataType] = {}
         self.memory_types: dict[str, dict[str, DataType]] = {}
         self.output_types: dict[str, dict[str, DataType]] = {}
+        self.input_types: dict[str, dict[str, DataType]] = {}
         #: link name -> `subsystem.outputBuffer` it carries, so a trace can be read by buffer name
         self.link_sources: dict[str, str] = {}
 
@@ -65,8 +81,13 @@ def build_network(
     seed: int = 0,
     code_directories: list[Path] | None = None,
     agents: set[str] | None = None,
+    remote: RemoteLinks | None = None,
 ) -> Network:
-    """Engines for every subsystem of the expanded `system` (of the agents named in `agents`, if given)."""
+    """Engines for every subsystem of the expanded `system` (of the agents named in `agents`, if given).
+
+    With `remote`, a link with one end built here and the other in an agent not built here
+    goes through that transport; without it, such a link is left out.
+    """
     types = TypeSystem(system)
     network = Network(types)
     problems: list[Diagnostic] = []
@@ -104,14 +125,17 @@ def build_network(
                 network.output_types[engine.name] = {
                     indexed(o.name, o.index): o.data_type for o in subsystem.output_buffers
                 }
+                network.input_types[engine.name] = {
+                    indexed(i.name, i.index): i.data_type for i in subsystem.input_buffers
+                }
                 keys[(agent.name, agent.index, subsystem.kind, subsystem.name, subsystem.index)] = engine
                 if subsystem.fsm is not None:
                     network.initial_states[engine.name] = subsystem.fsm.initial
     for agent in system.agents:
         for link in agent.links:
-            _connect(link, agent, keys, network, problems)
+            _connect(link, agent, keys, network, problems, remote)
     for link in system.links:
-        _connect(link, None, keys, network, problems)
+        _connect(link, None, keys, network, problems, remote)
     if problems:
         raise EarlError(problems, system.sources)  # type: ignore[arg-type]
     return network
@@ -304,11 +328,14 @@ def _connect(
     keys: dict[tuple[str, int | None, Kind, str, int | None], SubsystemEngine],
     network: Network,
     problems: list[Diagnostic],
+    remote: RemoteLinks | None = None,
 ) -> None:
     source = _end_engine(link.source, agent, keys)
     destination = _end_engine(link.destination, agent, keys)
     if source is None or destination is None:
-        return  # an end that runs elsewhere (another process) or was not built
+        if remote is not None and (source is None) != (destination is None):
+            _connect_remote(link, agent, source, destination, network, remote)
+        return  # otherwise an end that runs elsewhere (another process) or was not built
     buffer = reference_key(link.destination.buffer)
     channel = destination.channels.get(buffer)
     if channel is None:
@@ -321,11 +348,7 @@ def _connect(
             )
         )
         return
-    name = link.name_text
-    if agent is not None:
-        name = f"{agent_name(agent)}:{name}"
-    if link.index is not None and "[" not in name:
-        name = f"{name}[{link.index}]"
+    name = _link_name(link, agent)
     network.links.append(name)
     source_buffer = reference_key(link.source.buffer)
     data_type = network.output_types.get(source.name, {}).get(source_buffer)
@@ -335,3 +358,49 @@ def _connect(
     source.destinations.setdefault(reference_key(link.source.buffer), []).append(
         Destination(name, channel, destination, buffer)
     )
+
+
+def _link_name(link: Link, agent: Agent | None) -> str:
+    name = link.name_text
+    if agent is not None:
+        name = f"{agent_name(agent)}:{name}"
+    if link.index is not None and "[" not in name:
+        name = f"{name}[{link.index}]"
+    return name
+
+
+def _end_agent(end: LinkEnd, agent: Agent | None) -> str:
+    """The name (`task/a`) of the agent at one end of a link."""
+    if end.agent is not None:
+        return f"{indexed(end.agent.name, _index(end.agent))}/a"
+    return agent_name(agent) if agent is not None else ""
+
+
+def _connect_remote(
+    link: Link,
+    agent: Agent | None,
+    source: SubsystemEngine | None,
+    destination: SubsystemEngine | None,
+    network: Network,
+    remote: RemoteLinks,
+) -> None:
+    """A link with one end here and the other in another process: the transport carries it."""
+    name = _link_name(link, agent)
+    if source is not None:
+        source_buffer = reference_key(link.source.buffer)
+        data_type = network.output_types.get(source.name, {}).get(source_buffer)
+        if data_type is None:
+            return  # the checker reports a link from a buffer that does not exist
+        sink = remote.outgoing(name, data_type, network.types, source.name, _end_agent(link.destination, agent))
+        network.links.append(name)
+        network.link_types[name] = data_type
+        network.link_sources[name] = f"{source.name}.{source_buffer}"
+        source.destinations.setdefault(source_buffer, []).append(
+            Destination(name, sink, None, reference_key(link.destination.buffer))
+        )
+    elif destination is not None:
+        buffer = reference_key(link.destination.buffer)
+        data_type = network.input_types.get(destination.name, {}).get(buffer)
+        if data_type is None:
+            return
+        remote.incoming(name, data_type, network.types, destination, buffer, _end_agent(link.source, agent))

@@ -19,7 +19,7 @@ from __future__ import annotations
 import traceback
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Protocol
 
 from earl.runtime.binding import UserFunction
 from earl.runtime.channels import Channel
@@ -66,13 +66,23 @@ class StateRuntime:
     transitions: list[TransitionRuntime]
 
 
+class Sink(Protocol):
+    """What a send hands a message to: a local input buffer's `Channel`, or a remote link's publisher."""
+
+    def deliver(self, value: Any) -> None: ...
+
+
 @dataclass
 class Destination:
-    """Where an output buffer's messages go: an input buffer's channel, and the engine that owns it."""
+    """Where an output buffer's messages go: an input buffer's channel, and the engine that owns it.
+
+    A link whose input buffer runs in another process has no local engine (`None`) and a
+    transport's sink for a channel (docs/distributed.md).
+    """
 
     link: str
-    channel: Channel
-    engine: SubsystemEngine
+    channel: Channel | Sink
+    engine: SubsystemEngine | None
     buffer: str
 
 
@@ -109,6 +119,8 @@ class SubsystemEngine:
         self._error_in_iteration = False
         self._stuck = False
         self._timeouts_set = False
+        #: input buffers whose remote sender is gone (docs/distributed.md): `timeout(x/ib)` reads true
+        self.stale: set[str] = set()
         #: set by the scheduler: called when a message reaches an obligatory buffer this engine waits for
         self.on_delivery: Callable[[SubsystemEngine], None] | None = None
         self.waiting = False
@@ -168,7 +180,7 @@ class SubsystemEngine:
                 destination.channel.deliver(value)
                 recorder.message_sent(time, destination.link, value)
                 engine = destination.engine
-                if engine.waiting and engine.on_delivery is not None:
+                if engine is not None and engine.waiting and engine.on_delivery is not None:
                     engine.on_delivery(engine)
 
     def _function_fault(self, time: int, function: str, error: Exception) -> None:
@@ -235,6 +247,11 @@ class SubsystemEngine:
                 flag = flags[key] = timed_out and key in obligatory and not new_data[key]
                 any_set = any_set or flag
             self._timeouts_set = any_set
+        if self.stale:
+            # a stale buffer reads as timed out until its sender returns (the language has no stale() yet)
+            for key in self.stale:
+                self.timed_out[key] = True
+            self._timeouts_set = True
 
     # ------------------------------------------------------------------ Figure 5b, step 5 and Figure 5a
     def _evaluate(self, time: int, predicate: CompiledPredicate, what: str) -> bool:

@@ -23,7 +23,7 @@ import heapq
 import time as wall
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Protocol
 
 from earl.runtime.builder import Network
 from earl.runtime.engine import SubsystemEngine
@@ -40,6 +40,19 @@ class Lateness:
     overruns: int = 0
 
 
+class Inbox(Protocol):
+    """Messages from other processes, received on another thread (docs/distributed.md, "Scheduling")."""
+
+    @property
+    def pending(self) -> bool: ...
+
+    def wait(self, seconds: float) -> None:
+        """Sleep at most `seconds`; return early when something arrives."""
+
+    def drain(self, time: int) -> None:
+        """Deliver what arrived, in this (the scheduler's) thread, at run time `time`."""
+
+
 class Scheduler:
     """Runs a network of subsystem engines; `advance_to(t)` runs everything due until `t`."""
 
@@ -52,6 +65,7 @@ class Scheduler:
         realtime: bool = False,
         record_memory: set[str] | None = None,
         clock: Callable[[], int] = wall.perf_counter_ns,
+        inbox: Inbox | None = None,
     ) -> None:
         self.network = network
         self.recorder = recorder
@@ -69,6 +83,8 @@ class Scheduler:
         self._wall_start = 0
         self.lateness: dict[str, Lateness] = {}
         self.started = False
+        #: messages from other processes; only real-time runs have one
+        self.inbox = inbox
 
     # ------------------------------------------------------------------ start
     def start(self) -> None:
@@ -92,6 +108,9 @@ class Scheduler:
         """Run every event due at or before `until` (ns); `now` is `until` afterwards."""
         if not self.started:
             self.start()
+        if self.inbox is not None:
+            self._advance_with_inbox(until, self.inbox, should_stop)
+            return
         queue = self._queue
         pop = heapq.heappop
         advance = self._advance
@@ -131,6 +150,55 @@ class Scheduler:
         if advance is not None and self.now > self._environment_time:
             self._environment_time = self.now
             advance(self.now * 1e-9)
+
+    def _advance_with_inbox(self, until: int, inbox: Inbox, should_stop: Callable[[], bool] | None) -> None:
+        """Real time with messages from other processes: wait on the wall clock for the next event *or* a
+        message, whichever comes first, so that a remote message wakes a subsystem waiting for it at once.
+        Unlike the local loop it waits until `until` itself, since the next event may be a message."""
+        queue = self._queue
+        pop = heapq.heappop
+        advance = self._advance
+        tokens = self._tokens
+        while True:
+            if should_stop is not None and should_stop():
+                return
+            if inbox.pending:
+                # a message arriving now is handled at the wall-clock instant it was received
+                self.now = max(self.now, min(self.clock() - self._wall_start, until))
+                inbox.drain(self.now)
+            due = queue[0][0] if queue and queue[0][0] <= until else until
+            if not self._sleep_until(due, inbox):
+                continue  # something arrived first
+            if not queue or queue[0][0] > until:
+                break
+            time, _, _, kind, engine, token = pop(queue)
+            self.now = time
+            if advance is not None and time > self._environment_time:
+                self._environment_time = time
+                advance(time * 1e-9)
+            if kind == _START:
+                self._record_lateness(time, engine)
+                following = self._start(engine, time)
+                if following is not None:
+                    self._push(following, engine, _START)
+            elif engine.waiting and token == tokens[engine.name]:
+                self._push(self._finish(engine, time, timed_out=kind == _TIMEOUT), engine, _START)
+        self.now = max(self.now, until)
+        if advance is not None and self.now > self._environment_time:
+            self._environment_time = self.now
+            advance(self.now * 1e-9)
+
+    def _sleep_until(self, time: int, inbox: Inbox) -> bool:
+        """Wait until run time `time` on the wall clock; False as soon as a message is pending."""
+        due = self._wall_start + time
+        while True:
+            if inbox.pending:
+                return False
+            remaining = due - self.clock()
+            if remaining <= 0:
+                return True
+            if remaining > 300_000:
+                inbox.wait((remaining - 200_000) * 1e-9)
 
     def _start(self, engine: SubsystemEngine, time: int) -> int | None:
         """One iteration from START; the time of the next START, or None while the engine waits."""
@@ -177,20 +245,23 @@ class Scheduler:
         while self.clock() < due:
             pass
         if kind == _START:
-            late = self.clock() - due
-            record = self.lateness.get(engine.name)
-            if record is None:
-                record = self.lateness[engine.name] = Lateness()
-            record.samples.append(late)
-            if engine.period is not None and late > engine.period:
-                record.overruns += 1
-                if record.overruns == 1:
-                    engine.report_fault(
-                        time,
-                        "deadline",
-                        f"an iteration started {late / 1e6:.3f} ms late, more than its period "
-                        f"({engine.period / 1e6:g} ms); further overruns are only counted",
-                    )
+            self._record_lateness(time, engine)
+
+    def _record_lateness(self, time: int, engine: SubsystemEngine) -> None:
+        late = self.clock() - (self._wall_start + time)
+        record = self.lateness.get(engine.name)
+        if record is None:
+            record = self.lateness[engine.name] = Lateness()
+        record.samples.append(late)
+        if engine.period is not None and late > engine.period:
+            record.overruns += 1
+            if record.overruns == 1:
+                engine.report_fault(
+                    time,
+                    "deadline",
+                    f"an iteration started {late / 1e6:.3f} ms late, more than its period "
+                    f"({engine.period / 1e6:g} ms); further overruns are only counted",
+                )
 
     @property
     def next_event_time(self) -> int | None:

@@ -16,15 +16,15 @@ import tomllib
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 from earl.diagnostics import Diagnostic, EarlError, Severity
 from earl.model.elements import System
 from earl.model.expand import expand
 from earl.runtime.binding import BindingProblem, resolve_callable, user_code_path
-from earl.runtime.builder import NANOSECONDS, Network, build_network, to_nanoseconds
+from earl.runtime.builder import NANOSECONDS, Network, RemoteLinks, build_network, to_nanoseconds
 from earl.runtime.events import Fault, Recorder, Recorders, StatisticsRecorder
-from earl.runtime.scheduler import Scheduler
+from earl.runtime.scheduler import Inbox, Scheduler
 from earl.runtime.trace import TraceWriter
 
 ParameterValue = bool | int | float | str
@@ -45,6 +45,18 @@ class SubsystemState:
     iterations: int
     faults: int
     waiting: bool
+
+
+class Transport(RemoteLinks, Protocol):
+    """Links to agents in other processes (earl.transport.zenoh_transport.ZenohTransport)."""
+
+    @property
+    def inbox(self) -> Inbox: ...
+
+    def start(self) -> None:
+        """Every link is declared: announce this process's agents."""
+
+    def close(self) -> None: ...
 
 
 class _FaultList(Recorder):
@@ -72,8 +84,11 @@ class Simulation:
         check: bool = True,
         agents: list[str] | None = None,
         recorders: list[Recorder] | None = None,
+        transport: Transport | None = None,
     ) -> None:
         parameters = dict(parameters or {})
+        if transport is not None and not realtime:
+            raise ValueError("a run over a transport between processes runs in real time only (realtime=True)")
         if check:
             _check(system, parameters)
         self.system = system
@@ -92,7 +107,11 @@ class Simulation:
             seed=seed,
             code_directories=directories,
             agents=set(agents) if agents else None,
+            remote=transport,
         )
+        self.transport = transport
+        if transport is not None:
+            transport.start()
         memory = set(record_memory or [])
         if "all" in memory:
             memory = set(self.network.by_name)
@@ -117,7 +136,12 @@ class Simulation:
                 {"system": system.name, "seed": seed, "parameters": parameters, "realtime": realtime}
             )
         self.scheduler = Scheduler(
-            self.network, self.recorder, self.environment, realtime=realtime, record_memory=memory
+            self.network,
+            self.recorder,
+            self.environment,
+            realtime=realtime,
+            record_memory=memory,
+            inbox=None if transport is None else transport.inbox,
         )
         self.closed = False
 
@@ -148,6 +172,8 @@ class Simulation:
         close = getattr(self.environment, "close", None)
         if callable(close):
             close()
+        if self.transport is not None:
+            self.transport.close()
 
     def __enter__(self) -> Simulation:
         return self

@@ -1,0 +1,144 @@
+"""The deployment file: which agents run together in one process, and where it listens.
+
+    # deploy.toml
+    [[process]]
+    agents = ["manip/a", "grip/a"]       # run together in one OS process
+    listen = "tcp/127.0.0.1:7451"        # its Zenoh endpoint; every other process connects to it
+    environment = true                   # the run.toml environment (physics) lives here (default true)
+
+    [[process]]
+    agents = ["task/a"]
+    listen = "tcp/127.0.0.1:7452"
+    environment = false
+    host = "localhost"                   # `earl launch` starts only this host's processes
+    args = ["--trace", "task.mcap"]      # more `earl run` options for this process
+
+Every agent of the system must be in exactly one process (docs/distributed.md).
+"""
+
+from __future__ import annotations
+
+import socket
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+LOCAL_HOSTS = frozenset({"localhost", "127.0.0.1", "::1"})
+
+
+class DeploymentError(ValueError):
+    """The deployment file cannot be used; the message names the file and what is wrong."""
+
+
+@dataclass(frozen=True)
+class ProcessGroup:
+    """One OS process: the agents it runs and its Zenoh endpoint."""
+
+    agents: tuple[str, ...]
+    listen: str
+    environment: bool = True
+    host: str = "localhost"
+    args: tuple[str, ...] = ()
+
+    @property
+    def label(self) -> str:
+        return ",".join(self.agents)
+
+    @property
+    def is_local(self) -> bool:
+        return self.host in LOCAL_HOSTS or self.host in {socket.gethostname(), socket.getfqdn()}
+
+
+@dataclass(frozen=True)
+class Deployment:
+    path: Path
+    processes: tuple[ProcessGroup, ...] = field(default_factory=tuple)
+
+    def group_of(self, agents: list[str]) -> ProcessGroup:
+        """The process that runs exactly `agents` (in any order)."""
+        wanted = {normalise_agent(a) for a in agents}
+        for process in self.processes:
+            if set(process.agents) == wanted:
+                return process
+        known = "; ".join(process.label for process in self.processes)
+        raise DeploymentError(
+            f"{self.path}: no process runs exactly the agents {', '.join(sorted(wanted))} (its processes: {known})"
+        )
+
+    def connect_for(self, process: ProcessGroup) -> list[str]:
+        """The endpoints `process` connects to: every other process's."""
+        return [other.listen for other in self.processes if other is not process]
+
+    def check_agents(self, system_agents: list[str]) -> None:
+        """Every agent of the system runs in one process, and the file names no other."""
+        deployed = [agent for process in self.processes for agent in process.agents]
+        unknown = sorted(set(deployed) - set(system_agents))
+        if unknown:
+            raise DeploymentError(
+                f"{self.path}: `{unknown[0]}` is not an agent of this system (its agents: {', '.join(system_agents)})"
+            )
+        missing = [agent for agent in system_agents if agent not in deployed]
+        if missing:
+            raise DeploymentError(
+                f"{self.path}: the agent `{missing[0]}` runs in no process; add it to a process's `agents`"
+            )
+
+
+def normalise_agent(name: str) -> str:
+    """`task` and `task/a` both name the agent `task/a`."""
+    name = name.strip()
+    return name if name.endswith("/a") else f"{name}/a"
+
+
+def read_deployment(path: Path) -> Deployment:
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as error:
+        raise DeploymentError(f"cannot read the deployment file {path}: {error.strerror or error}") from None
+    except UnicodeDecodeError:
+        raise DeploymentError(f"{path}: not UTF-8 text") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as error:
+        raise DeploymentError(f"{path}: not valid TOML: {error}") from None
+    unknown = sorted(set(data) - {"process"})
+    if unknown:
+        raise DeploymentError(f"{path}: unknown setting `{unknown[0]}` (a deployment has `[[process]]` tables)")
+    tables = data.get("process")
+    if not isinstance(tables, list) or not tables:
+        raise DeploymentError(f"{path}: no `[[process]]` table; each names its `agents` and `listen` endpoint")
+    processes: list[ProcessGroup] = []
+    seen_agents: dict[str, int] = {}
+    seen_endpoints: dict[str, int] = {}
+    for number, table in enumerate(tables, start=1):
+        where = f"{path}: process {number}"
+        if not isinstance(table, dict):
+            raise DeploymentError(f"{where} is not a table")
+        extra = sorted(set(table) - {"agents", "listen", "environment", "host", "args"})
+        if extra:
+            raise DeploymentError(f"{where}: unknown key `{extra[0]}` (known: agents, listen, environment, host, args)")
+        agents = table.get("agents")
+        if not isinstance(agents, list) or not agents or not all(isinstance(a, str) and a.strip() for a in agents):
+            raise DeploymentError(f'{where}: `agents` must be a list of agent names, e.g. ["manip/a", "grip/a"]')
+        names = tuple(normalise_agent(a) for a in agents)
+        for agent in names:
+            if agent in seen_agents:
+                raise DeploymentError(f"{where}: `{agent}` already runs in process {seen_agents[agent]}")
+            seen_agents[agent] = number
+        listen = table.get("listen")
+        if not isinstance(listen, str) or "/" not in listen:
+            raise DeploymentError(f'{where}: `listen` must be a Zenoh endpoint such as "tcp/127.0.0.1:7451"')
+        if listen in seen_endpoints:
+            raise DeploymentError(f"{where}: `{listen}` is already process {seen_endpoints[listen]}'s endpoint")
+        seen_endpoints[listen] = number
+        environment = table.get("environment", True)
+        host = table.get("host", "localhost")
+        args = table.get("args", [])
+        if not isinstance(environment, bool):
+            raise DeploymentError(f"{where}: `environment` must be true or false")
+        if not isinstance(host, str) or not host:
+            raise DeploymentError(f"{where}: `host` must be a host name")
+        if not isinstance(args, list) or not all(isinstance(a, str) for a in args):
+            raise DeploymentError(f'{where}: `args` must be a list of `earl run` options, e.g. ["--trace", "x.mcap"]')
+        processes.append(ProcessGroup(names, listen, environment, host, tuple(args)))
+    return Deployment(path, tuple(processes))

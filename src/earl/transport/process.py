@@ -1,0 +1,83 @@
+"""One process of a distributed run: its agents, its Zenoh configuration, its peers.
+
+`earl run SPEC --transport zenoh --agents manip/a,grip/a` comes here to open the
+transport before the network is built (docs/distributed.md, "Running by hand").
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from earl.model.elements import System
+from earl.model.expand import expand
+from earl.runtime.names import agent_name
+from earl.transport.deployment import DeploymentError, normalise_agent, read_deployment
+from earl.transport.zenoh_transport import ZenohTransport, config_from_file, default_config
+
+DEPLOYMENT_FILE = "deploy.toml"
+
+
+def log(line: str) -> None:
+    print(line, file=sys.stderr, flush=True)
+
+
+def open_transport(
+    system: System, parameters: Mapping[str, Any], spec: Path, agents: list[str], arguments: argparse.Namespace
+) -> tuple[list[str], ZenohTransport]:
+    """The agents this process runs (normalised) and its open transport; `ValueError` for bad options."""
+    known = [agent_name(agent) for agent in expand(system, dict(parameters)).agents]
+    names = [normalise_agent(a) for a in agents]
+    for name in names:
+        if name not in known:
+            raise ValueError(f"--agents: `{name}` is not an agent of this system (its agents: {', '.join(known)})")
+    if arguments.zenoh_config:
+        config = config_from_file(Path(arguments.zenoh_config))
+        where = f"the Zenoh configuration {arguments.zenoh_config}"
+    else:
+        path = Path(arguments.deployment) if arguments.deployment else spec.parent / DEPLOYMENT_FILE
+        if not arguments.deployment and not path.is_file():
+            raise ValueError(
+                f"--transport zenoh needs the processes' endpoints: write {path} (docs/distributed.md), "
+                "name one with --deployment, or give your own --zenoh-config"
+            )
+        try:
+            deployment = read_deployment(path)
+            deployment.check_agents(known)
+            group = deployment.group_of(names)
+        except DeploymentError as error:
+            raise ValueError(str(error)) from None
+        connect = deployment.connect_for(group)
+        config = default_config([group.listen], connect)
+        where = f"listening on {group.listen}, connecting to {', '.join(connect) or 'nobody'}"
+    transport = ZenohTransport(system.name, names, config, log)
+    log(f"earl run: {', '.join(names)} over Zenoh ({where})")
+    return names, transport
+
+
+def wait_for_peers(transport: ZenohTransport, arguments: argparse.Namespace) -> None:
+    """Start when the agents our links talk to are there, so that no first message is lost."""
+    from earl.runtime.durations import parse_duration
+
+    seconds = parse_duration(arguments.wait_for_peers)
+    missing = transport.missing_peers()
+    if missing:
+        log(f"earl run: waiting up to {seconds:g} s for {', '.join(missing)}")
+        missing = transport.wait_for_peers(seconds)
+    if missing:
+        log(f"earl run: starting without {', '.join(missing)}: their links are stale until they appear")
+    else:
+        log(f"earl run: peers {', '.join(transport.peers) or '(none)'} are alive; starting")
+
+
+def print_link_statistics(transport: ZenohTransport) -> None:
+    """The closing lines: what went over each remote link."""
+    for statistics in transport.statistics:
+        arrow = "sent" if statistics.direction == "out" else "received"
+        line = f"link {statistics.link} ({statistics.key}): {statistics.messages} {arrow}"
+        if statistics.direction == "in":
+            line += f", {statistics.malformed} malformed (dropped), {statistics.refused} refused (type mismatch)"
+        print(line, flush=True)

@@ -1,0 +1,335 @@
+"""Links between processes over Eclipse Zenoh (docs/distributed.md).
+
+A `ZenohTransport` serves the links of one process whose other end runs elsewhere:
+
+- an **outgoing** link (its output buffer is here) gets a Zenoh publisher on the link's
+  key; the engine's send hands each message to it as it would to a local channel;
+- an **incoming** link (its input buffer is here) gets a subscriber; a message is
+  decoded and type-checked on Zenoh's thread and delivered to the input buffer's
+  channel in the scheduler's thread (see `inbox.py`).
+
+Liveliness: the process declares one token per agent it runs.  When the token of an
+agent that feeds one of our input buffers disappears, those buffers go *stale* —
+`newData()` stays false (nothing arrives) and `timeout(x/ib)` reads true — until the
+token comes back; nothing is restarted.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import threading
+import time as wall
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import zenoh
+
+from earl.model.types import DataType
+from earl.runtime.engine import SubsystemEngine
+from earl.runtime.values import TypeSystem
+from earl.transport.codec import FingerprintMismatch, LinkCodec, MalformedMessage
+from earl.transport.inbox import Inbox
+from earl.transport.keys import alive_key, alive_prefix, escape, link_key, type_key, unescape
+
+#: how long a restarted peer waits between attempts to reach the others (ms): restarts resume quickly
+RETRY_INITIAL_MS = 100
+RETRY_MAX_MS = 1000
+
+
+class TransportError(RuntimeError):
+    """Zenoh could not be configured or started; the message says what to change."""
+
+
+def default_config(listen: list[str], connect: list[str]) -> zenoh.Config:
+    """Peer mode, no multicast scouting, explicit endpoints: nothing is found by accident."""
+    config = zenoh.Config()
+    try:
+        config.insert_json5("mode", json.dumps("peer"))
+        config.insert_json5("scouting/multicast/enabled", "false")
+        config.insert_json5("listen/endpoints", json.dumps(listen))
+        config.insert_json5("connect/endpoints", json.dumps(connect))
+        config.insert_json5(
+            "connect/retry",
+            json.dumps(
+                {"period_init_ms": RETRY_INITIAL_MS, "period_max_ms": RETRY_MAX_MS, "period_increase_factor": 2}
+            ),
+        )
+    except Exception as error:  # zenoh reports a bad endpoint as a plain exception
+        raise TransportError(f"the Zenoh endpoints {listen + connect} are not valid: {error}") from None
+    return config
+
+
+def config_from_file(path: Path) -> zenoh.Config:
+    """A user's own Zenoh configuration (JSON5), passed through unchanged."""
+    try:
+        return zenoh.Config.from_file(str(path))
+    except Exception as error:
+        raise TransportError(f"cannot use the Zenoh configuration {path}: {error}") from None
+
+
+@dataclass
+class LinkStatistics:
+    """What went over one remote link in this process."""
+
+    link: str
+    key: str
+    direction: str  # "out" | "in"
+    messages: int = 0
+    malformed: int = 0
+    refused: int = 0
+
+
+class _Output:
+    """The sending end of a remote link: the engine's send calls `deliver` as on a local channel."""
+
+    __slots__ = ("_encode", "_put", "statistics")
+
+    def __init__(self, publisher: zenoh.Publisher, codec: LinkCodec, statistics: LinkStatistics) -> None:
+        self._put = publisher.put
+        self._encode = codec.encode
+        self.statistics = statistics
+
+    def deliver(self, value: Any) -> None:
+        self._put(self._encode(value))
+        self.statistics.messages += 1
+
+
+class _Input:
+    """The receiving end of a remote link: one input buffer of one engine, fed by one remote agent."""
+
+    def __init__(
+        self,
+        transport: ZenohTransport,
+        link: str,
+        engine: SubsystemEngine,
+        buffer: str,
+        source_agent: str,
+        codec: LinkCodec,
+        statistics: LinkStatistics,
+    ) -> None:
+        self.transport = transport
+        self.link = link
+        self.engine = engine
+        self.buffer = buffer
+        self.source_agent = source_agent
+        self.codec = codec
+        self.statistics = statistics
+        self.channel = engine.channels[buffer]
+
+    # ---------------------------------------------------------------- on Zenoh's thread
+    def on_sample(self, sample: zenoh.Sample) -> None:
+        """Never raises: a bad message is counted (and the first one of each kind reported)."""
+        try:
+            payload = sample.payload.to_bytes()
+            value = self.codec.decode(payload)
+        except FingerprintMismatch as mismatch:
+            self.statistics.refused += 1
+            if self.statistics.refused == 1:
+                self.transport.explain_mismatch(self, mismatch.received)
+            return
+        except MalformedMessage as error:
+            self._malformed(str(error))
+            return
+        except Exception as error:  # anything else a broken payload can provoke
+            self._malformed(f"{type(error).__name__}: {error}")
+            return
+        self.statistics.messages += 1
+        self.transport.inbox.put(self.arrive, value)
+
+    def _malformed(self, why: str) -> None:
+        self.statistics.malformed += 1
+        if self.statistics.malformed == 1:
+            message = (
+                f"link {self.link} ({self.statistics.key}): dropped malformed bytes ({why}); "
+                "further malformed messages on this link are only counted"
+            )
+            self.transport.inbox.put(self.report, ("malformed", message))
+
+    # ---------------------------------------------------------------- on the scheduler's thread
+    def arrive(self, time: int, value: Any) -> None:
+        self.channel.deliver(value)
+        engine = self.engine
+        if engine.waiting and engine.on_delivery is not None:
+            engine.on_delivery(engine)
+
+    def report(self, time: int, item: tuple[str, str]) -> None:
+        kind, message = item
+        self.engine.report_fault(time, kind, message)
+        self.transport.log(f"earl run: {self.engine.name}: {message}")
+
+
+class ZenohTransport:
+    """One process's Zenoh session, its remote links, and its peers' liveliness."""
+
+    def __init__(
+        self,
+        system: str,
+        local_agents: list[str],
+        config: zenoh.Config,
+        log: Callable[[str], None],
+    ) -> None:
+        self.system = system
+        self.local_agents = list(local_agents)
+        self.log = log
+        self.inbox = Inbox()
+        self.statistics: list[LinkStatistics] = []
+        self._inputs_by_agent: dict[str, list[_Input]] = {}
+        self._peers: set[str] = set()  # the agents other processes must run for our links
+        self._alive: set[str] = set()
+        self._seen: set[str] = set()  # peers seen alive at least once (scheduler's thread)
+        self._alive_changed = threading.Condition()
+        self._descriptions: dict[str, str] = {}  # fingerprint hex -> description, for the types queryable
+        self._declared: list[Any] = []
+        self._tokens: list[zenoh.LivelinessToken] = []
+        self._types: TypeSystem | None = None
+        try:
+            self.session = zenoh.open(config)
+        except Exception as error:
+            raise TransportError(f"Zenoh could not start: {error}") from None
+        self._declared.append(self.session.declare_queryable(f"earl/{escape(system)}/types/*", self._answer_type_query))
+        self._declared.append(
+            self.session.liveliness().declare_subscriber(alive_prefix(system) + "*", self._on_liveliness, history=True)
+        )
+
+    # ---------------------------------------------------------------- building (RemoteLinks)
+    def outgoing(
+        self, link: str, data_type: DataType, types: TypeSystem, source: str, destination_agent: str
+    ) -> _Output:
+        codec = self._codec(types, data_type, f"the link {link}")
+        key = link_key(self.system, link)
+        statistics = LinkStatistics(link, key, "out")
+        self.statistics.append(statistics)
+        self._peers.add(destination_agent)
+        publisher = self.session.declare_publisher(key, express=True)
+        self._declared.append(publisher)
+        return _Output(publisher, codec, statistics)
+
+    def incoming(
+        self, link: str, data_type: DataType, types: TypeSystem, engine: SubsystemEngine, buffer: str, source_agent: str
+    ) -> None:
+        codec = self._codec(types, data_type, f"a message on the link {link}")
+        key = link_key(self.system, link)
+        statistics = LinkStatistics(link, key, "in")
+        self.statistics.append(statistics)
+        self._peers.add(source_agent)
+        remote = _Input(self, link, engine, buffer, source_agent, codec, statistics)
+        self._inputs_by_agent.setdefault(source_agent, []).append(remote)
+        with self._alive_changed:
+            if source_agent not in self._alive:
+                engine.stale.add(buffer)  # stale until its sender is seen
+        self._declared.append(self.session.declare_subscriber(key, remote.on_sample))
+
+    def _codec(self, types: TypeSystem, data_type: DataType, where: str) -> LinkCodec:
+        codec = LinkCodec(types, data_type, where)
+        self._descriptions[codec.fingerprint.hex()] = codec.description
+        return codec
+
+    def start(self) -> None:
+        """Declare this process's agents alive: called once every link is declared, so a peer that
+        sees the token also finds the subscribers."""
+        for agent in self.local_agents:
+            self._tokens.append(self.session.liveliness().declare_token(alive_key(self.system, agent)))
+
+    # ---------------------------------------------------------------- peers
+    @property
+    def peers(self) -> list[str]:
+        return sorted(self._peers)
+
+    def missing_peers(self) -> list[str]:
+        with self._alive_changed:
+            return sorted(self._peers - self._alive)
+
+    def wait_for_peers(self, seconds: float) -> list[str]:
+        """Wait until every agent our links talk to is alive, at most `seconds`; those still missing."""
+        deadline = wall.monotonic() + seconds
+        with self._alive_changed:
+            while True:
+                missing = self._peers - self._alive
+                remaining = deadline - wall.monotonic()
+                if not missing or remaining <= 0:
+                    return sorted(missing)
+                self._alive_changed.wait(min(remaining, 0.5))
+
+    def _on_liveliness(self, sample: zenoh.Sample) -> None:
+        """On Zenoh's thread: a peer agent appeared or disappeared."""
+        agent = unescape(str(sample.key_expr).rsplit("/", 1)[-1])
+        alive = sample.kind == zenoh.SampleKind.PUT
+        with self._alive_changed:
+            if alive:
+                self._alive.add(agent)
+            else:
+                self._alive.discard(agent)
+            self._alive_changed.notify_all()
+        if agent in self._inputs_by_agent:
+            self.inbox.put(self._peer_changed, (agent, alive))
+
+    def _peer_changed(self, time: int, item: tuple[str, bool]) -> None:
+        """On the scheduler's thread: the buffers fed by `agent` go stale, or flow again."""
+        agent, alive = item
+        inputs = self._inputs_by_agent.get(agent, [])
+        touched: dict[str, list[str]] = {}
+        for remote in inputs:
+            stale = remote.engine.stale
+            if alive and remote.buffer in stale:
+                stale.discard(remote.buffer)
+                touched.setdefault(remote.engine.name, []).append(remote.buffer)
+            elif not alive and remote.buffer not in stale:
+                stale.add(remote.buffer)
+                touched.setdefault(remote.engine.name, []).append(remote.buffer)
+        if not touched:
+            if alive:
+                self._seen.add(agent)
+            return
+        for name, buffers in touched.items():
+            listed = ", ".join(f"{b}/ib" for b in buffers)
+            if alive:
+                again = "again " if agent in self._seen else ""
+                self.log(f"earl run: {agent} is alive: {name} {listed} receive {again}from it")
+            else:
+                engine = next(r.engine for r in inputs if r.engine.name == name)
+                message = f"{agent} disappeared: {listed} are stale (newData false, timeout true) until it returns"
+                engine.report_fault(time, "stale", message)
+                self.log(f"earl run: {name}: {message}")
+        if alive:
+            self._seen.add(agent)
+
+    # ---------------------------------------------------------------- data types
+    def _answer_type_query(self, query: zenoh.Query) -> None:
+        fingerprint = str(query.key_expr).rsplit("/", 1)[-1]
+        description = self._descriptions.get(fingerprint)
+        if description is not None:
+            query.reply(query.key_expr, description.encode("utf-8"))
+
+    def explain_mismatch(self, remote: _Input, received: bytes) -> None:
+        """Ask the peers what `received` stands for (off Zenoh's callback thread), then report once."""
+
+        def ask() -> None:
+            theirs = f"an unknown type (fingerprint {received.hex()}; its sender did not describe it)"
+            try:
+                for reply in self.session.get(type_key(self.system, received), timeout=2.0):
+                    ok = reply.ok
+                    if ok is not None:
+                        theirs = f"`{ok.payload.to_bytes().decode('utf-8', errors='replace')}`"
+                        break
+            except Exception as error:  # the session may be closing; the report still goes out
+                theirs += f" (asking for it failed: {error})"
+            message = (
+                f"link {remote.link} ({remote.statistics.key}): refused a message of {theirs} from "
+                f"{remote.source_agent}; {remote.engine.name} {remote.buffer}/ib expects `{remote.codec.description}` "
+                "— the two processes run different specifications; further mismatches are only counted"
+            )
+            self.inbox.put(remote.report, ("fingerprint", message))
+
+        threading.Thread(target=ask, name="earl-type-query", daemon=True).start()
+
+    # ---------------------------------------------------------------- the end
+    def close(self) -> None:
+        for token in self._tokens:
+            with contextlib.suppress(Exception):  # already gone with the session
+                token.undeclare()  # type: ignore[no-untyped-call]
+        self._tokens.clear()
+        with contextlib.suppress(Exception):  # closing twice, or Zenoh already shut down at interpreter exit
+            self.session.close()  # type: ignore[no-untyped-call]
