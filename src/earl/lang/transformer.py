@@ -103,14 +103,13 @@ class ParsedFile:
     header_comments: list[str] = field(default_factory=list)
 
 
-@dataclass
+@dataclass(slots=True)
 class _DeclaredName:
     name: str
     family: Family | None
-    location: SourceLocation
 
 
-@dataclass
+@dataclass(slots=True)
 class _BodyItem:
     """A `period` or buffer-group line, before it is placed in its subsystem or state."""
 
@@ -237,7 +236,7 @@ class ElementBuilder:
 
     def declared_name(self, meta: Meta, children: list[Any]) -> _DeclaredName:
         family = children[1] if len(children) > 1 else None
-        return _DeclaredName(str(children[0]), family, self._loc(children[0]))
+        return _DeclaredName(str(children[0]), family)
 
     def family(self, meta: Meta, children: list[Any]) -> Family:
         return Family(str(children[0]), children[1], children[2], self._loc(meta))

@@ -12,11 +12,13 @@ from dataclasses import dataclass, field
 from typing import ClassVar
 
 from earl.model.expressions import ElementReference, Expression
+from earl.model.frozen import quick_init
 from earl.model.kinds import Kind
 from earl.model.location import Comments, SourceLocation, comments_field, location_field
 from earl.model.types import DataType, TypeDefinition
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class Family:
     """`[K in 1..N]`: an element declared once for every value of its index."""
@@ -27,6 +29,7 @@ class Family:
     location: SourceLocation | None = location_field()
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class Duration:
     """A period or timeout as written (`2 ms`); `seconds` is its value."""
@@ -52,6 +55,7 @@ class Parameter:
     comments: Comments = comments_field()
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class Queue:
     """An Input Buffer that keeps a FIFO of messages instead of only the latest one."""
@@ -125,6 +129,7 @@ class Predicate:
     location: SourceLocation | None = location_field()
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class PythonImplementation:
     """`python "pick_and_place.manip:joint_move"`: where the runtime finds the code."""
@@ -363,6 +368,7 @@ SUBSYSTEM_CLASSES: dict[Kind, type[Subsystem]] = {
 }
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class LinkEnd:
     """One end of a Link: `task/a.cs.manipulatorCommand` or, inside an agent, `cs.motorControllerCommand[K]`.
@@ -377,6 +383,7 @@ class LinkEnd:
     location: SourceLocation | None = location_field()
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class LinkNamePart:
     """One side of a link's name; in `cs,motorController[K in 1..N]` the second part declares the family."""

@@ -10,10 +10,12 @@ from __future__ import annotations
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 
+from earl.model.frozen import quick_init
 from earl.model.kinds import Kind
 from earl.model.location import SourceLocation, location_field
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class Star:
     """The `[*]` index: every member of a family (`motorControllerState[*]/ib`)."""
@@ -21,6 +23,7 @@ class Star:
     location: SourceLocation | None = location_field()
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class ElementReference:
     """A name in the manual's notation: `manipulatorCommand/ib`, `windingCurrent[K]/mo`.
@@ -39,6 +42,7 @@ class ElementReference:
         return any(isinstance(index, Star) for index in self.indices)
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class Literal:
     """`true`, `false`, an integer, a real number or a string."""
@@ -47,6 +51,7 @@ class Literal:
     location: SourceLocation | None = location_field()
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class ListLiteral:
     """`[0.0, 0.0, 1.0]`: the initial value of an array."""
@@ -55,6 +60,7 @@ class ListLiteral:
     location: SourceLocation | None = location_field()
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class Name:
     """A parameter (`N`) or a family index variable (`K`)."""
@@ -63,12 +69,14 @@ class Name:
     location: SourceLocation | None = location_field()
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class FieldAccess:
     name: str
     location: SourceLocation | None = location_field()
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class IndexAccess:
     index: Expression
@@ -78,6 +86,7 @@ class IndexAccess:
 Accessor = FieldAccess | IndexAccess
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class Read:
     """The value of a buffer, memory or primitive predicate, possibly a part of it.
@@ -92,6 +101,7 @@ class Read:
     location: SourceLocation | None = location_field()
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class Call:
     """A built-in function: `newData(manipulatorCommand/ib.jointPosSetpoint)`, `timeout(x/ib)`."""
@@ -101,18 +111,21 @@ class Call:
     location: SourceLocation | None = location_field()
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class Not:
     operand: Expression
     location: SourceLocation | None = location_field()
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class Negate:
     operand: Expression
     location: SourceLocation | None = location_field()
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class BooleanOperation:
     """`a and b and c` or `a or b`: one operator over two or more operands."""
@@ -122,6 +135,7 @@ class BooleanOperation:
     location: SourceLocation | None = location_field()
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class Comparison:
     operator: str  # "==" "!=" "<" "<=" ">" ">="
@@ -130,6 +144,7 @@ class Comparison:
     location: SourceLocation | None = location_field()
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class Arithmetic:
     operator: str  # "+" "-" "*"
@@ -138,6 +153,7 @@ class Arithmetic:
     location: SourceLocation | None = location_field()
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class Quantifier:
     """`any(K in 1..N: motorControllerState[K]/ib.emergencyStop)`: the manual's `∨ … ∨`."""

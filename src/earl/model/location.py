@@ -9,7 +9,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from earl.model.frozen import quick_init
 
+
+@quick_init
 @dataclass(frozen=True, slots=True)
 class SourceLocation:
     """A span of text; lines and columns count from 1, the end is inclusive."""

@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from earl.model.expressions import Expression
+from earl.model.frozen import quick_init
 from earl.model.location import Comments, SourceLocation, comments_field, location_field
 
 #: The primitive types a spec may name without defining them.
@@ -27,12 +28,14 @@ PRIMITIVE_TYPES: tuple[str, ...] = (
 )
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class PrimitiveType:
     name: str
     location: SourceLocation | None = location_field()
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class TypeReference:
     """The name of a `struct` or `type` defined in the spec (`ManipulatorCommand`)."""
@@ -41,6 +44,7 @@ class TypeReference:
     location: SourceLocation | None = location_field()
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class ArrayType:
     """`double[N]` (fixed: `size` is an expression) or `double[]` (variable: `size` is None)."""
