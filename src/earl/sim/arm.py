@@ -318,7 +318,7 @@ def _gripper(pad: str) -> list[str]:
     ]
 
 
-def _actuators_and_sensors(n: int) -> str:
+def _actuators_and_encoders(n: int) -> str:
     lines = ["  <actuator>"]
     for k in range(1, n + 1):
         d = drive(n, k)
@@ -392,7 +392,7 @@ def robot_mjcf(n: int, timestep: float = TIMESTEP) -> str:
             "  </worldbody>",
             '  <contact><exclude body1="finger_left" body2="finger_right"/></contact>',
             _equalities(n),
-            _actuators_and_sensors(n),
+            _actuators_and_encoders(n),
             "</mujoco>",
         ]
     )
