@@ -66,4 +66,15 @@ def simulate(system: System, **options: object) -> Simulation:
 
 __version__ = "0.1.0"
 
+
+def _display_in_notebooks() -> None:
+    """In a Jupyter kernel, model objects display as their diagrams (SVG); elsewhere nothing is loaded."""
+    import sys
+
+    if "IPython" in sys.modules:
+        import earl.render  # noqa: F401  (registers the display formatters)
+
+
+_display_in_notebooks()
+
 __all__ = ["Diagnostic", "EarlError", "Severity", "__version__", "load", "loads", "save", "simulate", *_model_names]
