@@ -12,7 +12,7 @@ at the same position, so errors are Lark's own.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from typing import Any
 
 from lark import Token
@@ -20,27 +20,36 @@ from lark.lexer import ContextualLexer, PatternStr, UnlessCallback
 
 _new_string = str.__new__
 
+#: What the loop needs of one of Lark's per-state lexers: its match function, the terminals
+#: that may hold a newline, the ignored terminals, keyword tables and other callbacks.
+_Prepared = tuple[Callable[..., Any], frozenset[str], frozenset[str], dict[str, dict[str, str]], dict[str, Any]]
 
-class _Prepared:
-    """What the loop needs of one of Lark's per-state lexers, looked up once."""
 
-    __slots__ = ("callbacks", "ignore", "keywords", "matchers", "newline")
+def _prepare(lexer: Any) -> _Prepared:
+    scanner = lexer.scanner  # built lazily by Lark; builds its callbacks too
+    matchers = tuple(expression.match for expression in scanner._mres)
+    keywords: dict[str, dict[str, str]] = {}
+    callbacks: dict[str, Any] = {}
+    for type_, callback in lexer.callback.items():
+        if isinstance(callback, UnlessCallback) and all(
+            isinstance(t.pattern, PatternStr) and not t.pattern.flags for t in callback.scanner.terminals
+        ):
+            # A name that is exactly a keyword's text is that keyword (Lark's `_create_unless`).
+            keywords[type_] = {t.pattern.value: t.name for t in callback.scanner.terminals}
+        else:
+            callbacks[type_] = callback
+    if len(matchers) == 1:
+        match = matchers[0]
+    else:  # Python's `re` takes at most 100 groups, so Lark may split a scanner in several
 
-    def __init__(self, lexer: Any) -> None:
-        scanner = lexer.scanner  # built lazily by Lark; builds its callbacks too
-        self.matchers = tuple(expression.match for expression in scanner._mres)
-        self.ignore = lexer.ignore_types
-        self.newline = lexer.newline_types
-        self.keywords: dict[str, dict[str, str]] = {}
-        self.callbacks: dict[str, Any] = {}
-        for type_, callback in lexer.callback.items():
-            if isinstance(callback, UnlessCallback) and all(
-                isinstance(t.pattern, PatternStr) and not t.pattern.flags for t in callback.scanner.terminals
-            ):
-                # A name that is exactly a keyword's text is that keyword (Lark's `_create_unless`).
-                self.keywords[type_] = {t.pattern.value: t.name for t in callback.scanner.terminals}
-            else:
-                self.callbacks[type_] = callback
+        def match(text: str, position: int, end: int) -> Any:
+            for matcher in matchers:
+                found = matcher(text, position, end)
+                if found is not None:
+                    return found
+            return None
+
+    return (match, frozenset(lexer.newline_types), frozenset(lexer.ignore_types), keywords, callbacks)
 
 
 class FastContextualLexer(ContextualLexer):
@@ -60,27 +69,28 @@ class FastContextualLexer(ContextualLexer):
         basic = self.lexers[state]
         table = self._by_lexer.get(id(basic))
         if table is None:
-            table = self._by_lexer[id(basic)] = _Prepared(basic)
+            table = self._by_lexer[id(basic)] = _prepare(basic)
         self._prepared[state] = table
         return table
 
     def lex(self, lexer_state: Any, parser_state: Any) -> Iterator[Token]:
         prepared = self._prepared
-        line_counter = lexer_state.line_ctr
         text: str = lexer_state.text.text
         end: int = lexer_state.text.end
+        line_counter = lexer_state.line_ctr
         position: int = line_counter.char_pos
         line: int = line_counter.line
         line_start: int = line_counter.line_start_pos
         states: list[int] = parser_state.state_stack  # the same list for the whole parse
+        new = _new_string
+        token_class = Token
         while position < end:
             state = states[-1]
-            table = prepared.get(state) or self._prepare(state)
-            match = None
-            for matcher in table.matchers:
-                match = matcher(text, position, end)
-                if match is not None:
-                    break
+            table = prepared.get(state)
+            if table is None:
+                table = self._prepare(state)
+            match_at, newline, ignore, keywords, callbacks = table
+            match = match_at(text, position, end)
             if match is None:
                 # Let Lark's own loop meet the character it cannot read and raise its error.
                 line_counter.char_pos, line_counter.line = position, line
@@ -88,40 +98,40 @@ class FastContextualLexer(ContextualLexer):
                 line_counter.column = position - line_start + 1
                 yield from ContextualLexer.lex(self, lexer_state, parser_state)
                 return
-            value = match.group()
+            value: str = match.group()
             type_: str = match.lastgroup  # type: ignore[assignment]
-            column = position - line_start + 1
-            next_position = position + len(value)
-            end_line = line
-            if type_ in table.newline:
+            start, start_line, column = position, line, position - line_start + 1
+            position += len(value)
+            if type_ in newline:
                 newlines = value.count("\n")
                 if newlines:
-                    end_line = line + newlines
-                    line_start = position + value.rindex("\n") + 1
-            if type_ in table.ignore:
-                if type_ in table.callbacks:
-                    token = _token(type_, value, position, line, column, end_line, next_position - line_start + 1)
-                    token.end_pos = next_position
-                    table.callbacks[type_](token)
-                position, line = next_position, end_line
+                    line += newlines
+                    line_start = start + value.rindex("\n") + 1
+            if type_ in ignore:
+                if type_ in callbacks:
+                    ignored = _make(type_, value, start, start_line, column, line, position - line_start + 1)
+                    ignored.end_pos = position
+                    callbacks[type_](ignored)
                 continue
-            keywords = table.keywords.get(type_)
-            if keywords is not None:
-                type_ = keywords.get(value, type_)
-            token = _token(type_, value, position, line, column, end_line, next_position - line_start + 1)
-            token.end_pos = next_position
-            callback = table.callbacks.get(type_)
-            position, line = next_position, end_line
-            # Lark's own loop state, kept current for an error raised while this token is parsed.
-            line_counter.char_pos, line_counter.line = position, line
-            line_counter.line_start_pos = line_start
-            line_counter.column = position - line_start + 1
-            lexer_state.last_token = token
-            yield token if callback is None else callback(token)
+            if type_ in keywords:
+                type_ = keywords[type_].get(value, type_)
+            # Token's own constructor goes through two Python-level calls; its slots are public.
+            token = new(token_class, value)
+            token.type = type_
+            token.value = value
+            token.start_pos = start
+            token.line = start_line
+            token.column = column
+            token.end_line = line
+            token.end_column = position - line_start + 1
+            token.end_pos = position
+            yield token if type_ not in callbacks else callbacks[type_](token)
+        line_counter.char_pos, line_counter.line = position, line
+        line_counter.line_start_pos = line_start
+        line_counter.column = position - line_start + 1
 
 
-def _token(type_: str, value: str, position: int, line: int, column: int, end_line: int, end_column: int) -> Token:
-    # Token's own constructor goes through two Python-level calls; its slots are public.
+def _make(type_: str, value: str, position: int, line: int, column: int, end_line: int, end_column: int) -> Token:
     token: Token = _new_string(Token, value)
     token.type = type_
     token.value = value
