@@ -76,7 +76,7 @@ class Simulation:
         *,
         parameters: Mapping[str, ParameterValue] | None = None,
         seed: int = 0,
-        environment: object | str | None = None,
+        environment: object | str | None = "run.toml",
         trace: str | Path | None = None,
         record_memory: list[str] | None = None,
         record_links: list[str] | None = None,
@@ -95,6 +95,9 @@ class Simulation:
         self.expanded = expand(system, parameters)
         self.seed = seed
         directories = _code_directories(system)
+        if environment == "run.toml":
+            # like `earl run`: the environment a run.toml next to the spec names, if any
+            environment = read_run_settings(Path(system.source_file)).environment if system.source_file else None
         self.environment = _environment(environment, self.expanded, seed, directories, system)
         self.statistics = StatisticsRecorder()
         self._faults = _FaultList()
