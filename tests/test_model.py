@@ -228,3 +228,21 @@ a/a {
 def test_boolean_operations_keep_their_operands_in_order() -> None:
     expression = BooleanOperation("and", (Not(Name("a")), Name("b")))
     assert expression_text(expression) == "not a and b"
+
+
+def test_spans_cover_what_was_written_parentheses_included() -> None:
+    # The reader measures spans while it parses; they must match the text exactly (carets, SARIF).
+    text = (
+        "system s\n\nr/r {\n    a/a\n}\n\na/a {\n    cs {\n        x/ib: boolean\n"
+        "        p/pp = not (x/ib and x/ib)\n        q/pp = (x/ib)\n    }\n}\n"
+    )
+    cs = earl.loads(text, "spans.earl").agent("a").control_subsystem
+    p, q = cs.primitive_predicates
+    assert p.location is not None and (p.location.line, p.location.column, p.location.end_column) == (10, 9, 35)
+    negation = p.expression
+    assert isinstance(negation, Not) and negation.location is not None
+    assert (negation.location.column, negation.location.end_column) == (16, 35)  # `not (…)`, the `)` too
+    inner = negation.operand
+    assert inner.location is not None and (inner.location.column, inner.location.end_column) == (21, 34)
+    assert q.location is not None and (q.location.column, q.location.end_column) == (9, 22)
+    assert q.expression.location is not None and q.expression.location.column == 17  # inside the parentheses

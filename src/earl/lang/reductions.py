@@ -124,12 +124,13 @@ def _callback(rule: Any, builder: Any, table: SpanTable) -> Callable[[list[Any]]
     spans = table.spans
     measure = table.span
 
-    if expand_single and len(kept) == 1 and not kept[0][1]:
-        # `?sum: product` or `?atom: "(" expression ")"`: the one child is the result, span and all.
-        return itemgetter(kept[0][0])
+    if expand_single and len(rule.expansion) == 1 and kept and not kept[0][1]:
+        # `?sum: product`: the one child is the result, span and all.
+        return itemgetter(0)
 
     method: Callable[[Span | None, list[Any]], Any] | None = None
-    if not inline:
+    always_single = expand_single and len(kept) == 1 and not kept[0][1]
+    if not inline and not always_single:
         method = getattr(builder, name, None)
         if method is None:
             return None
@@ -143,7 +144,9 @@ def _callback(rule: Any, builder: Any, table: SpanTable) -> Callable[[list[Any]]
 
     def children_of(raw: list[Any]) -> list[Any]:
         if not splice:
-            return list(raw) if every else [raw[p] for p in positions]
+            # Lark hands each reduction a fresh slice of its stack: when every symbol is kept,
+            # that slice is already the list of children.
+            return raw if every else [raw[p] for p in positions]
         # `x*` compiles to a left-recursive rule: extend its list in place, or a long
         # list would be copied once per element.
         children: list[Any] = raw[first_position] if first_spliced else [raw[first_position]]
@@ -155,10 +158,38 @@ def _callback(rule: Any, builder: Any, table: SpanTable) -> Callable[[list[Any]]
         return children
 
     def reduce(raw: list[Any]) -> Any:
+        if not raw:
+            return method(None, []) if method is not None else Inline()
+        # The span, from the first and last values when both have one (nearly always).
+        first = raw[0]
+        last = raw[-1]
+        start: Any = first if type(first) is Token else spans.pop(id(first), None)
+        finish: Any = start if last is first else last if type(last) is Token else spans.pop(id(last), None)
+        span: Any  # Span | None; Lark types a token's positions as optional
+        if start is None or finish is None:
+            # Put back what was taken (one of them has no span); `measure` looks further in.
+            if type(first) is not Token:
+                spans[id(first)] = start
+            if type(last) is not Token:
+                spans[id(last)] = finish
+            span = measure(raw)
+        elif type(start) is Token:
+            if type(finish) is Token:
+                span = (start.line, start.column, finish.end_line, finish.end_column)
+            else:
+                span = (start.line, start.column, finish[2], finish[3])
+        elif type(finish) is Token:
+            span = (start[0], start[1], finish.end_line, finish.end_column)
+        else:
+            span = (start[0], start[1], finish[2], finish[3])
         children = children_of(raw)
         if expand_single and len(children) == 1:
-            return children[0]
-        span = measure(raw)
+            # `?atom: "(" expression ")"` passes its child through; like Lark's "container", the
+            # child's span then covers the parentheses too, for the span of whatever holds it.
+            only = children[0]
+            if type(only) is not Token:
+                spans[id(only)] = span
+            return only
         for value in raw:
             if type(value) is not Token:
                 spans.pop(id(value), None)
