@@ -19,6 +19,7 @@ from earl.cli import (
     doc_command,
     export_command,
     fmt_command,
+    launch_command,
     rules_command,
     run_command,
     trace_command,
@@ -68,6 +69,7 @@ def build_parser() -> argparse.ArgumentParser:
     doc_command.register(commands)
     export_command.register(commands)
     fmt_command.register(commands)
+    launch_command.register(commands)
     rules_command.register(commands)
     run_command.register(commands)
     trace_command.register(commands)

@@ -155,6 +155,10 @@ def run(arguments: argparse.Namespace) -> int:
     elif arguments.zenoh_config or arguments.deployment:
         return usage_error("--zenoh-config and --deployment go with --transport zenoh")
     record_memory = arguments.record_memory if arguments.record_memory is not None else settings.record_memory
+    if agents and arguments.record_memory is None and record_memory:
+        # run.toml names the subsystems of the whole system; this process records those it runs
+        wanted = {a if a.endswith("/a") else f"{a}/a" for a in agents}
+        record_memory = [m for m in record_memory if m.split(".", 1)[0] in wanted]
     transport: Any = None
     try:
         system = load(path, parameters)

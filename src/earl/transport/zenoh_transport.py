@@ -180,6 +180,7 @@ class ZenohTransport:
         self._peers: set[str] = set()  # the agents other processes must run for our links
         self._alive: set[str] = set()
         self._seen: set[str] = set()  # peers seen alive at least once (scheduler's thread)
+        self._lost: set[str] = set()  # peers seen, then gone (scheduler's thread)
         self._alive_changed = threading.Condition()
         self._descriptions: dict[str, str] = {}  # fingerprint hex -> description, for the types queryable
         self._declared: list[Any] = []
@@ -263,38 +264,35 @@ class ZenohTransport:
             else:
                 self._alive.discard(agent)
             self._alive_changed.notify_all()
-        if agent in self._inputs_by_agent:
-            self.inbox.put(self._peer_changed, (agent, alive))
+        # always handed over: the buffers it feeds may not be declared yet (the token can come first)
+        self.inbox.put(self._peer_changed, (agent, alive))
 
     def _peer_changed(self, time: int, item: tuple[str, bool]) -> None:
         """On the scheduler's thread: the buffers fed by `agent` go stale, or flow again."""
         agent, alive = item
         inputs = self._inputs_by_agent.get(agent, [])
-        touched: dict[str, list[str]] = {}
+        if alive == (agent in self._seen and agent not in self._lost):
+            return  # nothing changed (a token seen twice, or lost twice)
+        by_engine: dict[str, list[_Input]] = {}
         for remote in inputs:
-            stale = remote.engine.stale
-            if alive and remote.buffer in stale:
-                stale.discard(remote.buffer)
-                touched.setdefault(remote.engine.name, []).append(remote.buffer)
-            elif not alive and remote.buffer not in stale:
-                stale.add(remote.buffer)
-                touched.setdefault(remote.engine.name, []).append(remote.buffer)
-        if not touched:
+            by_engine.setdefault(remote.engine.name, []).append(remote)
+        for name, remotes in by_engine.items():
+            listed = ", ".join(f"{remote.buffer}/ib" for remote in remotes)
+            engine = remotes[0].engine
             if alive:
-                self._seen.add(agent)
-            return
-        for name, buffers in touched.items():
-            listed = ", ".join(f"{b}/ib" for b in buffers)
-            if alive:
+                engine.stale.difference_update(remote.buffer for remote in remotes)
                 again = "again " if agent in self._seen else ""
                 self.log(f"earl run: {agent} is alive: {name} {listed} receive {again}from it")
             else:
-                engine = next(r.engine for r in inputs if r.engine.name == name)
+                engine.stale.update(remote.buffer for remote in remotes)
                 message = f"{agent} disappeared: {listed} are stale (newData false, timeout true) until it returns"
                 engine.report_fault(time, "stale", message)
                 self.log(f"earl run: {name}: {message}")
         if alive:
             self._seen.add(agent)
+            self._lost.discard(agent)
+        else:
+            self._lost.add(agent)
 
     # ---------------------------------------------------------------- data types
     def _answer_type_query(self, query: zenoh.Query) -> None:

@@ -1,0 +1,325 @@
+"""Agents split over real OS processes on 127.0.0.1, linked by Zenoh (docs/distributed.md).
+
+Every wait here is bounded: a process that does not print what is expected within
+its deadline fails the test, and every process a test starts is killed at its end.
+The pick-and-place test runs the MuJoCo example in real time and takes about half
+a minute; the others a few seconds each.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+from mcap.reader import make_reader
+
+SPECS = Path(__file__).parent / "distributed_specs"
+PINGPONG = SPECS / "pingpong"
+PICK_AND_PLACE = Path(__file__).parent.parent / "examples" / "pick_and_place"
+PING = "struct Ping{count:int,stamp:double[2],note:string?}"
+
+
+def free_ports(count: int) -> list[int]:
+    sockets = [socket.socket() for _ in range(count)]
+    try:
+        for s in sockets:
+            s.bind(("127.0.0.1", 0))
+        return [s.getsockname()[1] for s in sockets]
+    finally:
+        for s in sockets:
+            s.close()
+
+
+def deployment(tmp_path: Path, groups: list[tuple[list[str], bool]]) -> Path:
+    path = tmp_path / "deploy.toml"
+    lines = []
+    for (agents, environment), port in zip(groups, free_ports(len(groups)), strict=True):
+        names = ", ".join(f'"{a}"' for a in agents)
+        lines += ["[[process]]", f"agents = [{names}]", f'listen = "tcp/127.0.0.1:{port}"']
+        lines += [f"environment = {'true' if environment else 'false'}", ""]
+    path.write_text("\n".join(lines))
+    return path
+
+
+class Process:
+    """One `earl run` child whose output goes to a file the test reads while it runs."""
+
+    def __init__(self, log: Path, arguments: list[str]) -> None:
+        self.log = log
+        self.stream = open(log, "wb")  # noqa: SIM115 — closed in stop()
+        self.child = subprocess.Popen(
+            [sys.executable, "-m", "earl.cli.main", "run", *arguments, "--no-progress"],
+            stdout=self.stream,
+            stderr=subprocess.STDOUT,
+            stdin=subprocess.DEVNULL,
+            start_new_session=True,
+            env={**os.environ, "PYTHONUNBUFFERED": "1", "COLUMNS": "200"},
+        )
+
+    @property
+    def output(self) -> str:
+        return self.log.read_text(encoding="utf-8", errors="replace")
+
+    def wait_for(self, text: str, seconds: float, after: int = 0) -> int:
+        """Where `text` first appears in the output after position `after`; fails after `seconds`."""
+        deadline = time.monotonic() + seconds
+        while time.monotonic() < deadline:
+            found = self.output.find(text, after)
+            if found >= 0:
+                return found
+            if self.child.poll() is not None:
+                found = self.output.find(text, after)
+                if found >= 0:
+                    return found
+                pytest.fail(f"the process exited ({self.child.returncode}) before printing {text!r}:\n{self.output}")
+            time.sleep(0.05)
+        pytest.fail(f"no {text!r} within {seconds} s:\n{self.output}")
+
+    def finish(self, seconds: float) -> int:
+        try:
+            return self.child.wait(timeout=seconds)
+        except subprocess.TimeoutExpired:
+            pytest.fail(f"the process did not end within {seconds} s:\n{self.output}")
+
+    def stop(self) -> None:
+        if self.child.poll() is None:
+            self.child.kill()
+            self.child.wait(timeout=10)
+        self.stream.close()
+
+
+@pytest.fixture
+def processes() -> Iterator[list[Process]]:
+    started: list[Process] = []
+    yield started
+    for process in started:
+        process.stop()
+
+
+def run(processes: list[Process], log: Path, arguments: list[str]) -> Process:
+    process = Process(log, arguments)
+    processes.append(process)
+    return process
+
+
+def trace(path: Path) -> list[tuple[str, int, dict[str, Any]]]:
+    with open(path, "rb") as stream:
+        return [
+            (channel.topic, message.log_time, json.loads(message.data))
+            for _, channel, message in make_reader(stream).iter_messages(log_time_order=True)
+        ]
+
+
+def received(output: str, link: str) -> int:
+    """The count in a closing line `link LINK (KEY): N received, …`."""
+    for line in output.splitlines():
+        if line.startswith(f"link {link} (") and " received" in line:
+            return int(line.split("): ", 1)[1].split(" ", 1)[0])
+    raise AssertionError(f"no closing line for the link {link}:\n{output}")
+
+
+def test_two_processes_exchange_messages_and_a_remote_message_wakes_a_waiting_subsystem(
+    tmp_path: Path, processes: list[Process]
+) -> None:
+    deploy = deployment(tmp_path, [(["sender/a"], False), (["receiver/a"], False)])
+    common = [str(PINGPONG), "--transport", "zenoh", "--deployment", str(deploy), "--duration", "3s"]
+    receiver = run(
+        processes,
+        tmp_path / "receiver.log",
+        [*common, "--agents", "receiver/a", "--trace", str(tmp_path / "r.mcap"), "--record-memory", "receiver/a.cs"],
+    )
+    sender = run(processes, tmp_path / "sender.log", [*common, "--agents", "sender"])
+    assert sender.finish(60) == 0, sender.output
+    assert receiver.finish(60) == 0, receiver.output
+    # the receiver has no period: each of its iterations was started by a ping from the other process
+    pings = received(receiver.output, "sender,receiver")
+    echoes = received(sender.output, "receiver,sender")
+    assert pings > 100 and echoes > 100, (receiver.output, sender.output)
+    events = trace(tmp_path / "r.mcap")
+    faults = [data for topic, _, data in events if topic == "/earl/faults"]
+    # a ping whose arrays were not tuples, or not a Record, would be an exception fault of answer/pf
+    assert not [f for f in faults if f["kind"] in ("exception", "type")], faults
+    memory = [data for topic, _, data in events if topic == "receiver/a.cs/memory"]
+    assert memory[-1]["received"] >= pings - 5
+    assert memory[-1]["lastPing"]["stamp"][1] == float(memory[-1]["lastPing"]["count"])
+    assert "Traceback" not in receiver.output + sender.output
+
+
+def test_a_killed_sender_leaves_its_receiver_holding_and_a_restarted_one_resumes_the_flow(
+    tmp_path: Path, processes: list[Process]
+) -> None:
+    deploy = deployment(tmp_path, [(["sender/a"], False), (["receiver/a"], False)])
+    common = [str(PINGPONG), "--transport", "zenoh", "--deployment", str(deploy)]
+    receiver = run(
+        processes,
+        tmp_path / "receiver.log",
+        [*common, "--agents", "receiver/a", "--duration", "60s", "--trace", str(tmp_path / "r.mcap")],
+    )
+    first = run(processes, tmp_path / "first.log", [*common, "--agents", "sender/a", "--duration", "60s"])
+    receiver.wait_for("sender/a is alive", 30)
+    first.wait_for("starting", 30)
+    time.sleep(1.0)
+    os.kill(first.child.pid, signal.SIGKILL)
+    lost = receiver.wait_for("sender/a disappeared: ping/ib are stale", 20)
+    time.sleep(1.0)
+    second = run(processes, tmp_path / "second.log", [*common, "--agents", "sender/a", "--duration", "3s"])
+    receiver.wait_for("sender/a is alive: receiver/a.cs ping/ib receive again from it", 30, after=lost)
+    assert second.finish(60) == 0, second.output
+    receiver.child.send_signal(signal.SIGTERM)
+    assert receiver.finish(30) == 130, receiver.output  # stopped by us: the trace is closed
+    assert "Traceback" not in receiver.output
+    events = trace(tmp_path / "r.mcap")
+    stale = [t for topic, t, data in events if topic == "/earl/faults" and data["kind"] == "stale"]
+    assert len(stale) >= 1
+    changes = [(t, data["to"]) for topic, t, data in events if topic == "receiver/a.cs/fsm"]
+    # stale input: timeout(ping/ib) holds, the receiver holds; the pings of the restarted sender bring it back
+    assert any(t >= stale[0] and state == "holding" for t, state in changes), changes
+    back = [t for t, state in changes if state == "listen" and t > stale[0]]
+    assert back, changes
+    assert received(second.output, "receiver,sender") > 50, second.output
+
+
+def test_a_peer_with_another_data_type_is_refused_with_both_types_named(
+    tmp_path: Path, processes: list[Process]
+) -> None:
+    other = tmp_path / "other"
+    shutil.copytree(PINGPONG, other)
+    spec = other / "system.earl"
+    spec.write_text(spec.read_text().replace("stamp: double[2]", "stamp: double[3]"))
+    (other / "pingpong" / "sender.py").write_text(
+        (other / "pingpong" / "sender.py")
+        .read_text()
+        .replace("(context.time, float(count))", "(context.time, 0.0, 1.0)")
+    )
+    deploy = deployment(tmp_path, [(["sender/a"], False), (["receiver/a"], False)])
+    common = ["--transport", "zenoh", "--deployment", str(deploy), "--duration", "3s"]
+    receiver = run(processes, tmp_path / "receiver.log", [str(PINGPONG), *common, "--agents", "receiver/a"])
+    sender = run(processes, tmp_path / "sender.log", [str(other), *common, "--agents", "sender/a"])
+    assert sender.finish(60) == 0, sender.output
+    assert receiver.finish(60) == 0, receiver.output
+    theirs = PING.replace("double[2]", "double[3]")
+    output = receiver.output
+    assert f"refused a message of `{theirs}` from sender/a; receiver/a.cs ping/ib expects `{PING}`" in output
+    # reported once (and shown again as the run's first fault), then counted
+    assert output.count("earl run: receiver/a.cs: link sender,receiver") == 1
+    line = next(line for line in output.splitlines() if line.startswith("link sender,receiver ("))
+    refused = int(line.split(", ")[-1].split(" ")[0])
+    assert refused > 50, line
+    assert received(output, "sender,receiver") == 0
+
+
+def test_malformed_bytes_injected_on_a_link_key_are_counted_and_dropped(
+    tmp_path: Path, processes: list[Process]
+) -> None:
+    import msgpack  # type: ignore[import-untyped]
+    import zenoh
+
+    from earl.transport.codec import fingerprint
+    from earl.transport.zenoh_transport import default_config
+
+    deploy = deployment(tmp_path, [(["sender/a"], False), (["receiver/a"], False)])
+    sender_endpoint = deploy.read_text().split('listen = "')[1].split('"')[0]
+    receiver_endpoint = deploy.read_text().split('listen = "')[2].split('"')[0]
+    receiver = run(
+        processes,
+        tmp_path / "receiver.log",
+        [str(PINGPONG), "--transport", "zenoh", "--deployment", str(deploy), "--duration", "4s"]
+        + ["--agents", "receiver/a", "--wait-for-peers", "0.5s"],
+    )
+    receiver.wait_for("starting without sender/a", 30)
+    # the test plays a broken sender/a, listening where sender/a would
+    session = zenoh.open(default_config([sender_endpoint], [receiver_endpoint]))
+    try:
+        publisher = session.declare_publisher("earl/pingPong/sender,receiver")
+        ours = fingerprint(PING)
+        garbage = [
+            b"",
+            b"\x01\x02",
+            ours + b"\xc1",  # never valid msgpack
+            ours + msgpack.packb({"count": "three", "stamp": [0.0, 0.0]}),
+            ours + msgpack.packb([1, 2]),
+            b"\xde\xad\xbe\xef" * 8,  # another fingerprint: refused, not malformed
+        ]
+        time.sleep(1.0)  # let the sessions meet
+        for payload in garbage:
+            publisher.put(payload)
+        valid = ours + msgpack.packb({"count": 7, "stamp": [0.5, 7.0], "note": None})
+        publisher.put(valid)
+        assert receiver.finish(60) == 0, receiver.output
+    finally:
+        session.close()  # type: ignore[no-untyped-call]
+    output = receiver.output
+    reported = "earl run: receiver/a.cs: link sender,receiver (earl/pingPong/sender,receiver): dropped malformed bytes"
+    assert output.count(reported) == 1  # the first is reported, the others counted
+    assert "refused a message of an unknown type (fingerprint deadbeefdeadbeef" in output
+    assert (
+        "link sender,receiver (earl/pingPong/sender,receiver): 1 received, 5 malformed (dropped), 1 refused" in output
+    )
+    assert "Traceback" not in output
+
+
+def test_pick_and_place_split_over_two_processes_survives_a_killed_task_agent_and_completes(
+    tmp_path: Path, processes: list[Process]
+) -> None:
+    """The example in real time: manip/a and grip/a with the MuJoCo workcell in one process, task/a in
+    another.  task/a is killed (SIGKILL) during its approach: the manipulator finishes the motion it was
+    given and holds still with stale inputs; a new task/a process starts the task over and completes it."""
+    deploy = deployment(tmp_path, [(["manip/a", "grip/a"], True), (["task/a"], False)])
+    common = [str(PICK_AND_PLACE), "--transport", "zenoh", "--deployment", str(deploy), "--param", "N=3"]
+    robot = run(
+        processes,
+        tmp_path / "robot.log",
+        [*common, "--agents", "manip/a,grip/a", "--duration", "120s", "--trace", str(tmp_path / "robot.mcap")],
+    )
+    task_arguments = [*common, "--agents", "task/a", "--environment", "none"]
+    first = run(processes, tmp_path / "first.log", [*task_arguments, "--duration", "120s"])
+    robot.wait_for("task/a is alive", 60)
+    time.sleep(1.5)  # task/a is in its approach: manip/a moves
+    os.kill(first.child.pid, signal.SIGKILL)
+    lost = robot.wait_for("task/a disappeared", 20)
+    time.sleep(2.0)  # manip/a finishes its motion and holds
+    second = run(
+        processes,
+        tmp_path / "second.log",
+        [*task_arguments, "--duration", "18s", "--trace", str(tmp_path / "task.mcap")],
+    )
+    robot.wait_for("task/a is alive: manip/a.cs manipulatorCommand/ib receive again from it", 60, after=lost)
+    assert second.finish(90) == 0, second.output
+    robot.child.send_signal(signal.SIGTERM)
+    assert robot.finish(60) == 130, robot.output
+    output = robot.output
+    assert "Traceback" not in output + second.output
+    assert "pick-and-place: placed=true" in output, output
+    task_states = [data["to"] for topic, _, data in trace(tmp_path / "task.mcap") if topic == "task/a.cs/fsm"]
+    assert task_states[-1] == "done", task_states
+
+    events = trace(tmp_path / "robot.mcap")
+    stale = [
+        t
+        for topic, t, data in events
+        if topic == "/earl/faults" and data["kind"] == "stale" and data["subsystem"] == "manip/a.cs"
+    ]
+    assert stale, "manip/a.cs never saw task/a go"
+    changes = [(t, data["to"]) for topic, t, data in events if topic == "manip/a.cs/fsm"]
+    resumed = next(t for t, state in changes if t > stale[0] and state != "idle")
+    idle = max(t for t, state in changes if t < resumed and state == "idle")
+    assert idle > stale[0] - 5_000_000_000  # it was idle, holding, when the new task/a began
+    holding = [
+        data["currentJointPos"]
+        for topic, t, data in events
+        if topic == "manip/a.cs/memory" and idle + 500_000_000 <= t < resumed
+    ]
+    assert len(holding) > 100, "manip/a.cs held for less than the outage"
+    for joint in range(3):
+        positions = [q[joint] for q in holding]
+        assert max(positions) - min(positions) < 2e-3, f"joint {joint + 1} moved while task/a was gone"
