@@ -115,7 +115,7 @@ def run(processes: list[Process], log: Path, arguments: list[str]) -> Process:
 def trace(path: Path) -> list[tuple[str, int, dict[str, Any]]]:
     with open(path, "rb") as stream:
         return [
-            (channel.topic, message.log_time, json.loads(message.data))
+            (channel.topic, message.log_time, json.loads(bytes(message.data)))
             for _, channel, message in make_reader(stream).iter_messages(log_time_order=True)
         ]
 
@@ -233,8 +233,10 @@ def test_malformed_bytes_injected_on_a_link_key_are_counted_and_dropped(
     receiver = run(
         processes,
         tmp_path / "receiver.log",
-        [str(PINGPONG), "--transport", "zenoh", "--deployment", str(deploy), "--duration", "4s"]
-        + ["--agents", "receiver/a", "--wait-for-peers", "0.5s"],
+        [
+            *(str(PINGPONG), "--transport", "zenoh", "--deployment", str(deploy), "--duration", "4s"),
+            *("--agents", "receiver/a", "--wait-for-peers", "0.5s"),
+        ],
     )
     receiver.wait_for("starting without sender/a", 30)
     # the test plays a broken sender/a, listening where sender/a would
