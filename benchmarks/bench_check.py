@@ -144,6 +144,11 @@ def bench_sizes(sizes: list[int], runs: int) -> list[dict[str, Any]]:
         row["runs"] = runs
         for phase in ("read", "expand", "rules", "total"):
             row[phase] = asdict(median([Timing(**one[phase]) for one in measured]))
+        # Another process on a shared machine only ever adds time: the best run is the least disturbed.
+        row["best_total"] = {
+            "wall": min(one["total"]["wall"] for one in measured),
+            "cpu": min(one["total"]["cpu"] for one in measured),
+        }
         rows.append(row)
     return rows
 
@@ -316,10 +321,13 @@ def bench_fsm(predicates: int, transitions: int, runs: int, peer: bool) -> dict[
 
 def report(sizes: list[dict[str, Any]], fsms: list[dict[str, Any]]) -> dict[str, Any]:
     print()
-    print(f"{'agents':>8} {'subsystems':>10} | {'read (peer)':>13} {'expand':>13} {'rules':>13} {'total':>13}")
-    print(f"{'':>8} {'':>10} | {'wall / CPU s':>13} {'wall / CPU s':>13} {'wall / CPU s':>13} {'wall / CPU s':>13}")
+    heads = ("read (peer)", "expand", "rules", "total", "best total")
+    print(f"{'agents':>8} {'subsystems':>10} | " + " ".join(f"{h:>13}" for h in heads))
+    print(f"{'':>8} {'':>10} | " + " ".join(f"{'wall / CPU s':>13}" for _ in heads))
     for row in sizes:
-        cells = [f"{row[p]['wall']:5.2f} / {row[p]['cpu']:5.2f}" for p in ("read", "expand", "rules", "total")]
+        cells = [
+            f"{row[p]['wall']:5.2f} / {row[p]['cpu']:5.2f}" for p in ("read", "expand", "rules", "total", "best_total")
+        ]
         print(f"{row['agents']:>8} {row['subsystems']:>10} | " + " ".join(f"{c:>13}" for c in cells))
     doubling = []
     for smaller, larger in itertools.pairwise(sizes):
@@ -330,12 +338,15 @@ def report(sizes: list[dict[str, Any]], fsms: list[dict[str, Any]]) -> dict[str,
                     "to_agents": larger["agents"],
                     "wall_ratio": larger["total"]["wall"] / smaller["total"]["wall"],
                     "cpu_ratio": larger["total"]["cpu"] / smaller["total"]["cpu"],
+                    "best_wall_ratio": larger["best_total"]["wall"] / smaller["best_total"]["wall"],
+                    "best_cpu_ratio": larger["best_total"]["cpu"] / smaller["best_total"]["cpu"],
                 }
             )
     print()
     for d in doubling:
         print(
-            f"doubling {d['from_agents']} -> {d['to_agents']} agents: {d['wall_ratio']:.2f}x wall, {d['cpu_ratio']:.2f}x CPU"
+            f"doubling {d['from_agents']} -> {d['to_agents']} agents: median {d['wall_ratio']:.2f}x wall, "
+            f"{d['cpu_ratio']:.2f}x CPU; best run {d['best_wall_ratio']:.2f}x wall, {d['best_cpu_ratio']:.2f}x CPU"
         )
     print()
     print(f"{'predicates':>10} {'transitions':>11} | {'BDD (earl) s':>13} {'truth table (peer) s':>21} | findings")
@@ -353,12 +364,15 @@ def report(sizes: list[dict[str, Any]], fsms: list[dict[str, Any]]) -> dict[str,
         else {
             "wall": target["total"]["wall"] < TARGET_SECONDS,
             "cpu": target["total"]["cpu"] < TARGET_SECONDS,
+            "best_wall": target["best_total"]["wall"] < TARGET_SECONDS,
         },
         "b_doubling_under_2_2x": None
         if not doubling
         else {
             "wall": all(d["wall_ratio"] < TARGET_DOUBLING for d in doubling),
             "cpu": all(d["cpu_ratio"] < TARGET_DOUBLING for d in doubling),
+            "best_wall": all(d["best_wall_ratio"] < TARGET_DOUBLING for d in doubling),
+            "best_cpu": all(d["best_cpu_ratio"] < TARGET_DOUBLING for d in doubling),
         },
         "c_fsm_20_predicates_50_transitions_under_1_s": None
         if fsm is None
