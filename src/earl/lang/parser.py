@@ -8,6 +8,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from functools import lru_cache
 from importlib import resources
+from operator import attrgetter
 from typing import Any
 
 from lark import Lark, Token
@@ -201,34 +202,48 @@ def _explain(error: UnexpectedInput, path: str, text: str) -> Diagnostic:
     return translate(error, path, text, keyword_terminals())
 
 
+#: The attributes that hold an element's parts, in any order; `fsm` holds one part, not a list.
+_PART_LISTS = (
+    "fields",
+    "subsystems",
+    "links",
+    "parameters",
+    "input_buffers",
+    "output_buffers",
+    "memories",
+    "primitive_predicates",
+    "partial_transition_functions",
+    "stage_sets",
+    "basic_behaviours",
+    "states",
+    "transitions",
+    "assumptions",
+)
+
+#: Per class: whether it carries comments, which of `_PART_LISTS` it has, whether it has an `fsm`.
+_SHAPES: dict[type, tuple[bool, tuple[str, ...], bool]] = {}
+
+
+def _shape(cls: type) -> tuple[bool, tuple[str, ...], bool]:
+    fields = {f.name for f in getattr(cls, "__dataclass_fields__", {}).values()}
+    shape = ("comments" in fields, tuple(a for a in _PART_LISTS if a in fields), "fsm" in fields)
+    _SHAPES[cls] = shape
+    return shape
+
+
 def _statements(declarations: list[Any]) -> list[Any]:
     """Every element that can carry comments, in any order (sorted later)."""
     found: list[Any] = []
     stack = list(declarations)
     while stack:
         element = stack.pop()
-        if hasattr(element, "comments") and getattr(element, "location", None) is not None:
+        carries, parts, has_fsm = _SHAPES.get(type(element)) or _shape(type(element))
+        if carries and element.location is not None:
             found.append(element)
-        for attribute in (
-            "fields",
-            "subsystems",
-            "links",
-            "parameters",
-            "input_buffers",
-            "output_buffers",
-            "memories",
-            "primitive_predicates",
-            "partial_transition_functions",
-            "stage_sets",
-            "basic_behaviours",
-            "states",
-            "transitions",
-            "assumptions",
-        ):
-            stack.extend(getattr(element, attribute, None) or [])
-        fsm = getattr(element, "fsm", None)
-        if fsm is not None:
-            stack.append(fsm)
+        for attribute in parts:
+            stack.extend(getattr(element, attribute) or ())
+        if has_fsm and element.fsm is not None:
+            stack.append(element.fsm)
     return found
 
 
@@ -241,7 +256,7 @@ def attach_comments(declarations: list[Any], comments: list[Token], path: str) -
     closing: list[str] = []
     if not comments:
         return closing
-    elements = sorted(_statements(declarations), key=lambda e: (e.location.line, e.location.column))
+    elements = sorted(_statements(declarations), key=attrgetter("location.line", "location.column"))
     by_line: dict[int, Any] = {}
     for element in elements:
         by_line.setdefault(element.location.line, element)
