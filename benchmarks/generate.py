@@ -245,7 +245,7 @@ def generate(agents: int) -> str:
         robot = f"robot{(first - 1) // AGENTS_PER_ROBOT + 1:04d}"
         body = [f"    {_agent_name(i)}/a" for i in members]
         body.extend(f"    link {_agent_name(i)},{_agent_name(i + 1)}" for i in members if i + 1 in members)
-        parts.append(f"{robot}/r {{\n" + "\n".join(body) + "\n}\n")
+        parts.append(("\n" if first > 1 else "") + f"{robot}/r {{\n" + "\n".join(body) + "\n}\n")
     return "".join(parts)
 
 

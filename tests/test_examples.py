@@ -79,6 +79,8 @@ def test_the_benchmark_spec_generator_writes_a_valid_canonical_spec() -> None:
     assert [len(agent.subsystems) for agent in system.agents] == [7, 7, 7]
     assert _problems(check(system), Severity.ERROR, Severity.WARNING) == []
     assert system.to_earl() == text
+    larger = generate(12)  # two robots
+    assert earl.loads(larger, "generated.earl").to_earl() == larger
 
 
 def test_a_non_canonical_file_fails_fmt_check(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
