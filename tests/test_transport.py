@@ -157,3 +157,21 @@ def test_a_deployment_must_cover_the_agents_of_the_system(tmp_path: Path) -> Non
         deployment.check_agents(["receiver/a"])
     with pytest.raises(DeploymentError, match="no process runs exactly the agents receiver/a"):
         deployment.group_of(["receiver/a"])
+
+
+@pytest.mark.parametrize("size", [0, 1, 6, 454])
+def test_arrays_of_doubles_are_written_exactly_as_msgpack_writes_them(size: int) -> None:
+    types = type_system(f"system wire\ntype Joints = double[{size}]\n")
+    codec = LinkCodec(types, TypeReference("Joints"), "a test")
+    value = tuple(float(i) * -1.5 for i in range(size))
+    payload = codec.encode(value)
+    assert payload == codec.fingerprint + msgpack.packb(value)
+    decoded = codec.decode(payload)
+    assert decoded == value and type(decoded) is tuple
+    # the general path reads what another msgpack writer sends: ints where doubles are declared
+    assert codec.decode(codec.fingerprint + msgpack.packb(list(range(size)))) == tuple(float(i) for i in range(size))
+    if size:
+        with pytest.raises(MalformedMessage, match="NaN"):
+            codec.decode(codec.fingerprint + msgpack.packb([float("nan")] * size))
+        with pytest.raises(MalformedMessage):
+            codec.decode(codec.fingerprint + msgpack.packb(["x"] * size))

@@ -30,8 +30,12 @@ class Inbox:
 
     def put(self, action: Action, value: Any) -> None:
         """From any thread: run `action(time, value)` in the scheduler's thread at its next drain."""
-        self._items.append((action, value))
-        self._event.set()
+        items = self._items
+        idle = not items
+        items.append((action, value))
+        # only a consumer that found the inbox empty can be asleep: waking it once is enough
+        if idle:
+            self._event.set()
 
     @property
     def pending(self) -> bool:

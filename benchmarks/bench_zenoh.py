@@ -1,0 +1,398 @@
+"""A link between two processes: earl's Zenoh transport against raw Zenoh pub/sub, same payloads.
+
+    .venv/bin/python benchmarks/bench_zenoh.py
+
+Two OS processes on 127.0.0.1 (this one and an echo child), peer mode, explicit endpoints.
+For 64 B and 4 KiB messages (a `double[6]` and a `double[454]` with earl's 8-byte type
+fingerprint; raw Zenoh sends byte strings of exactly the same length):
+
+- latency: ping-pong; one-way latency = round trip / 2; p50 and p99 over the samples;
+- throughput: the sender publishes as fast as it can for a fixed time; the receiver counts
+  what it received and for how long (messages per second at the receiver).
+
+The earl side is the real transport (earl.transport.zenoh_transport) serving links built
+by the real builder: the sender's output goes through the codec and a publisher; the
+receiver decodes and type-checks on Zenoh's thread, hands over through the inbox and
+delivers into the input buffer's channel in its main thread, which is where a subsystem
+would read it.  The raw peer is the least a Python program can do: the echo publishes
+from the subscriber callback, and the pinger wakes on a threading.Event.  Results go to
+benchmarks/results/zenoh.json.  Goals (issue 7): earl latency <= 1.2x raw, throughput >= 0.8x raw.
+"""
+
+from __future__ import annotations
+
+import json
+import socket
+import statistics
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from collections import deque
+from pathlib import Path
+from typing import Any
+
+import zenoh
+
+import earl
+from earl.model.expand import expand
+from earl.runtime.builder import build_network
+from earl.runtime.engine import Destination, SubsystemEngine
+from earl.runtime.events import Recorder
+from earl.transport.zenoh_transport import ZenohTransport, default_config
+
+HERE = Path(__file__).resolve().parent
+RESULTS = HERE / "results" / "zenoh.json"
+SIZES = {"64 B": 6, "4 KiB": 454}  # doubles per message: 8 + 1 + 9*6 = 63 B, 8 + 3 + 9*454 = 4097 B
+ROUND_TRIPS = 2000
+WARM_UP = 200
+THROUGHPUT_SECONDS = 2.0
+
+SPEC = """\
+system bench
+param K: int = 6
+ping/a {
+    cs {
+        period 1 ms
+        back/ib: double[K]
+        out/ob: double[K]
+        last/m: double[K]
+        false/pp = false
+        copy/pf(back/ib -> last/mo) = python "benchcode:copy"
+        send/pf(last/mi -> out/ob) = python "benchcode:send"
+        run/bb {
+            tf = {copy/pf} then {send/pf}
+            tc = false/pp
+        }
+        fsm {
+            initial run
+            state run: run/bb
+        }
+    }
+}
+echo/a {
+    cs {
+        period 1 ms
+        in/ib: double[K]
+        back/ob: double[K]
+        last/m: double[K]
+        false/pp = false
+        copy/pf(in/ib -> last/mo) = python "benchcode:copy_in"
+        send/pf(last/mi -> back/ob) = python "benchcode:send_back"
+        run/bb {
+            tf = {copy/pf} then {send/pf}
+            tc = false/pp
+        }
+        fsm {
+            initial run
+            state run: run/bb
+        }
+    }
+}
+link ping,echo: ping/a.cs.out -> echo/a.cs.in
+link echo,ping: echo/a.cs.back -> ping/a.cs.back
+benchRobot/r {
+    ping/a
+    echo/a
+    link ping,echo
+    link echo,ping
+}
+"""
+
+CODE = """\
+def copy(i, o, c): o.last = i.back
+def send(i, o, c): o.out = i.last
+def copy_in(i, o, c): o.last = i["in/ib"]
+def send_back(i, o, c): o.back = i.last
+"""
+
+
+# ---------------------------------------------------------------- earl side
+class EarlEnd:
+    """One agent of the bench spec in this process: its input channel and its output's sink."""
+
+    def __init__(self, directory: Path, agent: str, doubles: int, listen: str, connect: str) -> None:
+        system = earl.load(directory / "system.earl")
+        expanded = expand(system, {"K": doubles})
+        self.transport = ZenohTransport("bench", [agent], default_config([listen], [connect]), lambda _: None)
+        network = build_network(
+            expanded, recorder=Recorder(), agents={agent}, remote=self.transport, code_directories=[directory]
+        )
+        engine: SubsystemEngine = network.engines[0]
+        self.channel = next(iter(engine.channels.values()))
+        destination: Destination = next(iter(engine.destinations.values()))[0]
+        self.sink = destination.channel
+        self.transport.start()
+        self.inbox = self.transport.inbox
+
+    def receive(self, timeout: float) -> Any:
+        """The next message in the input buffer's channel, as the scheduler would deliver it."""
+        deadline = time.perf_counter() + timeout
+        queue = self.channel.queue
+        while not queue:
+            remaining = deadline - time.perf_counter()
+            if remaining <= 0:
+                raise TimeoutError("no message")
+            self.inbox.wait(remaining)
+            self.inbox.drain(0)
+        return queue.popleft()
+
+    def close(self) -> None:
+        self.transport.close()
+
+
+def earl_echo(directory: Path, doubles: int, listen: str, connect: str) -> None:
+    end = EarlEnd(directory, "echo/a", doubles, listen, connect)
+    print("ready", flush=True)
+    try:
+        while True:
+            try:
+                value = end.receive(10.0)
+            except TimeoutError:
+                return
+            if value and value[0] < 0:  # the throughput phase: count, do not answer
+                _count_throughput(end, value)
+                continue
+            end.sink.deliver(value)
+    finally:
+        end.close()
+
+
+def _count_throughput(end: EarlEnd, first: Any) -> None:
+    count, started, last = 1, time.perf_counter(), time.perf_counter()
+    while True:
+        try:
+            value = end.receive(1.0)
+        except TimeoutError:
+            break
+        if value[0] == -2.0:  # end marker
+            break
+        count += 1
+        last = time.perf_counter()
+    end.sink.deliver((float(count), last - started) + (0.0,) * (len(first) - 2))
+
+
+# ---------------------------------------------------------------- raw side
+class RawEnd:
+    def __init__(self, listen: str, connect: str, subscribe: str, publish: str) -> None:
+        self.session = zenoh.open(default_config([listen], [connect]))
+        self.publisher = self.session.declare_publisher(publish, express=True)
+        self.received: deque[bytes] = deque()
+        self.event = threading.Event()
+        self.subscriber = self.session.declare_subscriber(subscribe, self._on_sample)
+
+    def _on_sample(self, sample: zenoh.Sample) -> None:
+        self.received.append(sample.payload.to_bytes())
+        self.event.set()
+
+    def receive(self, timeout: float) -> bytes:
+        deadline = time.perf_counter() + timeout
+        while not self.received:
+            remaining = deadline - time.perf_counter()
+            if remaining <= 0:
+                raise TimeoutError("no message")
+            self.event.wait(remaining)
+            self.event.clear()
+        return self.received.popleft()
+
+
+def raw_echo(size: int, listen: str, connect: str, handover: bool) -> None:
+    """Echo raw bytes; with `handover`, from the main thread (as a control loop must), else from the callback."""
+    session = zenoh.open(default_config([listen], [connect]))
+    publisher = session.declare_publisher("raw/back", express=True)
+    state: dict[str, Any] = {"count": 0, "first": 0.0, "last": 0.0}
+    done = threading.Event()
+    arrived: deque[bytes] = deque()
+    wake = threading.Event()
+
+    def on_sample(sample: zenoh.Sample) -> None:
+        if handover:
+            idle = not arrived
+            arrived.append(sample.payload.to_bytes())
+            if idle:
+                wake.set()
+        else:
+            handle(sample.payload.to_bytes())
+
+    def handle(payload: bytes) -> None:
+        if payload[:1] == b"T":  # throughput phase
+            if state["count"] == 0:
+                state["first"] = time.perf_counter()
+            state["count"] += 1
+            state["last"] = time.perf_counter()
+            return
+        if payload[:1] == b"E":  # end of the throughput phase
+            report = json.dumps({"count": state["count"], "seconds": state["last"] - state["first"]}).encode()
+            publisher.put(b"R" + report)
+            state["count"] = 0
+            return
+        if payload[:1] == b"Q":
+            done.set()
+            return
+        publisher.put(payload)  # echo straight from the callback: the least work possible
+
+    subscriber = session.declare_subscriber("raw/out", on_sample)
+    print("ready", flush=True)
+    deadline = time.monotonic() + 120
+    while handover and not done.is_set() and time.monotonic() < deadline:
+        if not arrived:
+            wake.wait(1.0)
+        wake.clear()
+        while arrived:
+            handle(arrived.popleft())
+    done.wait(max(0.0, deadline - time.monotonic()))
+    del subscriber
+    session.close()  # type: ignore[no-untyped-call]
+
+
+# ---------------------------------------------------------------- the measuring side
+def free_ports(count: int) -> list[int]:
+    sockets = [socket.socket() for _ in range(count)]
+    for s in sockets:
+        s.bind(("127.0.0.1", 0))
+    ports = [s.getsockname()[1] for s in sockets]
+    for s in sockets:
+        s.close()
+    return ports
+
+
+def child(arguments: list[str]) -> subprocess.Popen[str]:
+    process = subprocess.Popen(
+        [sys.executable, __file__, *arguments], stdout=subprocess.PIPE, stdin=subprocess.DEVNULL, text=True
+    )
+    assert process.stdout is not None
+    if process.stdout.readline().strip() != "ready":
+        process.kill()
+        raise RuntimeError(f"the echo process did not start: {arguments}")
+    return process
+
+
+def percentile(samples: list[float], fraction: float) -> float:
+    ordered = sorted(samples)
+    return ordered[min(len(ordered) - 1, int(fraction * len(ordered)))]
+
+
+def measure_earl(directory: Path, doubles: int) -> dict[str, float]:
+    mine, theirs = free_ports(2)
+    listen, connect = f"tcp/127.0.0.1:{mine}", f"tcp/127.0.0.1:{theirs}"
+    echo = child(["earl-echo", str(directory), str(doubles), connect, listen])
+    end = EarlEnd(directory, "ping/a", doubles, listen, connect)
+    try:
+        end.transport.wait_for_peers(10)
+        time.sleep(0.5)
+        value = tuple(float(i) for i in range(doubles))
+        samples = []
+        for round_trip in range(WARM_UP + ROUND_TRIPS):
+            started = time.perf_counter()
+            end.sink.deliver(value)
+            end.receive(5.0)
+            if round_trip >= WARM_UP:
+                samples.append((time.perf_counter() - started) / 2)
+        marker = (-1.0, *value[1:])
+        stop_at = time.perf_counter() + THROUGHPUT_SECONDS
+        sent = 0
+        while time.perf_counter() < stop_at:
+            end.sink.deliver(marker)
+            sent += 1
+        end.sink.deliver((-2.0, *value[1:]))
+        report = end.receive(15.0)
+        count, seconds = report[0], report[1]
+        return _figures(samples, count, seconds, sent)
+    finally:
+        end.close()
+        echo.wait(20)
+
+
+def measure_raw(size: int, handover: bool) -> dict[str, float]:
+    mine, theirs = free_ports(2)
+    listen, connect = f"tcp/127.0.0.1:{mine}", f"tcp/127.0.0.1:{theirs}"
+    echo = child(["raw-echo", str(size), connect, listen, "handover" if handover else "callback"])
+    end = RawEnd(listen, connect, "raw/back", "raw/out")
+    try:
+        time.sleep(1.0)
+        payload = bytes(size)
+        samples = []
+        for round_trip in range(WARM_UP + ROUND_TRIPS):
+            started = time.perf_counter()
+            end.publisher.put(payload)
+            end.receive(5.0)
+            if round_trip >= WARM_UP:
+                samples.append((time.perf_counter() - started) / 2)
+        marker = b"T" + bytes(size - 1)
+        stop_at = time.perf_counter() + THROUGHPUT_SECONDS
+        sent = 0
+        while time.perf_counter() < stop_at:
+            end.publisher.put(marker)
+            sent += 1
+        time.sleep(0.3)
+        end.publisher.put(b"E")
+        report = json.loads(end.receive(15.0)[1:])
+        end.publisher.put(b"Q")
+        return _figures(samples, report["count"], report["seconds"], sent)
+    finally:
+        end.session.close()  # type: ignore[no-untyped-call]
+        echo.wait(20)
+
+
+def _figures(samples: list[float], count: float, seconds: float, sent: int) -> dict[str, float]:
+    return {
+        "latency_p50_us": statistics.median(samples) * 1e6,
+        "latency_p99_us": percentile(samples, 0.99) * 1e6,
+        "throughput_msgs_per_s": count / seconds if seconds > 0 else 0.0,
+        "delivered_fraction": count / sent if sent else 0.0,
+    }
+
+
+def main() -> int:
+    results: dict[str, Any] = {"round_trips": ROUND_TRIPS, "throughput_seconds": THROUGHPUT_SECONDS, "sizes": {}}
+    rows = []
+    with tempfile.TemporaryDirectory() as scratch:
+        directory = Path(scratch)
+        (directory / "system.earl").write_text(SPEC)
+        (directory / "benchcode.py").write_text(CODE)
+        for label, doubles in SIZES.items():
+            size = 8 + (1 if doubles < 16 else 3) + 9 * doubles
+            raw = measure_raw(size, handover=False)
+            handed = measure_raw(size, handover=True)
+            mine = measure_earl(directory, doubles)
+            latency_ratio = mine["latency_p50_us"] / raw["latency_p50_us"]
+            p99_ratio = mine["latency_p99_us"] / raw["latency_p99_us"]
+            throughput_ratio = mine["throughput_msgs_per_s"] / raw["throughput_msgs_per_s"]
+            results["sizes"][label] = {
+                "bytes": size,
+                "earl": mine,
+                "raw_zenoh": raw,
+                "raw_zenoh_with_handover": handed,
+                "latency_p50_ratio": latency_ratio,
+                "latency_p99_ratio": p99_ratio,
+                "throughput_ratio": throughput_ratio,
+                "latency_goal_met": latency_ratio <= 1.2,
+                "throughput_goal_met": throughput_ratio >= 0.8,
+            }
+            for name, key, ratio, goal in [
+                (f"{label} latency p50 (us)", "latency_p50_us", latency_ratio, 1.2),
+                (f"{label} latency p99 (us)", "latency_p99_us", p99_ratio, 1.2),
+                (f"{label} throughput (msg/s)", "throughput_msgs_per_s", throughput_ratio, 0.8),
+            ]:
+                rows.append((name, mine[key], raw[key], handed[key], ratio, goal))
+    print(f"{'benchmark':30} {'earl':>10} {'raw zenoh':>10} {'raw+handover':>13} {'ratio':>6}  goal (earl/raw)")
+    for name, mine_value, raw_value, handed_value, ratio, goal in rows:
+        if "throughput" in name:
+            verdict = f"ratio >= {goal} {'met' if ratio >= goal else 'NOT met'}"
+        else:
+            verdict = f"ratio <= {goal} {'met' if ratio <= goal else 'NOT met'}"
+        print(f"{name:30} {mine_value:10,.1f} {raw_value:10,.1f} {handed_value:13,.1f} {ratio:6.2f}  {verdict}")
+    RESULTS.parent.mkdir(parents=True, exist_ok=True)
+    RESULTS.write_text(json.dumps(results, indent=2) + "\n")
+    print(f"results: {RESULTS}")
+    return 0
+
+
+if __name__ == "__main__":
+    if len(sys.argv) > 1 and sys.argv[1] == "earl-echo":
+        earl_echo(Path(sys.argv[2]), int(sys.argv[3]), sys.argv[4], sys.argv[5])
+    elif len(sys.argv) > 1 and sys.argv[1] == "raw-echo":
+        raw_echo(int(sys.argv[2]), sys.argv[3], sys.argv[4], sys.argv[5] == "handover")
+    else:
+        raise SystemExit(main())
