@@ -195,17 +195,22 @@ def save(system: System, path: str | Path) -> None:
 
 def loads(text: str, path: str = "<text>", parameters: Mapping[str, ParameterValue] | None = None) -> System:
     """Like `load`, for text in memory; imports are resolved against the working directory."""
+    sources = SourceMap()
+    with collection_paused():
+        return _loads(text, path, parameters, sources)
+
+
+def _loads(text: str, path: str, parameters: Mapping[str, ParameterValue] | None, sources: SourceMap) -> System:
     from earl.lang.resolver import resolve
 
-    sources = SourceMap()
     root = parse_text(text, path, sources)
     if any(isinstance(d, Import) for d in root.declarations):
         base = Path(path).parent if path != "<text>" else Path.cwd()
         imported: list[ParsedFile] = []
         for declaration in root.declarations:
             if isinstance(declaration, Import):
-                _, more = load_files(base / declaration.path, sources)
-                imported.extend([*more, read_file(base / declaration.path, sources, declaration.location)])
+                first, more = load_files(base / declaration.path, sources)
+                imported.extend([*more, first])
     else:
         imported = []
     system = merge(root, imported, sources)
