@@ -111,7 +111,7 @@ def _literal(value: object) -> object:
     return value.value if isinstance(value, Literal) else id(value)
 
 
-@dataclass
+@dataclass(slots=True)
 class ResolvedLink:
     """A concrete link with the subsystems and buffers at its ends."""
 
