@@ -7,6 +7,7 @@ For 64 B and 4 KiB messages (a `double[6]` and a `double[454]` with earl's 8-byt
 fingerprint; raw Zenoh sends byte strings of exactly the same length):
 
 - latency: ping-pong; one-way latency = round trip / 2; p50 and p99 over the samples;
+  each figure is the median of REPEATS runs that alternate earl and its peers;
 - throughput: the sender publishes as fast as it can for a fixed time; the receiver counts
   what it received and for how long (messages per second at the receiver).
 
@@ -14,7 +15,8 @@ The earl side is the real transport (earl.transport.zenoh_transport) serving lin
 by the real builder: the sender's output goes through the codec and a publisher; the
 receiver decodes and type-checks on Zenoh's thread, hands over through the inbox and
 delivers into the input buffer's channel in its main thread, which is where a subsystem
-would read it.  The raw peer is the least a Python program can do: the echo publishes
+would read it (the echo's buffer is a FIFO, so that every delivery is counted: a
+latest-value buffer keeps only the newest).  The raw peer is the least a Python program can do: the echo publishes
 from the subscriber callback, and the pinger wakes on a threading.Event.  Results go to
 benchmarks/results/zenoh.json.  Goals (issue 7): earl latency <= 1.2x raw, throughput >= 0.8x raw.
 """
@@ -45,9 +47,11 @@ from earl.transport.zenoh_transport import ZenohTransport, default_config
 HERE = Path(__file__).resolve().parent
 RESULTS = HERE / "results" / "zenoh.json"
 SIZES = {"64 B": 6, "4 KiB": 454}  # doubles per message: 8 + 1 + 9*6 = 63 B, 8 + 3 + 9*454 = 4097 B
-ROUND_TRIPS = 2000
+ROUND_TRIPS = 1000
+#: each measurement is repeated, alternating earl and its peers, and the median of each figure kept
+REPEATS = 3
 WARM_UP = 200
-THROUGHPUT_SECONDS = 2.0
+THROUGHPUT_SECONDS = 1.5
 
 SPEC = """\
 system bench
@@ -74,7 +78,7 @@ ping/a {
 echo/a {
     cs {
         period 1 ms
-        in/ib: double[K]
+        in/ib: double[K] fifo 1000000
         back/ob: double[K]
         last/m: double[K]
         false/pp = false
@@ -344,8 +348,17 @@ def _figures(samples: list[float], count: float, seconds: float, sent: int) -> d
     }
 
 
+def _medians(runs: list[dict[str, float]]) -> dict[str, float]:
+    return {key: statistics.median(run[key] for run in runs) for key in runs[0]}
+
+
 def main() -> int:
-    results: dict[str, Any] = {"round_trips": ROUND_TRIPS, "throughput_seconds": THROUGHPUT_SECONDS, "sizes": {}}
+    results: dict[str, Any] = {
+        "round_trips": ROUND_TRIPS,
+        "throughput_seconds": THROUGHPUT_SECONDS,
+        "repeats": REPEATS,
+        "sizes": {},
+    }
     rows = []
     with tempfile.TemporaryDirectory() as scratch:
         directory = Path(scratch)
@@ -353,9 +366,12 @@ def main() -> int:
         (directory / "benchcode.py").write_text(CODE)
         for label, doubles in SIZES.items():
             size = 8 + (1 if doubles < 16 else 3) + 9 * doubles
-            raw = measure_raw(size, handover=False)
-            handed = measure_raw(size, handover=True)
-            mine = measure_earl(directory, doubles)
+            runs: dict[str, list[dict[str, float]]] = {"raw": [], "handed": [], "earl": []}
+            for _ in range(REPEATS):
+                runs["raw"].append(measure_raw(size, handover=False))
+                runs["handed"].append(measure_raw(size, handover=True))
+                runs["earl"].append(measure_earl(directory, doubles))
+            raw, handed, mine = (_medians(runs[name]) for name in ("raw", "handed", "earl"))
             latency_ratio = mine["latency_p50_us"] / raw["latency_p50_us"]
             p99_ratio = mine["latency_p99_us"] / raw["latency_p99_us"]
             throughput_ratio = mine["throughput_msgs_per_s"] / raw["throughput_msgs_per_s"]

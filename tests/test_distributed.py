@@ -54,11 +54,12 @@ def deployment(tmp_path: Path, groups: list[tuple[list[str], bool]]) -> Path:
 class Process:
     """One `earl run` child whose output goes to a file the test reads while it runs."""
 
-    def __init__(self, log: Path, arguments: list[str]) -> None:
+    def __init__(self, log: Path, arguments: list[str], command: str = "run") -> None:
         self.log = log
         self.stream = open(log, "wb")  # noqa: SIM115 — closed in stop()
+        tail = ["--no-progress"] if command == "run" else []
         self.child = subprocess.Popen(
-            [sys.executable, "-m", "earl.cli.main", "run", *arguments, "--no-progress"],
+            [sys.executable, "-m", "earl.cli.main", command, *arguments, *tail],
             stdout=self.stream,
             stderr=subprocess.STDOUT,
             stdin=subprocess.DEVNULL,
@@ -267,6 +268,30 @@ def test_malformed_bytes_injected_on_a_link_key_are_counted_and_dropped(
     assert (
         "link sender,receiver (earl/pingPong/sender,receiver): 1 received, 5 malformed (dropped), 1 refused" in output
     )
+    assert "Traceback" not in output
+
+
+def test_launch_starts_each_process_prefixes_its_output_and_stops_them_all_on_ctrl_c(
+    tmp_path: Path, processes: list[Process]
+) -> None:
+    deploy = deployment(tmp_path, [(["sender/a"], False), (["receiver/a"], False)])
+    launch = Process(tmp_path / "launch.log", [str(PINGPONG), "--deployment", str(deploy), "--duration", "60s"], "launch")
+    processes.append(launch)
+    # the labels are padded to the longest, so the columns line up
+    launch.wait_for("[receiver/a] earl run: peers sender/a are alive; starting", 60)
+    launch.wait_for("[sender/a  ] earl run: peers receiver/a are alive; starting", 60)
+    time.sleep(0.5)
+    launch.child.send_signal(signal.SIGINT)  # what Ctrl-C sends
+    assert launch.finish(30) == 130, launch.output
+    output = launch.output
+    pids = [int(line.split("(pid ")[1].split(")")[0]) for line in output.splitlines() if "] started (pid " in line]
+    assert len(pids) == 2
+    for pid in pids:
+        with pytest.raises(ProcessLookupError):
+            os.kill(pid, 0)
+    for label in ("[receiver/a]", "[sender/a  ]"):
+        assert f"{label} stopping" in output
+        assert f"{label} earl run: interrupted at" in output  # each closed its run (and trace) itself
     assert "Traceback" not in output
 
 

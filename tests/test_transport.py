@@ -175,3 +175,35 @@ def test_arrays_of_doubles_are_written_exactly_as_msgpack_writes_them(size: int)
             codec.decode(codec.fingerprint + msgpack.packb([float("nan")] * size))
         with pytest.raises(MalformedMessage):
             codec.decode(codec.fingerprint + msgpack.packb(["x"] * size))
+
+
+@pytest.mark.parametrize(
+    ("arguments", "fragment"),
+    [
+        (["--transport", "zenoh"], "--transport zenoh needs --agents"),
+        (["--transport", "zenoh", "--agents", "nobody"], "`nobody/a` is not an agent of this system"),
+        (["--transport", "zenoh", "--agents", "sender/a"], "deploy.toml"),
+        (["--agents", "sender/a", "--zenoh-config", "z.json5"], "go with --transport zenoh"),
+        (["--transport", "zenoh", "--agents", "sender/a", "--wait-for-peers", "soon"], "is not a duration"),
+    ],
+)
+def test_distributed_usage_errors_exit_2_with_one_line(
+    arguments: list[str], fragment: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from earl.cli.main import main
+
+    assert main(["run", str(PINGPONG), *arguments]) == 2
+    error = capsys.readouterr().err
+    assert fragment in error and "Traceback" not in error
+
+
+def test_a_deployment_that_does_not_cover_the_system_stops_earl_run(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from earl.cli.main import main
+
+    deploy = tmp_path / "deploy.toml"
+    deploy.write_text("[[process]]\nagents = ['sender']\nlisten = 'tcp/127.0.0.1:1'\n")
+    arguments = ["run", str(PINGPONG), "--transport", "zenoh", "--agents", "sender", "--deployment", str(deploy)]
+    assert main(arguments) == 2
+    assert "the agent `receiver/a` runs in no process" in capsys.readouterr().err

@@ -151,6 +151,10 @@ def run(arguments: argparse.Namespace) -> int:
     if arguments.transport == "zenoh":
         if not agents:
             return usage_error("--transport zenoh needs --agents: the agents this process runs, e.g. task/a")
+        try:
+            parse_duration(arguments.wait_for_peers)
+        except ValueError as error:
+            return usage_error(f"--wait-for-peers: {error}")
         arguments.realtime = True  # distribution runs in real time only (docs/distributed.md)
     elif arguments.zenoh_config or arguments.deployment:
         return usage_error("--zenoh-config and --deployment go with --transport zenoh")
@@ -196,7 +200,18 @@ def run(arguments: argparse.Namespace) -> int:
     if transport is not None:
         from earl.transport.process import wait_for_peers
 
-        wait_for_peers(transport, arguments)
+        def stop(*_: object) -> None:
+            raise KeyboardInterrupt
+
+        previous = signal.signal(signal.SIGTERM, stop)
+        try:
+            wait_for_peers(transport, arguments)
+        except KeyboardInterrupt:
+            simulation.close()  # nothing ran; the trace is still closed and readable
+            print("earl run: interrupted while waiting for the other processes", file=sys.stderr)
+            return EXIT_INTERRUPTED
+        finally:
+            signal.signal(signal.SIGTERM, previous)
     return _execute(simulation, duration, arguments, None if no_environment else settings.report, path)
 
 

@@ -78,6 +78,8 @@ def print_link_statistics(transport: ZenohTransport) -> None:
     for statistics in transport.statistics:
         arrow = "sent" if statistics.direction == "out" else "received"
         line = f"link {statistics.link} ({statistics.key}): {statistics.messages} {arrow}"
+        if statistics.failed:
+            line += f", {statistics.failed} not sent (Zenoh refused them)"
         if statistics.direction == "in":
             line += f", {statistics.malformed} malformed (dropped), {statistics.refused} refused (type mismatch)"
         print(line, flush=True)

@@ -80,6 +80,7 @@ class LinkStatistics:
     messages: int = 0
     malformed: int = 0
     refused: int = 0
+    failed: int = 0  # sends Zenoh refused (the session closing)
 
 
 class _Output:
@@ -93,7 +94,11 @@ class _Output:
         self.statistics = statistics
 
     def deliver(self, value: Any) -> None:
-        self._put(self._encode(value))
+        try:
+            self._put(self._encode(value))
+        except Exception:  # a closing session: the sender's iteration must go on
+            self.statistics.failed += 1
+            return
         self.statistics.messages += 1
 
 
