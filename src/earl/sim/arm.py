@@ -409,8 +409,8 @@ _LOOKS = (
     "  </asset>\n"
 )
 #: The overview camera: in front, between the box and the place target, looking at the work area.
-_CAMERA = (1.25, 0.95, 0.85)
-_CAMERA_TARGET = (0.22, 0.12, 0.05)
+_CAMERA = (1.12, 0.86, 0.9)
+_CAMERA_TARGET = (0.2, 0.12, 0.2)
 
 
 def _look_at(eye: tuple[float, float, float], target: tuple[float, float, float]) -> tuple[float, ...]:
