@@ -63,6 +63,7 @@ class RobotModel:
         self.roll_joints = np.array([1.0 if kind == "roll" else 0.0 for kind in arm.joint_layout(n)])
         self._configured: tuple[float, ...] | None = None
         self._dynamics = False
+        self._bias = np.zeros(self.model.nv)
 
     def _joint(self, k: int) -> int:
         return int(mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_JOINT, arm.joint_name(k)))
@@ -107,8 +108,13 @@ class RobotModel:
             mujoco.mj_kinematics(m, d)
             mujoco.mj_comPos(m, d)
         else:
+            # only what inverse dynamics needs: the mass matrix and the bias forces (no constraints)
             d.qvel[:] = self.coupling @ qd
-            mujoco.mj_forward(m, d)
+            mujoco.mj_kinematics(m, d)
+            mujoco.mj_comPos(m, d)
+            mujoco.mj_crb(m, d)
+            mujoco.mj_comVel(m, d)
+            mujoco.mj_rne(m, d, 0, self._bias)
         self._configured = key
         self._dynamics = dynamics
 
@@ -176,7 +182,7 @@ class RobotModel:
         acceleration = np.empty(self.model.nv)
         mujoco.mj_mulM(self.model, d, acceleration, self.coupling @ np.asarray(qdd, dtype=float))
         friction = self.model.dof_damping * (self.coupling @ qd)
-        torques: Vector = self.coupling.T @ (acceleration + d.qfrc_bias + friction)
+        torques: Vector = self.coupling.T @ (acceleration + self._bias + friction)
         return torques
 
     def joint_inertia(self, q: Vector) -> Vector:
