@@ -133,7 +133,7 @@ def test_two_processes_exchange_messages_and_a_remote_message_wakes_a_waiting_su
     tmp_path: Path, processes: list[Process]
 ) -> None:
     deploy = deployment(tmp_path, [(["sender/a"], False), (["receiver/a"], False)])
-    common = [str(PINGPONG), "--transport", "zenoh", "--deployment", str(deploy), "--duration", "3s"]
+    common = [str(PINGPONG), "--transport", "zenoh", "--deployment", str(deploy), "--duration", "2s"]
     receiver = run(
         processes,
         tmp_path / "receiver.log",
@@ -173,7 +173,7 @@ def test_a_killed_sender_leaves_its_receiver_holding_and_a_restarted_one_resumes
     os.kill(first.child.pid, signal.SIGKILL)
     lost = receiver.wait_for("sender/a disappeared: ping/ib are stale", 20)
     time.sleep(1.0)
-    second = run(processes, tmp_path / "second.log", [*common, "--agents", "sender/a", "--duration", "3s"])
+    second = run(processes, tmp_path / "second.log", [*common, "--agents", "sender/a", "--duration", "2s"])
     receiver.wait_for("sender/a is alive: receiver/a.cs ping/ib receive again from it", 30, after=lost)
     assert second.finish(60) == 0, second.output
     receiver.child.send_signal(signal.SIGTERM)
@@ -203,7 +203,7 @@ def test_a_peer_with_another_data_type_is_refused_with_both_types_named(
         .replace("(context.time, float(count))", "(context.time, 0.0, 1.0)")
     )
     deploy = deployment(tmp_path, [(["sender/a"], False), (["receiver/a"], False)])
-    common = ["--transport", "zenoh", "--deployment", str(deploy), "--duration", "3s"]
+    common = ["--transport", "zenoh", "--deployment", str(deploy), "--duration", "2s"]
     receiver = run(processes, tmp_path / "receiver.log", [str(PINGPONG), *common, "--agents", "receiver/a"])
     sender = run(processes, tmp_path / "sender.log", [str(other), *common, "--agents", "sender/a"])
     assert sender.finish(60) == 0, sender.output
@@ -275,7 +275,9 @@ def test_launch_starts_each_process_prefixes_its_output_and_stops_them_all_on_ct
     tmp_path: Path, processes: list[Process]
 ) -> None:
     deploy = deployment(tmp_path, [(["sender/a"], False), (["receiver/a"], False)])
-    launch = Process(tmp_path / "launch.log", [str(PINGPONG), "--deployment", str(deploy), "--duration", "60s"], "launch")
+    launch = Process(
+        tmp_path / "launch.log", [str(PINGPONG), "--deployment", str(deploy), "--duration", "60s"], "launch"
+    )
     processes.append(launch)
     # the labels are padded to the longest, so the columns line up
     launch.wait_for("[receiver/a] earl run: peers sender/a are alive; starting", 60)

@@ -50,7 +50,9 @@ def register(commands: Any) -> None:
     )
     parser.add_argument("spec", metavar="SPEC", help="the .earl file, or a directory with a system.earl")
     parser.add_argument(
-        "--deployment", metavar="deploy.toml", help="the processes and their endpoints (default: deploy.toml next to SPEC)"
+        "--deployment",
+        metavar="deploy.toml",
+        help="the processes and their endpoints (default: deploy.toml next to SPEC)",
     )
     parser.add_argument("--duration", metavar="TIME", help="run time of every process (default: run.toml's)")
     parser.add_argument(
