@@ -121,6 +121,11 @@ def trace(path: Path) -> list[tuple[str, int, dict[str, Any]]]:
         ]
 
 
+def endpoints(deploy: Path) -> list[str]:
+    """The `listen` endpoints of a deployment file, in order."""
+    return [line.split('"')[1] for line in deploy.read_text().splitlines() if line.startswith("listen = ")]
+
+
 def received(output: str, link: str) -> int:
     """The count in a closing line `link LINK (KEY): N received, …`."""
     for line in output.splitlines():
@@ -133,13 +138,31 @@ def test_two_processes_exchange_messages_and_a_remote_message_wakes_a_waiting_su
     tmp_path: Path, processes: list[Process]
 ) -> None:
     deploy = deployment(tmp_path, [(["sender/a"], False), (["receiver/a"], False)])
-    common = [str(PINGPONG), "--transport", "zenoh", "--deployment", str(deploy), "--duration", "2s"]
+    sender_endpoint, receiver_endpoint = endpoints(deploy)
+    # the sender passes its own Zenoh configuration (JSON5) instead of the deployment's endpoints
+    config = tmp_path / "sender.json5"
+    config.write_text(
+        "// a user's own configuration, used unchanged\n{\n  mode: 'peer',\n"
+        f"  listen: {{ endpoints: ['{sender_endpoint}'] }},\n  connect: {{ endpoints: ['{receiver_endpoint}'] }},\n"
+        "  scouting: { multicast: { enabled: false } },\n}\n"
+    )
+    common = [str(PINGPONG), "--transport", "zenoh", "--duration", "2s"]
     receiver = run(
         processes,
         tmp_path / "receiver.log",
-        [*common, "--agents", "receiver/a", "--trace", str(tmp_path / "r.mcap"), "--record-memory", "receiver/a.cs"],
+        [
+            *common,
+            "--agents",
+            "receiver/a",
+            "--deployment",
+            str(deploy),
+            "--trace",
+            str(tmp_path / "r.mcap"),
+            "--record-memory",
+            "receiver/a.cs",
+        ],
     )
-    sender = run(processes, tmp_path / "sender.log", [*common, "--agents", "sender"])
+    sender = run(processes, tmp_path / "sender.log", [*common, "--agents", "sender", "--zenoh-config", str(config)])
     assert sender.finish(60) == 0, sender.output
     assert receiver.finish(60) == 0, receiver.output
     # the receiver has no period: each of its iterations was started by a ping from the other process
@@ -229,8 +252,7 @@ def test_malformed_bytes_injected_on_a_link_key_are_counted_and_dropped(
     from earl.transport.zenoh_transport import default_config
 
     deploy = deployment(tmp_path, [(["sender/a"], False), (["receiver/a"], False)])
-    sender_endpoint = deploy.read_text().split('listen = "')[1].split('"')[0]
-    receiver_endpoint = deploy.read_text().split('listen = "')[2].split('"')[0]
+    sender_endpoint, receiver_endpoint = endpoints(deploy)
     receiver = run(
         processes,
         tmp_path / "receiver.log",

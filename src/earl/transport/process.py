@@ -16,7 +16,7 @@ from earl.model.elements import System
 from earl.model.expand import expand
 from earl.runtime.names import agent_name
 from earl.transport.deployment import DeploymentError, normalise_agent, read_deployment
-from earl.transport.zenoh_transport import ZenohTransport, config_from_file, default_config
+from earl.transport.zenoh_transport import TransportError, ZenohTransport, config_from_file, default_config
 
 DEPLOYMENT_FILE = "deploy.toml"
 
@@ -35,7 +35,13 @@ def open_transport(
         if name not in known:
             raise ValueError(f"--agents: `{name}` is not an agent of this system (its agents: {', '.join(known)})")
     if arguments.zenoh_config:
-        config = config_from_file(Path(arguments.zenoh_config))
+        config_path = Path(arguments.zenoh_config)
+        if not config_path.is_file():
+            raise ValueError(f"--zenoh-config: no such file: {config_path}")
+        try:
+            config = config_from_file(config_path)
+        except TransportError as error:
+            raise ValueError(str(error)) from None
         where = f"the Zenoh configuration {arguments.zenoh_config}"
     else:
         path = Path(arguments.deployment) if arguments.deployment else spec.parent / DEPLOYMENT_FILE
