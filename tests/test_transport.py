@@ -184,6 +184,7 @@ def test_arrays_of_doubles_are_written_exactly_as_msgpack_writes_them(size: int)
         (["--transport", "zenoh", "--agents", "nobody"], "`nobody/a` is not an agent of this system"),
         (["--transport", "zenoh", "--agents", "sender/a"], "deploy.toml"),
         (["--agents", "sender/a", "--zenoh-config", "z.json5"], "go with --transport zenoh"),
+        (["--agents", "sender/a,nobody"], "`nobody/a` is not an agent of this system"),
         (["--transport", "zenoh", "--agents", "sender/a", "--wait-for-peers", "soon"], "is not a duration"),
         (["--transport", "zenoh", "--agents", "sender/a", "--zenoh-config", "/no/such.json5"], "no such file"),
         (["--transport", "zenoh", "--agents", "sender/a", "--zenoh-config", __file__], "cannot use the Zenoh"),

@@ -170,6 +170,10 @@ def run(arguments: argparse.Namespace) -> int:
             from earl.transport.process import open_transport
 
             agents, transport = open_transport(system, parameters, path, agents or [], arguments)
+        elif agents:
+            from earl.transport.process import agents_of
+
+            agents = agents_of(system, parameters, agents)
         simulation = Simulation(
             system,
             parameters=parameters,

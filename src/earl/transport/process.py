@@ -30,10 +30,7 @@ def open_transport(
 ) -> tuple[list[str], ZenohTransport]:
     """The agents this process runs (normalised) and its open transport; `ValueError` for bad options."""
     known = [agent_name(agent) for agent in expand(system, dict(parameters)).agents]
-    names = [normalise_agent(a) for a in agents]
-    for name in names:
-        if name not in known:
-            raise ValueError(f"--agents: `{name}` is not an agent of this system (its agents: {', '.join(known)})")
+    names = agents_of(system, parameters, agents)
     if arguments.zenoh_config:
         config_path = Path(arguments.zenoh_config)
         if not config_path.is_file():
@@ -62,6 +59,16 @@ def open_transport(
     transport = ZenohTransport(system.name, names, config, log)
     log(f"earl run: {', '.join(names)} over Zenoh ({where})")
     return names, transport
+
+
+def agents_of(system: System, parameters: Mapping[str, Any], agents: list[str]) -> list[str]:
+    """`--agents` normalised (`task` is `task/a`); `ValueError` naming one that the system does not have."""
+    known = [agent_name(agent) for agent in expand(system, dict(parameters)).agents]
+    names = [normalise_agent(a) for a in agents]
+    for name in names:
+        if name not in known:
+            raise ValueError(f"--agents: `{name}` is not an agent of this system (its agents: {', '.join(known)})")
+    return names
 
 
 def wait_for_peers(transport: ZenohTransport, arguments: argparse.Namespace) -> None:
