@@ -4,6 +4,7 @@ type fingerprints, the key expressions, the deployment file (docs/distributed.md
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import msgpack  # type: ignore[import-untyped]
 import pytest
@@ -210,3 +211,56 @@ def test_a_deployment_that_does_not_cover_the_system_stops_earl_run(
     arguments = ["run", str(PINGPONG), "--transport", "zenoh", "--agents", "sender", "--deployment", str(deploy)]
     assert main(arguments) == 2
     assert "the agent `receiver/a` runs in no process" in capsys.readouterr().err
+
+
+class RecordingLinks:
+    """A transport that records what the builder asks of it."""
+
+    def __init__(self) -> None:
+        self.out: list[tuple[str, str, str, str]] = []
+        self.into: list[tuple[str, str, str, str, str]] = []
+        self.delivered: list[object] = []
+
+    def outgoing(self, link: str, data_type: object, types: TypeSystem, source: str, destination_agent: str) -> Any:
+        self.out.append((link, str(getattr(data_type, "name", data_type)), source, destination_agent))
+        return self
+
+    def deliver(self, value: object) -> None:
+        self.delivered.append(value)
+
+    def incoming(
+        self, link: str, data_type: object, types: TypeSystem, engine: Any, buffer: str, source_agent: str
+    ) -> None:
+        self.into.append((link, str(getattr(data_type, "name", data_type)), engine.name, buffer, source_agent))
+
+
+def test_the_builder_hands_the_links_with_one_end_elsewhere_to_the_transport() -> None:
+    from earl.runtime.builder import build_network
+    from earl.runtime.events import Recorder
+
+    system = earl.load(PINGPONG / "system.earl")
+    links = RecordingLinks()
+    network = build_network(
+        expand(system, {}), recorder=Recorder(), agents={"receiver/a"}, remote=links, code_directories=[PINGPONG]
+    )
+    assert [engine.name for engine in network.engines] == ["receiver/a.cs"]
+    assert links.out == [("receiver,sender", "Ping", "receiver/a.cs", "sender/a")]
+    assert links.into == [("sender,receiver", "Ping", "receiver/a.cs", "ping", "sender/a")]
+    # the sender's end of the remote link is an ordinary destination without a local engine
+    (destination,) = network.by_name["receiver/a.cs"].destinations["echo"]
+    assert destination.engine is None and destination.channel is links
+    assert network.link_types["receiver,sender"].name == "Ping"  # type: ignore[union-attr]
+
+
+def test_a_stale_input_reads_as_timed_out_until_its_sender_returns() -> None:
+    simulation = earl.simulate(earl.load(Path(__file__).parent / "runtime_specs" / "counter"), seed=1)
+    engine = simulation.network.by_name["counter/a.cs"]
+    simulation.advance_to(0.02)
+    assert simulation.state_of("counter/a.cs").timed_out["echo"] is False  # echo/ib is not obligatory
+    engine.stale.add("echo")  # what the transport does when the echo's sender disappears
+    simulation.advance_to(0.04)
+    assert simulation.state_of("counter/a.cs").timed_out["echo"] is True
+    engine.stale.discard("echo")  # it is back
+    simulation.advance_to(0.06)
+    assert simulation.state_of("counter/a.cs").timed_out["echo"] is False
+    simulation.close()
