@@ -1,0 +1,416 @@
+"""`earl export sysml`: the golden file, every model element found in the export, names, expressions, the CLI.
+
+The element walk reads the export with the independent SysML v2 parser (tests/test_sysml_parse.py)
+and looks every element of the expanded model up by its EARL name, the short name it must carry.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import sys
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+import earl
+from earl.check import context_for
+from earl.cli.main import main
+from earl.export.sysml import export_sysml, library_text
+from earl.export.sysml_expressions import ExpressionWriter, literal
+from earl.export.sysml_names import Namespace, is_basic_name, name_text, quoted, readable
+from earl.model import (
+    Agent,
+    BooleanOperation,
+    Comparison,
+    ElementReference,
+    FieldAccess,
+    IndexAccess,
+    Kind,
+    Literal,
+    Not,
+    Read,
+    System,
+)
+from test_sysml_parse import FLAGSHIP, GOLDEN, ROOT, parse_tree, syntax_errors
+
+SMALL = GOLDEN / "small.earl"
+SMALL_EXPECTED = GOLDEN / "small.sysml"
+
+
+# ---------------------------------------------------------------------- golden file
+def test_the_small_spec_exports_as_the_golden_file() -> None:
+    text = export_sysml(earl.load(SMALL))
+    if os.environ.get("EARL_UPDATE_GOLDEN"):
+        SMALL_EXPECTED.write_text(text, encoding="utf-8")
+    assert text == SMALL_EXPECTED.read_text(encoding="utf-8"), (
+        "the export of tests/golden/sysml/small.earl changed; if the change is wanted, run "
+        "EARL_UPDATE_GOLDEN=1 pytest tests/test_sysml_export.py and review the diff"
+    )
+
+
+def test_the_golden_file_parses() -> None:
+    assert not syntax_errors(SMALL_EXPECTED.read_text(encoding="utf-8"))
+
+
+def test_the_export_does_not_depend_on_the_working_directory(monkeypatch: pytest.MonkeyPatch) -> None:
+    first = export_sysml(earl.load(SMALL))
+    monkeypatch.chdir(GOLDEN)
+    assert export_sysml(earl.load("small.earl")) == first
+
+
+# ---------------------------------------------------------------------- every element is there
+_ELEMENT = re.compile(r"(Usage|Definition|Package|TransitionUsage|Membership)Context$")
+_REDEFINED = re.compile(r":>>((?:[A-Za-z_]\w*)|(?:'[^']*'))")
+
+
+def _unquote(text: str) -> str:
+    return text[1:-1].replace("\\'", "'").replace("\\\\", "\\") if text.startswith("'") else text
+
+
+def _identification(context: Any) -> tuple[list[str], bool]:
+    """The names an element declares (its short name and its name), or else the feature it redefines."""
+    from sysmlpy.antlr.SysMLv2Parser import SysMLv2Parser
+
+    stack = list(context.getChildren())
+    while stack:
+        child = stack.pop(0)
+        if isinstance(child, (SysMLv2Parser.IdentificationContext, SysMLv2Parser.FeatureIdentificationContext)):
+            return [_unquote(n.getText()) for n in child.getTypedRuleContexts(SysMLv2Parser.NameContext)], False
+        if hasattr(child, "getChildren") and not _ELEMENT.search(type(child).__name__):
+            if "Body" in type(child).__name__:
+                continue
+            stack[:0] = list(child.getChildren())
+    found = _REDEFINED.match(re.sub(r"^[a-z]+", "", context.getText()))
+    return ([_unquote(found.group(1))] if found else []), True
+
+
+def _paths(context: Any, path: tuple[frozenset[str], ...] = ()) -> Iterator[tuple[frozenset[str], ...]]:
+    """Every element of the tree as the names of it and of each element around it."""
+    if not hasattr(context, "getChildren"):
+        return
+    if _ELEMENT.search(type(context).__name__) and "Membership" not in type(context).__name__:
+        declared, redefined = _identification(context)
+        names = frozenset(declared)
+        # The grammar nests a usage in a context of its kind: an unnamed one is met twice, and counted once.
+        if names and not (redefined and path and path[-1] == names):
+            path = (*path, names)
+            yield path
+    for child in context.getChildren():
+        yield from _paths(child, path)
+
+
+def _index(text: str) -> set[tuple[str, ...]]:
+    """Every path of names, each step by any of its names, for lookups."""
+    errors = syntax_errors(text)
+    assert not errors, errors
+    result: set[tuple[str, ...]] = set()
+    for path in _paths(parse_tree(text)):
+        choices: list[tuple[str, ...]] = [()]
+        for step in path:
+            choices = [(*prefix, name) for prefix in choices for name in step]
+        result.update(choices)
+    return result
+
+
+def _member(name: str, index: int | None, kind: str) -> str:
+    return f"{name if index is None else f'{name}[{index}]'}/{kind}"
+
+
+def _expected(system: System) -> Iterator[tuple[str, ...]]:
+    """Every element of the expanded model, as the path of EARL names the export must have."""
+    package = system.name
+    top = (package, system.name)
+    for definition in system.types:
+        yield (package, definition.name)
+        for field in getattr(definition, "fields", []):
+            yield (package, definition.name, field.name)
+    for parameter in system.parameters:
+        yield (*top, parameter.name)
+    for robot in system.robots:
+        yield (*top, f"{robot.name}/r")
+    for link in system.links:
+        yield (*top, link.name_text)
+    for agent in system.agents:
+        yield from _agent_paths(top, agent)
+
+
+def _agent_paths(top: tuple[str, ...], agent: Agent) -> Iterator[tuple[str, ...]]:
+    own = (*top, _member(agent.name, agent.index, "a"))
+    yield own
+    yield (*own, "agentType")
+    for parameter in agent.parameters:
+        yield (*own, parameter.name)
+    for link in agent.links:
+        yield (*own, link.name_text)
+    for subsystem in agent.subsystems:
+        sub = (
+            *own,
+            "cs"
+            if subsystem.kind is Kind.CONTROL_SUBSYSTEM
+            else _member(subsystem.name, subsystem.index, subsystem.kind.value),
+        )
+        yield sub
+        for parameter in subsystem.parameters:
+            yield (*sub, parameter.name)
+        for buffer in subsystem.input_buffers:
+            yield (*sub, _member(buffer.name, buffer.index, "ib"), "msg")
+        for output in subsystem.output_buffers:
+            yield (*sub, _member(output.name, output.index, "ob"), "msg")
+        for memory in subsystem.memories:
+            yield (*sub, _member(memory.name, memory.index, "m"), "data")
+        for predicate in subsystem.primitive_predicates:
+            yield (*sub, f"{predicate.name}/pp")
+        for function in subsystem.partial_transition_functions:
+            yield (*sub, f"{function.name}/pf")
+        for stage_set in subsystem.stage_sets:
+            yield (*sub, f"stage {stage_set.name}")
+        for behaviour in subsystem.basic_behaviours:
+            yield (*sub, f"{behaviour.name}/bb", "tf")
+            yield (*sub, f"{behaviour.name}/bb", "terminalCondition")
+            if behaviour.error_condition is not None:
+                yield (*sub, f"{behaviour.name}/bb", "errorCondition")
+        if subsystem.fsm is not None:
+            fsm = (*sub, "fsm")
+            for state in subsystem.fsm.states:
+                yield (*fsm, state.name)
+            for transition in subsystem.fsm.transitions:
+                yield (*fsm, f"{transition.source},{transition.destination}/t")
+            for number in range(1, len(subsystem.fsm.assumptions) + 1):
+                yield (*fsm, f"assumption{number}")
+
+
+@pytest.mark.parametrize("path", [FLAGSHIP, SMALL], ids=lambda p: p.name)
+def test_every_element_of_the_model_is_in_the_export(path: Path) -> None:
+    system = earl.load(path)
+    expanded = context_for(system).system
+    found = _index(export_sysml(system))
+    expected = list(_expected(expanded))
+    missing = [" :: ".join(p) for p in expected if p not in found]
+    assert not missing, f"{len(missing)} of {len(expected)} elements are not in the export: {missing[:10]}"
+    assert len(expected) > 100
+
+
+def test_the_element_walk_can_fail() -> None:
+    """A path that is not in the export is reported missing."""
+    found = _index(export_sysml(earl.load(SMALL)))
+    assert ("conveyor", "conveyor", "line/a", "cs", "order/ib", "msg") in found
+    assert ("conveyor", "conveyor", "line/a", "cs", "nothing/ib", "msg") not in found
+    assert ("conveyor", "conveyor", "line/a", "belt[3]/ve") not in found  # N = 2
+
+
+# ---------------------------------------------------------------------- what the export says
+def test_families_are_expanded_with_the_given_parameters() -> None:
+    text = export_sysml(earl.load(FLAGSHIP, {"N": 3}), {"N": 3})
+    assert "motorController3_ve" in text and "motorController4_ve" not in text
+    assert "attribute N : EARL::int = 3;" in text
+    assert "<'motorController[3]/ve'>" in text
+
+
+def test_agent_types_are_the_checkers_table_1() -> None:
+    system = earl.load(ROOT / "examples" / "mobile_robot")
+    context = context_for(system)
+    text = export_sysml(system)
+    for agent in context.system.agents:
+        row = context.agent_type(agent)
+        own = re.escape(f"<'{_member(agent.name, agent.index, 'a')}'>")
+        block = re.search(own + r".*?attribute :>> agentType = EARL::AgentType::(\w+);", text, re.DOTALL)
+        assert block is not None and block.group(1) == row.name
+
+
+def test_transitions_keep_priorities_and_guards() -> None:
+    text = export_sysml(earl.load(FLAGSHIP))
+    assert "transition <'idle,jointMove/t'> idle_jointMove_t" in text
+    guard = re.search(r"idle_jointMove_t\s+first idle\s+if ([^\n]*)\n\s+then jointMove \{([^}]*\}[^}]*)\}", text)
+    assert guard is not None
+    assert guard.group(1) == "newJointPos_pp and not emergencyStop_pp"
+    assert "@EARL::TransitionPriority { priority = 2; }" in guard.group(2)
+    # `* -> emergencyStop` is one transition per other state
+    assert text.count("then emergencyStop {") == 3
+
+
+def test_a_two_stage_transition_function_is_a_fork_and_a_join_per_stage() -> None:
+    text = export_sysml(earl.load(FLAGSHIP))
+    block = re.search(r"<'jointMove/bb'>.*?action :>> tf \{(.*?)\n\s+\}", text, re.DOTALL)
+    assert block is not None
+    lines = [line.strip() for line in block.group(1).strip().splitlines()]
+    assert lines[:4] == [
+        "first start then stage1Fork;",
+        "fork stage1Fork;",
+        "then calculatePosition_pf;",
+        "then jointMove_pf;",
+    ]
+    assert "join stage1Join;" in lines and "first stage1Join then stage2Fork;" in lines
+    assert lines[-1] == "first stage2Join then done;"
+
+
+def test_memory_buffers_and_links_carry_the_spec_types() -> None:
+    text = export_sysml(earl.load(SMALL))
+    assert "attribute :>> data : Speeds[2] ordered nonunique := (0.0, 0.0);" in text
+    assert "in item :>> msg : Order;" in text
+    assert "attribute :>> capacity = 4;" in text and "EARL::OverflowPolicy::dropOldest" in text
+    assert re.search(
+        r"flow <'supervisor,line'> supervisor_line : EARL::InterAgentLink of Order\s+"
+        r"from supervisor_a\.cs\.order_ob\.msg\s+to line_a\.cs\.order_ib\.msg",
+        text,
+    )
+
+
+# ---------------------------------------------------------------------- names
+def test_names() -> None:
+    assert readable("manip/a") == "manip_a"
+    assert readable("motorController[3]/ve") == "motorController3_ve"
+    assert readable("task,manip") == "task_manip"
+    assert readable("idle,jointMove/t") == "idle_jointMove_t"
+    assert not is_basic_name("part") and name_text("part") == "'part'"
+    assert name_text("then") == "'then'" and name_text("idle") == "idle"
+    assert quoted("it's") == "'it\\'s'"
+    namespace = Namespace(("ib",))
+    assert [namespace.claim("ib"), namespace.claim("x"), namespace.claim("x")] == ["ib_2", "x", "x_2"]
+
+
+def test_a_state_named_like_a_keyword_is_quoted() -> None:
+    text = (
+        SMALL.read_text(encoding="utf-8")
+        .replace("initial stop", "initial then")
+        .replace("state stop: stop/bb", "state then: stop/bb")
+        .replace("* -> stop", "* -> then")
+        .replace("stop -> run", "then -> run")
+    )
+    exported = export_sysml(earl.loads(text, "keywords.earl"))
+    assert "state 'then' : EARL::FSMState" in exported
+    assert "entry; then 'then';" in exported
+    assert not syntax_errors(exported)
+
+
+# ---------------------------------------------------------------------- expressions
+def _writer() -> ExpressionWriter:
+    return ExpressionWriter(lambda reference: readable(f"{reference.name}/{reference.kind.value}"))
+
+
+def _read(name: str, kind: Kind, *path: Any) -> Read:
+    return Read(ElementReference(name, kind), tuple(path))
+
+
+def test_not_and_comparisons_get_sysml_parentheses() -> None:
+    a, b = _read("a", Kind.PRIMITIVE_PREDICATE), _read("b", Kind.PRIMITIVE_PREDICATE)
+    x = _read("x", Kind.INPUT_BUFFER, FieldAccess("speed"))
+    writer = _writer()
+    # EARL's `not x <= 2.5` is `not (x <= 2.5)`; SysML's `not` binds tighter than `<=`.
+    assert writer.text(Not(Comparison("<=", x, Literal(2.5)))) == "not (x_ib.msg.speed <= 2.5)"
+    assert writer.text(BooleanOperation("or", (a, BooleanOperation("and", (a, b))))) == "a_pp or (a_pp and b_pp)"
+    assert writer.text(Not(a)) == "not a_pp"
+    assert (
+        writer.text(Comparison("==", Comparison("<", x, Literal(1)), Literal(True))) == "(x_ib.msg.speed < 1) == true"
+    )
+
+
+def test_indices_move_from_zero_based_to_one_based() -> None:
+    values = _read("v", Kind.MEMORY_INPUT, IndexAccess(Literal(0)))
+    assert _writer().text(values) == "v_mi.data#(1)"
+    grid = _read("g", Kind.INPUT_BUFFER, FieldAccess("cells"), IndexAccess(Literal(2)), IndexAccess(Literal(0)))
+    assert _writer().text(grid) == "g_ib.msg.cells#(3).elements#(1)"
+
+
+def test_literals() -> None:
+    assert literal(True) == "true" and literal(3) == "3" and literal(0.5) == "0.5"
+    assert literal('belt "A"\n') == '"belt \\"A\\"\\n"'
+    assert literal(float("inf")) == "1e999"
+
+
+# ---------------------------------------------------------------------- the library
+def test_every_library_definition_names_its_source_in_the_manual() -> None:
+    text = library_text()
+    definitions = re.findall(
+        r"^\s*(?:abstract )?\w+ def (\w+)[^{;]*\{\s*doc\s*/\*(.*?)\*/", text, re.DOTALL | re.MULTILINE
+    )
+    assert len(definitions) >= 30
+    for name, doc in definitions:
+        assert re.search(r"§\d|Table \d|earl", doc), f"{name}: its doc names no section of the manual"
+    for concept in (
+        "System",
+        "Robot",
+        "Agent",
+        "ControlSubsystem",
+        "VirtualEffector",
+        "RealEffector",
+        "VirtualReceptor",
+        "RealReceptor",
+        "InputBuffer",
+        "OutputBuffer",
+        "InternalMemory",
+        "FSM",
+        "FSMState",
+        "BasicBehaviour",
+        "TransitionFunction",
+        "PartialTransitionFunction",
+        "PrimitivePredicate",
+        "Predicate",
+        "Link",
+        "AgentType",
+        "agentTypeOf",
+    ):
+        assert any(name == concept for name, _ in definitions), concept
+    assert "equation1" in text and "table1" in text
+
+
+# ---------------------------------------------------------------------- the command
+def test_the_command_writes_the_export_and_the_library(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    output = tmp_path / "small.sysml"
+    assert main(["export", "sysml", str(SMALL), "-o", str(output)]) == 0
+    assert output.read_text(encoding="utf-8") == export_sysml(earl.load(SMALL))
+    assert (tmp_path / "EARL.sysml").read_text(encoding="utf-8") == library_text()
+    assert "wrote" in capsys.readouterr().err
+
+
+def test_the_command_prints_to_standard_output(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["export", "sysml", str(SMALL), "--param", "N=3"]) == 0
+    assert "belt3_ve" in capsys.readouterr().out
+
+
+def test_the_command_refuses_an_invalid_spec(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    broken = tmp_path / "broken.earl"
+    broken.write_text(SMALL.read_text(encoding="utf-8").replace("tf = {plan/pf} then {send/pf}", "tf = {nope/pf}"))
+    output = tmp_path / "out.sysml"
+    assert main(["export", "sysml", str(broken), "-o", str(output)]) == 1
+    assert "nope/pf" in capsys.readouterr().err
+    assert not output.exists()
+    rules = tmp_path / "rules.earl"
+    rules.write_text(SMALL.read_text(encoding="utf-8").replace("    supervisor/a\n", ""))
+    assert main(["export", "sysml", str(rules)]) == 1
+    assert "not exported" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    "arguments, message",
+    [
+        (["export", "sysml", "missing.earl"], "no such file"),
+        (["export", "sysml", str(SMALL), "-o", "/nonexistent/dir/x.sysml"], "no such directory"),
+        (["export", "sysml", str(SMALL), "--param", "N"], "NAME=VALUE"),
+        (["export", "uml", str(SMALL)], "invalid choice"),
+    ],
+)
+def test_the_command_reports_usage_errors(
+    arguments: list[str], message: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    try:
+        status = main(arguments)
+    except SystemExit as exit_:
+        status = int(exit_.code or 0)
+    assert status == 2
+    assert message in capsys.readouterr().err
+
+
+def test_exporting_never_imports_code_the_spec_names(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    marker = tmp_path / "imported"
+    package = tmp_path / "conveyor"
+    package.mkdir()
+    (package / "__init__.py").write_text(f"open({str(marker)!r}, 'w').close()\n")
+    (package / "supervisor.py").write_text(f"open({str(marker)!r}, 'w').close()\n")
+    (package / "line.py").write_text(f"open({str(marker)!r}, 'w').close()\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    assert main(["export", "sysml", str(SMALL), "-o", str(tmp_path / "out.sysml")]) == 0
+    assert not marker.exists()
+    assert "conveyor" not in sys.modules
