@@ -10,7 +10,7 @@ from typing import Any
 from earl.check import check
 from earl.cli.common import UsageError, parse_parameter, spec_path, usage_error
 from earl.cli.output import print_diagnostics
-from earl.diagnostics import EarlError, Severity
+from earl.diagnostics import EarlError, Severity, SourceMap
 from earl.export.sysml import LIBRARY_FILE, export_sysml, library_text
 from earl.lang.loader import load
 
@@ -61,7 +61,8 @@ def run(arguments: argparse.Namespace) -> int:
         return 1
     errors = [d for d in check(system, parameters) if d.severity is Severity.ERROR]
     if errors:
-        print_diagnostics(errors, system.sources)
+        sources = system.sources if isinstance(system.sources, SourceMap) else SourceMap()
+        print_diagnostics(errors, sources)
         sys.stderr.write(f"{path}: not exported: the specification breaks the rules above (see `earl check`)\n")
         return 1
     text = export_sysml(system, parameters)
