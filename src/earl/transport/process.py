@@ -19,6 +19,8 @@ from earl.transport.deployment import DeploymentError, normalise_agent, read_dep
 from earl.transport.zenoh_transport import TransportError, ZenohTransport, config_from_file, default_config
 
 DEPLOYMENT_FILE = "deploy.toml"
+#: seconds; see open_transport
+SWITCH_INTERVAL = 0.0005
 
 
 def log(line: str) -> None:
@@ -56,6 +58,9 @@ def open_transport(
         connect = deployment.connect_for(group)
         config = default_config([group.listen], connect)
         where = f"listening on {group.listen}, connecting to {', '.join(connect) or 'nobody'}"
+    # Zenoh's callbacks need the GIL: while the scheduler runs Python, a message would wait up
+    # to the interpreter's switch interval (5 ms) to be taken; 0.5 ms bounds that delay
+    sys.setswitchinterval(SWITCH_INTERVAL)
     transport = ZenohTransport(system.name, names, config, log)
     log(f"earl run: {', '.join(names)} over Zenoh ({where})")
     return names, transport
