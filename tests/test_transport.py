@@ -264,3 +264,35 @@ def test_a_stale_input_reads_as_timed_out_until_its_sender_returns() -> None:
     simulation.advance_to(0.06)
     assert simulation.state_of("counter/a.cs").timed_out["echo"] is False
     simulation.close()
+
+
+@pytest.mark.parametrize(
+    ("deployment", "code", "fragment"),
+    [
+        (None, 2, "no deployment file"),
+        ("[[process]\n", 1, "not valid TOML"),
+        (
+            "[[process]]\nagents = ['sender']\nlisten = 'tcp/127.0.0.1:1'\n",
+            1,
+            "the agent `receiver/a` runs in no process",
+        ),
+        (
+            "[[process]]\nagents = ['sender', 'receiver']\nlisten = 'tcp/192.0.2.1:1'\nhost = 'elsewhere.invalid'\n",
+            1,
+            "has no process for this host",
+        ),
+    ],
+)
+def test_launch_refuses_a_deployment_it_cannot_run_before_starting_anything(
+    tmp_path: Path, deployment: str | None, code: int, fragment: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from earl.cli.main import main
+
+    arguments = ["launch", str(PINGPONG)]
+    if deployment is not None:
+        path = tmp_path / "deploy.toml"
+        path.write_text(deployment)
+        arguments += ["--deployment", str(path)]
+    assert main(arguments) == code
+    captured = capsys.readouterr()
+    assert fragment in captured.err and "started" not in captured.out

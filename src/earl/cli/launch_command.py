@@ -20,6 +20,8 @@ from pathlib import Path
 from typing import IO, Any
 
 from earl.cli.common import UsageError, spec_path, usage_error
+from earl.cli.output import print_diagnostics
+from earl.diagnostics import EarlError
 
 EXIT_OK, EXIT_FAILED, EXIT_INTERRUPTED = 0, 1, 130
 #: seconds a process gets to finish its trace after SIGTERM before it is killed
@@ -74,8 +76,15 @@ def run(arguments: argparse.Namespace) -> int:
         return usage_error(f"no deployment file {deployment_path}; name one with --deployment (docs/distributed.md)")
     try:
         deployment = read_deployment(deployment_path)
+        deployment.check_agents(_agents(path, arguments.param))
     except DeploymentError as error:
         print(f"earl launch: {error}", file=sys.stderr)
+        return EXIT_FAILED
+    except UsageError as error:
+        return usage_error(str(error))
+    except EarlError as error:
+        print_diagnostics(error.diagnostics, error.sources)
+        print("earl launch: the specification cannot be read; nothing was started", file=sys.stderr)
         return EXIT_FAILED
     local = [process for process in deployment.processes if process.is_local]
     if not local:
@@ -94,6 +103,17 @@ def run(arguments: argparse.Namespace) -> int:
         command += list(process.args)
         supervisor.start(process.label, command)
     return supervisor.wait()
+
+
+def _agents(spec: Path, parameters: list[str]) -> list[str]:
+    """The agents of the expanded system, so that a deployment missing one fails before anything starts."""
+    from earl.cli.common import parse_parameter
+    from earl.lang.loader import load
+    from earl.model.expand import expand
+    from earl.runtime.names import agent_name
+
+    values = dict(parse_parameter(p) for p in parameters)
+    return [agent_name(agent) for agent in expand(load(spec, values), values).agents]
 
 
 class _Supervisor:
