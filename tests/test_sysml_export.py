@@ -252,7 +252,7 @@ def test_memory_buffers_and_links_carry_the_spec_types() -> None:
     assert "in item :>> msg : Order;" in text
     assert "attribute :>> capacity = 4;" in text and "EARL::OverflowPolicy::dropOldest" in text
     assert re.search(
-        r"flow <'supervisor,line'> supervisor_line : EARL::InterAgentLink of Order\s+"
+        r"flow <'supervisor,line'> supervisor_line : EARL::InterAgentLink :> links of Order\s+"
         r"from supervisor_a\.cs\.order_ob\.msg\s+to line_a\.cs\.order_ib\.msg",
         text,
     )

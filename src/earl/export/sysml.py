@@ -45,8 +45,9 @@ from earl.model.elements import (
     Transition,
 )
 from earl.model.expressions import ElementReference, Literal
-from earl.model.kinds import SUBSYSTEM_KINDS, Kind
+from earl.model.kinds import Kind
 from earl.model.location import Comments, SourceLocation
+from earl.model.text import expression_text
 from earl.model.types import ArrayType, DataType, PrimitiveType, StructType, TypeAlias, TypeReference, type_text
 
 Value = bool | int | float | str
@@ -77,7 +78,7 @@ def library_text() -> str:
 
 def export_sysml(system: System, parameters: Mapping[str, Value] | None = None) -> str:
     """`system` as SysML v2 text, every family expanded with `parameters` (the system's own values by default)."""
-    return _Writer(system, check_context_for(system, parameters or {}), dict(parameters or {})).write()
+    return _Writer(system, check_context_for(system, parameters or {})).write()
 
 
 # ---------------------------------------------------------------------- small helpers
@@ -135,11 +136,10 @@ class _Named:
 
 
 class _Writer:
-    def __init__(self, declared: System, context: CheckContext, parameters: dict[str, Value]) -> None:
+    def __init__(self, declared: System, context: CheckContext) -> None:
         self.declared = declared
         self.context = context
         self.system = context.system
-        self.parameters = parameters
         self.lines: list[str] = []
         self.depth = 0
         self.comments = _comments_by_location(declared)
@@ -618,7 +618,8 @@ class _Writer:
         own = self.link_names[id(link)]
         earl_name = link.name_text
         declaration = _declaration(own, earl_name)
-        definition = "EARL::InterAgentLink" if owner is None else "EARL::InterSubsystemLink"
+        # A system's links are its `links`; an agent's are between its subsystems and subset nothing.
+        definition = "EARL::InterAgentLink :> links" if owner is None else "EARL::InterSubsystemLink"
         source = self.link_end(link.source.agent, link.source.subsystem, link.source.buffer, Kind.OUTPUT_BUFFER, owner)
         target = self.link_end(
             link.destination.agent, link.destination.subsystem, link.destination.buffer, Kind.INPUT_BUFFER, owner
@@ -663,8 +664,6 @@ def _size_text(array: ArrayType) -> str:
     size = array.size
     if isinstance(size, Literal):
         return literal(size.value)
-    from earl.model.text import expression_text
-
     return expression_text(size) if size is not None else "*"
 
 
@@ -754,4 +753,4 @@ def _comments_by_location(system: System) -> dict[SourceLocation, Comments]:
     return table
 
 
-__all__ = ["LIBRARY_FILE", "SUBSYSTEM_DEFINITIONS", "SUBSYSTEM_KINDS", "export_sysml", "library_text"]
+__all__ = ["LIBRARY_FILE", "SUBSYSTEM_DEFINITIONS", "export_sysml", "library_text"]
