@@ -319,7 +319,7 @@ class _Writer:
                 if _earl_name(r.name, _index_of(r), Kind.AGENT) in self.agent_names
             ]
             if agents:
-                self.emit(f"ref part :>> agents = ({', '.join(name_text(a) for a in agents)});")
+                self.emit(f"ref part :>> agents = {_sequence(agents)};")
             links = [
                 self.link_names[id(link)]
                 for reference in robot.links
@@ -327,7 +327,7 @@ class _Writer:
                 if _robot_refers_to(reference, link)
             ]
             if links:
-                self.emit(f":>> links = ({', '.join(name_text(link) for link in links)});")
+                self.emit(f":>> links = {_sequence(links)};")
 
     # ------------------------------------------------------------------ agents (§2.1, §2.4)
     def agent(self, agent: Agent) -> None:
@@ -346,7 +346,7 @@ class _Writer:
                 if id(resolved.link) in self.link_names
             ]
             if links:
-                self.emit(f":>> aa = ({', '.join(name_text(link) for link in dict.fromkeys(links))});")
+                self.emit(f":>> aa = {_sequence(list(dict.fromkeys(links)))};")
             subsystem_names = {}
             for subsystem in agent.subsystems:
                 earl_sub = (
