@@ -25,7 +25,6 @@ def register(commands: Any) -> None:
         "specification must pass `earl check` first. Exporting never runs code a spec names. See docs/sysml.md.",
         epilog="exit codes: 0 written, 1 invalid specification, 2 usage error (missing file, bad option, "
         "output not writable)",
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("language", choices=["sysml"], help="the language to write: sysml (SysML v2 text)")
     parser.add_argument("spec", metavar="SPEC", help="the .earl file, or a directory with a system.earl")
