@@ -14,7 +14,7 @@ from typing import Any, Protocol
 
 from earl.diagnostics import Diagnostic, EarlError, Severity
 from earl.model.elements import Agent, Link, LinkEnd, Subsystem, System
-from earl.model.expressions import ElementReference, Literal
+from earl.model.expressions import ElementReference, Literal, Read
 from earl.model.kinds import Kind
 from earl.model.types import DataType
 from earl.runtime.binding import BindingProblem, UserFunction, bind_function, user_code_path
@@ -249,6 +249,7 @@ def _behaviour(
             stages,
             compile_predicate(behaviour.terminal_condition.expression, f"{engine.name} {behaviour.name}/bb tc"),
             error_condition,
+            never_ends=error_condition is None and _constant_false(behaviour.terminal_condition.expression, subsystem),
         )
     fsm = subsystem.fsm
     if fsm is None:
@@ -298,6 +299,18 @@ def _behaviour(
                 for _, transition in leaving
             ],
         )
+
+
+def _constant_false(expression: Any, subsystem: Subsystem) -> bool:
+    """`false`, or a primitive predicate defined as `false` (the manual's `false/pp`)."""
+    if isinstance(expression, Literal):
+        return expression.value is False
+    if isinstance(expression, Read) and expression.target.kind is Kind.PRIMITIVE_PREDICATE and not expression.path:
+        predicate = subsystem.primitive_predicate(expression.target.name)
+        return (
+            predicate is not None and isinstance(predicate.expression, Literal) and predicate.expression.value is False
+        )
+    return False
 
 
 def _end_engine(

@@ -47,6 +47,8 @@ class BehaviourRuntime:
     error_condition: CompiledPredicate | None
     #: the output buffers some function of this behaviour may write (in send order)
     outputs: list[str] = field(default_factory=list)
+    #: its terminal condition is the constant false and it has no error condition
+    never_ends: bool = False
 
 
 @dataclass
@@ -174,11 +176,14 @@ class SubsystemEngine:
         self.total_iterations += 1
 
     def _send(self, time: int, sent: dict[str, Any]) -> None:
-        recorder = self.recorder
+        # a recorder that looks at no message (no trace) is not called for each of them
+        record = self.recorder.message_sent if getattr(self.recorder, "wants_messages", True) else None
+        destinations = self.destinations
         for key, value in sent.items():
-            for destination in self.destinations.get(key, ()):
+            for destination in destinations.get(key, ()):
                 destination.channel.deliver(value)
-                recorder.message_sent(time, destination.link, value)
+                if record is not None:
+                    record(time, destination.link, value)
                 engine = destination.engine
                 if engine is not None and engine.waiting and engine.on_delivery is not None:
                     engine.on_delivery(engine)
@@ -267,6 +272,8 @@ class SubsystemEngine:
         assert state is not None
         behaviour = state.behaviour
         error = self._error_in_iteration
+        if not error and behaviour.never_ends:
+            return  # `tc = false/pp` and no `ec`: nothing to evaluate (a deliberate sink state)
         if not error and behaviour.error_condition is not None:
             error = self._evaluate(time, behaviour.error_condition, f"the error condition of `{behaviour.name}/bb`")
         if error:

@@ -71,6 +71,10 @@ class Recorders(Recorder):
         # messages are the most frequent event: call only the recorders that look at them
         self._message_recorders = [r for r in recorders if type(r).message_sent is not Recorder.message_sent]
 
+    @property
+    def wants_messages(self) -> bool:
+        return bool(self._message_recorders)
+
     def add(self, recorder: Recorder) -> None:
         self.recorders.append(recorder)
         if type(recorder).message_sent is not Recorder.message_sent:
