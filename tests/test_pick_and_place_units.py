@@ -555,6 +555,12 @@ def test_pictures_of_a_run_or_the_reason_why_not(tmp_path: Path, monkeypatch: py
     monkeypatch.setattr(environment_module, "VIDEO_SIZE", (64, 48))
     monkeypatch.setattr(environment_module, "PICTURE_SIZE", (64, 48))
     monkeypatch.setattr(environment_module, "VIDEO_FPS", 100.0)
+    still = environment_module.PickAndPlaceEnvironment(3, 0, output=tmp_path / "still")
+    still.advance(0.01)
+    still.close()
+    if not still.render_messages:  # without EARL_SIM_VIDEO=1: the picture of the end only
+        assert [p.name for p in still.pictures] == ["final.png"]
+    monkeypatch.setenv("EARL_SIM_VIDEO", "1")
     environment = environment_module.PickAndPlaceEnvironment(3, 0, output=tmp_path)
     environment.advance(0.03)
     environment.close()
