@@ -174,7 +174,8 @@ def test_two_processes_exchange_messages_and_a_remote_message_wakes_a_waiting_su
     # a ping whose arrays were not tuples, or not a Record, would be an exception fault of answer/pf
     assert not [f for f in faults if f["kind"] in ("exception", "type")], faults
     memory = [data for topic, _, data in events if topic == "receiver/a.cs/memory"]
-    assert memory[-1]["received"] >= pings - 5
+    # one iteration per ping (two pings between receives leave one: a latest-value buffer)
+    assert 100 < memory[-1]["received"] <= pings, (memory[-1], pings)
     assert memory[-1]["lastPing"]["stamp"][1] == float(memory[-1]["lastPing"]["count"])
     assert "Traceback" not in receiver.output + sender.output
 
