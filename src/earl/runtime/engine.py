@@ -49,6 +49,28 @@ class BehaviourRuntime:
     outputs: list[str] = field(default_factory=list)
     #: its terminal condition is the constant false and it has no error condition
     never_ends: bool = False
+    #: the stages as the engine runs them: (one function alone?, [what a call needs, unpacked])
+    plan: list[tuple[bool, list[tuple[Any, ...]]]] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        self.plan = [
+            (
+                len(stage) == 1,
+                [
+                    (
+                        function.function,
+                        function.inputs,
+                        function.outputs,
+                        function.inputs.refresh,
+                        function.outputs.memory_written,
+                        function.outputs.sent,
+                        function.name,
+                    )
+                    for function in stage
+                ],
+            )
+            for stage in self.stages
+        ]
 
 
 @dataclass
@@ -144,31 +166,30 @@ class SubsystemEngine:
         self.iteration_start = time
         self._error_in_iteration = False
         memory = self.memory
-        sent: dict[str, Any] = {}
-        for stage in state.behaviour.stages:
+        sent: dict[str, Any] | None = None
+        for single, calls in state.behaviour.plan:
             # one function alone in its stage may write memory at once: there is nobody to isolate
-            stage_memory: dict[str, Any] = memory if len(stage) == 1 else {}
-            for function in stage:
-                outputs = function.outputs
-                inputs = function.inputs
-                inputs.refresh()
+            stage_memory: dict[str, Any] = memory if single else {}
+            for function, inputs, outputs, refresh, memory_written, outputs_sent, name in calls:
+                refresh()
                 try:
-                    function.function(inputs, outputs, context)
+                    function(inputs, outputs, context)
                 except Exception as error:
-                    outputs.clear()  # a function that failed writes nothing
-                    self._function_fault(time, function.name, error)
+                    memory_written.clear()  # a function that failed writes nothing
+                    outputs_sent.clear()
+                    self._function_fault(time, name, error)
                     continue
                 # the writes are taken and the call's dictionaries left empty for the next call
-                written = outputs.memory_written
-                if written:
-                    stage_memory.update(written)
-                    written.clear()
-                written = outputs.sent
-                if written:
-                    sent.update(written)
-                    written.clear()
+                if memory_written:
+                    stage_memory.update(memory_written)
+                    memory_written.clear()
+                if outputs_sent:
+                    if sent is None:
+                        sent = {}
+                    sent.update(outputs_sent)
+                    outputs_sent.clear()
             # the stage's writes become visible only now: no function saw another's (Eq. 7-8)
-            if stage_memory and stage_memory is not memory:
+            if not single and stage_memory:
                 memory.update(stage_memory)
         if sent:
             self._send(time, sent)
