@@ -42,9 +42,13 @@ examples:
   earl check examples/pick_and_place --param N=3      with a system parameter changed
   earl fmt examples/pick_and_place/system.earl        print it in canonical form
   earl fmt --check examples/**/*.earl                 fail (exit 1) if any is not canonical
+  earl doc examples/pick_and_place -o site/           the manual's diagrams and tables as a document
+  earl run examples/pick_and_place --trace run.mcap   run it against MuJoCo, record a trace
+  earl trace summary run.mcap                         time in each state, transitions, faults
 
 exit codes: 0 valid, 1 invalid specification, 2 usage error (missing file, bad option)
-language reference: docs/language.md
+docs: docs/language.md (the language), docs/rules.md (the checks), docs/semantics.md (how a run
+behaves), docs/runtime.md (user code), docs/distributed.md, docs/diagrams.md, docs/sysml.md
 """
 
 
