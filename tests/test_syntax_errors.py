@@ -291,7 +291,7 @@ SYNTAX = [
         9,
         14,
         "EARL-S006",
-        "expected `=` after `pp`, found `true`",
+        "expected `(` or `=` after `pp`, found `true`",
     ),
     Malformed(
         "param_without_value",

@@ -333,7 +333,9 @@ def _report(simulation: Any, report: str, path: Path, console: Console) -> None:
 
     with user_code_path([path.resolve().parent]):
         try:
-            function = resolve_callable(report, "the run report", None, arity=1)
+            function = resolve_callable(
+                report, "the run report", None, arity=1, signature="def NAME(simulation) -> str"
+            )
             text = function(simulation)
         except BindingProblem as problem:
             console.print(f"earl run: {problem.diagnostic.message}")

@@ -256,7 +256,11 @@ def _body_item(printer: _Printer, depth: int, item: object) -> None:
             text += f" = {expression_text(item.initial_value)}"
         printer.line(depth, text, item.comments)
     elif isinstance(item, PrimitivePredicate):
-        printer.line(depth, f"{item.name}/pp = {expression_text(item.expression)}", item.comments)
+        if item.implementation is not None:
+            text = f"{item.name}/pp({_references(item.reads)}) = python {literal_text(item.implementation.path)}"
+            printer.line(depth, text, item.comments)
+        else:
+            printer.line(depth, f"{item.name}/pp = {expression_text(item.expression)}", item.comments)
     elif isinstance(item, PartialTransitionFunction):
         reads = _references(item.reads)
         writes = _references(item.writes)

@@ -26,6 +26,7 @@ from earl.model.elements import (
 )
 from earl.model.expressions import (
     BUILTIN_FUNCTIONS,
+    PYTHON_PREDICATE,
     Call,
     ConstantError,
     ElementReference,
@@ -672,6 +673,10 @@ class Resolver:
                     index = getattr(accessor, "index", None)
                     if index is not None:
                         stack.append((index, node_scope))
+                continue
+            if isinstance(node, Call) and node.function == PYTHON_PREDICATE:
+                # a Python primitive predicate: its arguments are the reads it declares
+                stack.extend((child, node_scope) for child in children(node))
                 continue
             if isinstance(node, Call):
                 arity = BUILTIN_FUNCTIONS.get(node.function)

@@ -62,7 +62,7 @@ HINTS: dict[str, str] = {
 
 #: How a declaration of each kind is written, for a slip right after its kind suffix.
 DECLARATION_FORMS: dict[str, str] = {
-    "PP": "a Primitive Predicate is written `name/pp = CONDITION`",
+    "PP": 'a Primitive Predicate is written `name/pp = CONDITION`, or `name/pp(reads) = python "module:function"`',
     "M": "an Internal Memory is written `name/m: Type` or `name/m: Type = INITIAL`",
     "IB": "an Input Buffer is written `name/ib: Type`, optionally followed by `fifo N`",
     "OB": "an Output Buffer is written `name/ob: Type`",

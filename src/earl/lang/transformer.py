@@ -46,6 +46,7 @@ from earl.model.elements import (
     TransitionFunction,
 )
 from earl.model.expressions import (
+    PYTHON_PREDICATE,
     Arithmetic,
     BooleanOperation,
     Call,
@@ -404,6 +405,18 @@ class ElementBuilder:
 
     def primitive_predicate(self, meta: Meta, children: list[Any]) -> PrimitivePredicate:
         return PrimitivePredicate(self._single(children[0], "Primitive Predicate"), children[2], self._loc(meta))
+
+    def python_primitive_predicate(self, meta: Meta, children: list[Any]) -> PrimitivePredicate:
+        name, _kind, reads, implementation = children
+        location = self._loc(meta)
+        expression = Call(PYTHON_PREDICATE, tuple(Read(r, (), r.location) for r in reads), location)
+        return PrimitivePredicate(
+            self._single(name, "Primitive Predicate"),
+            expression,
+            location,
+            reads=list(reads),
+            implementation=implementation,
+        )
 
     def partial_transition_function(self, meta: Meta, children: list[Any]) -> PartialTransitionFunction:
         name, _kind, reads, writes, *implementation = children

@@ -112,12 +112,21 @@ class Memory:
 
 @dataclass
 class PrimitivePredicate:
-    """`newJointPos/pp = newData(manipulatorCommand/ib.jointPosSetpoint)` (Table 4)."""
+    """`newJointPos/pp = newData(manipulatorCommand/ib.jointPosSetpoint)` (Table 4).
+
+    A predicate too involved for an expression is computed by Python code:
+    `graspStable/pp(fingerState/ib, grip/mi) = python "gripping:stable"`.  Then
+    `implementation` names the code, `reads` what it takes its arguments from (Figure 6),
+    and `expression` is `python(fingerState/ib, grip/mi)`: a Boolean that depends on those
+    reads, which is all the checker needs to know of it.
+    """
 
     name: str
     expression: Expression
     location: SourceLocation | None = location_field()
     comments: Comments = comments_field()
+    reads: list[ElementReference] = field(default_factory=list)
+    implementation: PythonImplementation | None = None
     kind: ClassVar[Kind] = Kind.PRIMITIVE_PREDICATE
 
 

@@ -293,7 +293,14 @@ def _subsystem(subsystem: Subsystem, environment: Environment, index: int | None
         return result
     context = _Context(inner, members)
     result.primitive_predicates = [
-        PrimitivePredicate(p.name, context.expression(p.expression), p.location) for p in subsystem.primitive_predicates
+        PrimitivePredicate(
+            p.name,
+            context.expression(p.expression),
+            p.location,
+            reads=context.references(p.reads),
+            implementation=p.implementation,
+        )
+        for p in subsystem.primitive_predicates
     ]
     result.partial_transition_functions = [
         PartialTransitionFunction(

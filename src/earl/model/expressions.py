@@ -178,6 +178,9 @@ BUILTIN_FUNCTIONS: dict[str, int] = {
     "timeout": 1,
 }
 
+#: The call that stands for a primitive predicate computed by Python code (see PrimitivePredicate).
+PYTHON_PREDICATE = "python"
+
 COMPARISON_OPERATORS = ("==", "!=", "<=", ">=", "<", ">")
 ARITHMETIC_OPERATORS = ("+", "-", "*")
 

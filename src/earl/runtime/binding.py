@@ -26,6 +26,8 @@ from earl.model.location import SourceLocation
 UserFunction = Callable[[Any, Any, Any], object]
 
 SIGNATURE = "def NAME(inputs, outputs, context) -> None"
+#: how a primitive predicate computed by Python is written
+PREDICATE_SIGNATURE = "def NAME(inputs, context) -> bool"
 
 
 class BindingProblem(Exception):
@@ -65,8 +67,13 @@ def _forget_shadowed(directory: Path) -> None:
             del sys.modules[name]
 
 
-def resolve_callable(path: str, what: str, location: SourceLocation | None, arity: int = 3) -> Callable[..., Any]:
-    """Import `module:function` (or `module.function`) and check that it can be called with `arity` arguments."""
+def resolve_callable(
+    path: str, what: str, location: SourceLocation | None, arity: int = 3, signature: str = SIGNATURE
+) -> Callable[..., Any]:
+    """Import `module:function` (or `module.function`) and check that it can be called with `arity` arguments.
+
+    `signature` shows how such a function is written, in hints (`def NAME(inputs, outputs, context)`).
+    """
     module_name, function_name = _split(path)
     if not module_name or not function_name:
         raise BindingProblem(
@@ -115,7 +122,7 @@ def resolve_callable(path: str, what: str, location: SourceLocation | None, arit
                 f"{what} names `{function_name}`, but the module `{module_name}` has no such function",
                 location,
                 code="EARL-X004",
-                hint=suggestion or f"define `{SIGNATURE.replace('NAME', function_name)}` in `{module.__file__}`",
+                hint=suggestion or f"define `{signature.replace('NAME', function_name)}` in `{module.__file__}`",
             )
         )
     if not callable(function):
@@ -127,7 +134,7 @@ def resolve_callable(path: str, what: str, location: SourceLocation | None, arit
                 code="EARL-X004",
             )
         )
-    _check_arity(function, arity, f"{module_name}:{function_name}", what, location)
+    _check_arity(function, arity, f"{module_name}:{function_name}", what, location, signature)
     return function  # type: ignore[no-any-return]
 
 
@@ -139,21 +146,23 @@ def _split(path: str) -> tuple[str, str]:
     return module.strip(), function.strip()
 
 
-def _check_arity(function: Any, arity: int, name: str, what: str, location: SourceLocation | None) -> None:
+def _check_arity(
+    function: Any, arity: int, name: str, what: str, location: SourceLocation | None, signature: str
+) -> None:
     try:
-        signature = inspect.signature(function)
+        actual = inspect.signature(function)
     except (TypeError, ValueError):
         return  # a builtin or C function: trust it
     try:
-        signature.bind(*range(arity))
+        actual.bind(*range(arity))
     except TypeError:
         raise BindingProblem(
             Diagnostic(
                 Severity.ERROR,
-                f"`{name}`{signature} cannot be called as {what} needs: with {arity} arguments",
+                f"`{name}`{actual} cannot be called as {what} needs: with {arity} arguments",
                 location,
                 code="EARL-X005",
-                hint=f"write it as `{SIGNATURE.replace('NAME', name.rpartition(':')[2])}` (see docs/runtime.md)",
+                hint=f"write it as `{signature.replace('NAME', name.rpartition(':')[2])}` (see docs/runtime.md)",
             )
         ) from None
 

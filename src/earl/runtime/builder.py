@@ -13,11 +13,18 @@ from pathlib import Path
 from typing import Any, Protocol
 
 from earl.diagnostics import Diagnostic, EarlError, Severity
-from earl.model.elements import Agent, Link, LinkEnd, Subsystem, System
+from earl.model.elements import Agent, Link, LinkEnd, PrimitivePredicate, Subsystem, System
 from earl.model.expressions import ElementReference, Literal, Read
 from earl.model.kinds import Kind
 from earl.model.types import DataType
-from earl.runtime.binding import BindingProblem, UserFunction, bind_function, user_code_path
+from earl.runtime.binding import (
+    PREDICATE_SIGNATURE,
+    BindingProblem,
+    UserFunction,
+    bind_function,
+    resolve_callable,
+    user_code_path,
+)
 from earl.runtime.channels import Channel
 from earl.runtime.engine import (
     BehaviourRuntime,
@@ -30,7 +37,7 @@ from earl.runtime.engine import (
 )
 from earl.runtime.events import Recorder
 from earl.runtime.names import agent_name, indexed, reference_key, subsystem_name
-from earl.runtime.predicates import PredicateCompileError, compile_predicate
+from earl.runtime.predicates import CompiledPredicate, PredicateCompileError, compile_predicate
 from earl.runtime.values import TypeSystem, ValueTypeError
 from earl.runtime.views import Context, build_inputs, build_outputs
 
@@ -185,7 +192,8 @@ def _engine(
         else:
             engine.memory[key] = types.constant(memory.initial_value, memory.data_type, f"the initial value of {key}/m")
     for predicate in subsystem.primitive_predicates:
-        engine.predicates[predicate.name] = compile_predicate(predicate.expression, f"{name} {predicate.name}/pp")
+        if predicate.implementation is None:  # Python ones are bound with the functions
+            engine.predicates[predicate.name] = compile_predicate(predicate.expression, f"{name} {predicate.name}/pp")
     return engine
 
 
@@ -209,6 +217,12 @@ def _behaviour(
     bound: dict[str, UserFunction],
     problems: list[Diagnostic],
 ) -> None:
+    for predicate in subsystem.primitive_predicates:
+        if predicate.implementation is not None:
+            try:
+                engine.predicates[predicate.name] = _python_predicate(engine, predicate)
+            except BindingProblem as problem:
+                problems.append(problem.diagnostic)
     functions: dict[str, FunctionRuntime] = {}
     for declared in subsystem.partial_transition_functions:
         try:
@@ -299,6 +313,27 @@ def _behaviour(
                 for _, transition in leaving
             ],
         )
+
+
+def _python_predicate(engine: SubsystemEngine, predicate: PrimitivePredicate) -> CompiledPredicate:
+    """`ready/pp(x/ib, y/mi) = python "m:f"`: `f(inputs, context)`, its result taken as a Boolean."""
+    assert predicate.implementation is not None
+    function = resolve_callable(
+        predicate.implementation.path,
+        f"`{predicate.name}/pp` of {engine.name}",
+        predicate.location,
+        arity=2,
+        signature=PREDICATE_SIGNATURE,
+    )
+    inputs = build_inputs(f"{predicate.name}/pp", predicate.reads, engine.inputs, engine.memory)
+    refresh = inputs.refresh
+    context = engine.context
+
+    def evaluate(*_: object) -> bool:
+        refresh()
+        return bool(function(inputs, context))
+
+    return evaluate
 
 
 def _constant_false(expression: Any, subsystem: Subsystem) -> bool:

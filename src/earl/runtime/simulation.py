@@ -242,7 +242,9 @@ def _environment(
         return environment
     with user_code_path(directories):
         try:
-            factory = resolve_callable(environment, "the environment", None, arity=2)
+            factory = resolve_callable(
+                environment, "the environment", None, arity=2, signature="def NAME(system, seed) -> object"
+            )
         except BindingProblem as problem:
             raise EarlError([problem.diagnostic], system.sources) from None  # type: ignore[arg-type]
         try:

@@ -1,0 +1,126 @@
+"""Primitive predicates computed by Python: `big/pp(x/mi) = python "module:function"`.
+
+The spec below is also tests/runtime_specs/thresholds/system.earl, so the other readers' tests
+(SysML export, the document) read it too.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+import earl
+from earl.check import check
+from earl.diagnostics import EarlError, Severity
+
+SPEC = """\
+system thresholds
+
+param LIMIT: int = 3
+
+counter/a {
+    cs {
+        period 1 ms
+
+        x/m: int = 0
+
+        // computed by Python from the memory it declares
+        big/pp(x/mi) = python "limits:big"
+        false/pp = false
+
+        increment/pf(x/mi -> x/mo) = python "limits:increment"
+
+        count/bb {
+            tf = {increment/pf}
+            tc = big/pp
+        }
+
+        done/bb {
+            tf = {}
+            tc = false/pp
+        }
+
+        fsm {
+            initial count
+            state count: count/bb
+            state done: done/bb
+
+            count -> done when big/pp
+        }
+    }
+}
+
+r/r {
+    counter/a
+}
+"""
+
+CODE = """\
+def big(inputs, context):
+    return inputs.x >= context.parameters["LIMIT"]
+
+
+def increment(inputs, outputs, context):
+    outputs.x = inputs.x + 1
+"""
+
+
+def test_the_spec_file_is_this_spec() -> None:
+    folder = Path(__file__).parent / "runtime_specs" / "thresholds"
+    assert (folder / "system.earl").read_text() == SPEC
+    assert (folder / "limits.py").read_text() == CODE
+
+
+def write(tmp_path: Path, code: str = CODE) -> Path:
+    spec = tmp_path / "system.earl"
+    spec.write_text(SPEC)
+    (tmp_path / "limits.py").write_text(code)
+    return spec
+
+
+def test_a_python_primitive_predicate_reads_back_and_is_canonical(tmp_path: Path) -> None:
+    system = earl.load(write(tmp_path))
+    predicate = system.agent("counter").control_subsystem.primitive_predicate("big")  # type: ignore[union-attr]
+    assert predicate is not None and predicate.implementation is not None
+    assert predicate.implementation.path == "limits:big"
+    assert [r.name for r in predicate.reads] == ["x"]
+    assert system.to_earl() == SPEC
+    assert earl.loads(system.to_earl(), str(tmp_path / "system.earl")) == system
+
+
+def test_the_checker_treats_it_as_a_condition_it_cannot_see_into_and_never_imports_it(tmp_path: Path) -> None:
+    spec = write(tmp_path, "raise SystemExit('imported')\n")
+    errors = [d for d in check(earl.load(spec)) if d.severity is Severity.ERROR]
+    assert errors == []
+
+
+def test_the_runtime_calls_it_with_its_declared_reads(tmp_path: Path) -> None:
+    sim = earl.simulate(earl.load(write(tmp_path)))
+    sim.advance_to(0.0015)
+    assert sim.state_of("counter/a.cs").state == "count"
+    sim.advance_to(0.0025)
+    # x reached LIMIT (3) in the third iteration, at 2 ms: big/pp held and the FSM moved on
+    assert sim.state_of("counter/a.cs").state == "done"
+    assert sim.state_of("counter/a.cs").memory["x"] == 3
+    assert sim.faults == []
+
+
+def test_a_predicate_whose_code_is_missing_is_reported_at_its_line(tmp_path: Path) -> None:
+    spec = write(tmp_path, CODE.replace("def big(", "def large("))
+    with pytest.raises(EarlError) as raised:
+        earl.simulate(earl.load(spec))
+    [diagnostic] = raised.value.diagnostics
+    assert diagnostic.code == "EARL-X004"
+    assert "`big/pp`" in diagnostic.message
+    assert diagnostic.location is not None and diagnostic.location.line == 12
+    assert "def big(inputs, context) -> bool" in (diagnostic.hint or "")
+
+
+def test_a_predicate_that_raises_is_a_fault_and_counts_as_false(tmp_path: Path) -> None:
+    spec = write(tmp_path, CODE.replace("return inputs.x >=", "return inputs.y >="))
+    sim = earl.simulate(earl.load(spec))
+    sim.advance_to(0.005)
+    assert sim.state_of("counter/a.cs").state == "count"
+    assert sim.faults and sim.faults[0].kind == "predicate"
+    assert "does not declare that it reads `y`" in sim.faults[0].message
