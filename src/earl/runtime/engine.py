@@ -300,14 +300,15 @@ class SubsystemEngine:
         if error:
             reason = "error"
         else:
+            # inline rather than through _evaluate: its message is built only when something fails
             try:
                 terminal = behaviour.terminal_condition(
                     self.inputs, self.new_data, self.timed_out, self.memory, self.predicates
                 )
-            except Exception:
-                terminal = self._evaluate(
-                    time, behaviour.terminal_condition, f"the terminal condition of `{behaviour.name}/bb`"
-                )
+            except Exception as failure:
+                what = f"the terminal condition of `{behaviour.name}/bb`"
+                self.report_fault(time, "predicate", f"evaluating {what} raised {type(failure).__name__}: {failure}")
+                terminal = False
             if not terminal:
                 return
             reason = "terminal"
