@@ -367,9 +367,10 @@ def test_stopped_driver_gets_no_current_and_reports_the_stop() -> None:
 
 def test_output_state_writes_the_buffer_its_subsystem_declares() -> None:
     inputs = Inputs(currentMotorPos=1.0, emergencyStop=False)
-    for name in ("motorControllerState", "fingerState"):
+    # a joint's motor controller has the parameter `joint`; the gripper's finger controller has not
+    for name, parameters in (("motorControllerState", {"N": 6, "joint": 2}), ("fingerState", {})):
         outputs = Outputs(name)
-        motor_controller.output_state(inputs, outputs, context())
+        motor_controller.output_state(inputs, outputs, context(parameters=parameters))
         assert outputs.written == {name: {"currentMotorPos": 1.0, "emergencyStop": False}}
 
 

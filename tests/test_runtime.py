@@ -140,6 +140,8 @@ def test_functions_of_one_stage_see_one_snapshot() -> None:
         (1, "exception", "RuntimeError: the probe trips on purpose"),
         (2, "undeclared-write", "does not declare that it writes `recoveries`; it writes: trips"),
         (3, "type", "trips/mo must be a whole number (int), not the string 'many'"),
+        (4, "undeclared-read", "`trip/pf` does not declare that it reads `recoveries`; it reads: trips"),
+        (5, "type", "trips/mo must be a whole number (int)"),
     ],
 )
 def test_a_failing_function_makes_the_error_condition_true_and_the_fsm_recovers(

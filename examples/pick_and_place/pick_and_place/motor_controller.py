@@ -59,7 +59,7 @@ def output_motor_command(inputs: Any, outputs: Any, context: Any) -> None:
 def output_state(inputs: Any, outputs: Any, context: Any) -> None:
     """motorControllerState/ob (a joint's controller) or fingerState/ob (the gripper's)."""
     state = {"currentMotorPos": float(inputs.currentMotorPos), "emergencyStop": bool(inputs.emergencyStop)}
-    if "fingerState" in dir(outputs):
+    if "joint" not in context.parameters:  # the gripper's controller belongs to no joint
         outputs.fingerState = state
     else:
         outputs.motorControllerState = state

@@ -326,7 +326,7 @@ def _python_predicate(engine: SubsystemEngine, predicate: PrimitivePredicate) ->
         signature=PREDICATE_SIGNATURE,
     )
     inputs = build_inputs(f"{predicate.name}/pp", predicate.reads, engine.inputs, engine.memory)
-    refresh = inputs.refresh
+    refresh = inputs._earl_refresh
     context = engine.context
 
     def evaluate(*_: object) -> bool:

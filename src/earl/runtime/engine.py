@@ -1,17 +1,20 @@
 """One subsystem at run time: Figure 5 of the manual, to the letter (docs/semantics.md).
 
-`bb.execute()` is one iteration, split in two halves because the receive in the
-middle may have to wait for obligatory buffers:
+`bb.execute()` is one iteration, `iterate()` here:
 
-    execute_and_send()   1. tf.execute(): the stages in order, the functions of a stage
-                            on one snapshot (Eq. 4–8)
-                         2. tf.pf.ob.send(): every output buffer written this iteration
-                         3. iterationNumber += 1
-    receive_and_decide() 4. tf.pf.ib.receive()
-                         5. ec.fun, then tc.fun; when either holds, fsm.selectState()
-                            enters the next state's behaviour (iterationNumber = 0)
+    1. tf.execute(): the stages in order, the functions of a stage on one snapshot
+       (Eq. 4–8), compiled per behaviour by earl/runtime/iteration.py
+    2. tf.pf.ob.send(): every output buffer written this iteration
+    3. iterationNumber += 1
+    4. tf.pf.ib.receive()
+    5. ec.fun, then tc.fun; when either holds, fsm.selectState() enters the next
+       state's behaviour (iterationNumber = 0)
 
-A scheduler (virtual or real time) decides when each half runs.
+When the state has an obligatory input buffer that is still empty after step 3,
+`iterate()` stops there and the scheduler waits for the message (or the timeout)
+before it calls `receive()` and `decide()`.
+
+A scheduler (virtual or real time) decides when each iteration runs.
 """
 
 from __future__ import annotations
@@ -24,9 +27,10 @@ from typing import Any, Protocol
 from earl.runtime.binding import UserFunction
 from earl.runtime.channels import Channel
 from earl.runtime.events import Fault, Recorder
+from earl.runtime.iteration import Execute, compile_execute
 from earl.runtime.predicates import CompiledPredicate
 from earl.runtime.values import ValueTypeError
-from earl.runtime.views import Context, Inputs, Outputs, UndeclaredAccess
+from earl.runtime.views import Context, Inputs, Outputs, UndeclaredAccess, explain
 
 
 @dataclass
@@ -49,28 +53,8 @@ class BehaviourRuntime:
     outputs: list[str] = field(default_factory=list)
     #: its terminal condition is the constant false and it has no error condition
     never_ends: bool = False
-    #: the stages as the engine runs them: (one function alone?, [what a call needs, unpacked])
-    plan: list[tuple[bool, list[tuple[Any, ...]]]] = field(default_factory=list)
-
-    def __post_init__(self) -> None:
-        self.plan = [
-            (
-                len(stage) == 1,
-                [
-                    (
-                        function.function,
-                        function.inputs,
-                        function.outputs,
-                        function.inputs.refresh,
-                        function.outputs.memory_written,
-                        function.outputs.sent,
-                        function.name,
-                    )
-                    for function in stage
-                ],
-            )
-            for stage in self.stages
-        ]
+    #: `tf.execute()` compiled for the engine that runs it (earl/runtime/iteration.py)
+    execute: Execute | None = None
 
 
 @dataclass
@@ -159,42 +143,35 @@ class SubsystemEngine:
         self.recorder.behaviour_started(time, self.name, initial, self.state.behaviour.name)
 
     # ------------------------------------------------------------------ Figure 5b, steps 1-3
-    def execute_and_send(self, time: int) -> None:
+    def iterate(self, time: int) -> bool:
+        """One whole iteration (steps 1-5) when the state waits for no buffer that is still empty.
+
+        False after step 3 when an obligatory input buffer is empty: the scheduler then waits
+        for it (or its timeout) and calls `receive` and `decide` itself. One method rather than
+        the scheduler calling each step, because this is the path of nearly every iteration.
+        """
         state = self.state
         assert state is not None
-        context = self.context
+        behaviour = state.behaviour
         self.iteration_start = time
         self._error_in_iteration = False
-        memory = self.memory
-        sent: dict[str, Any] | None = None
-        for single, calls in state.behaviour.plan:
-            # one function alone in its stage may write memory at once: there is nobody to isolate
-            stage_memory: dict[str, Any] = memory if single else {}
-            for function, inputs, outputs, refresh, memory_written, outputs_sent, name in calls:
-                refresh()
-                try:
-                    function(inputs, outputs, context)
-                except Exception as error:
-                    memory_written.clear()  # a function that failed writes nothing
-                    outputs_sent.clear()
-                    self._function_fault(time, name, error)
-                    continue
-                # the writes are taken and the call's dictionaries left empty for the next call
-                if memory_written:
-                    stage_memory.update(memory_written)
-                    memory_written.clear()
-                if outputs_sent:
-                    if sent is None:
-                        sent = {}
-                    sent.update(outputs_sent)
-                    outputs_sent.clear()
-            # the stage's writes become visible only now: no function saw another's (Eq. 7-8)
-            if not single and stage_memory:
-                memory.update(stage_memory)
+        execute = behaviour.execute
+        if execute is None:
+            execute = behaviour.execute = compile_execute(
+                behaviour.stages, self.memory, self.context, self._function_fault
+            )
+        sent = execute(time)
         if sent:
             self._send(time, sent)
         self.iteration += 1
         self.total_iterations += 1
+        if state.obligatory and not self.obligatory_ready():
+            return False
+        if self.channels or self._timeouts_set or self.stale:
+            self.receive(time)
+        if self._error_in_iteration or not behaviour.never_ends:
+            self.decide(time)
+        return True
 
     def _send(self, time: int, sent: dict[str, Any]) -> None:
         # a recorder that looks at no message (no trace) is not called for each of them
@@ -209,15 +186,18 @@ class SubsystemEngine:
                 if engine is not None and engine.waiting and engine.on_delivery is not None:
                     engine.on_delivery(engine)
 
-    def _function_fault(self, time: int, function: str, error: Exception) -> None:
+    def _function_fault(self, time: int, function: str, raised: Exception) -> None:
+        error = explain(raised)
         if isinstance(error, UndeclaredAccess):
-            kind = "undeclared-write" if "writes" in str(error) else "undeclared-read"
+            kind = "undeclared-write" if error.write else "undeclared-read"
         elif isinstance(error, ValueTypeError):
             kind = "type"
         else:
             kind = "exception"
         trace = "".join(
-            traceback.format_exception(type(error), error, error.__traceback__.tb_next if error.__traceback__ else None)
+            traceback.format_exception(
+                type(raised), raised, raised.__traceback__.tb_next if raised.__traceback__ else None
+            )
         )
         self.report_fault(time, kind, f"`{function}/pf` raised {type(error).__name__}: {error}", function, trace)
         # Faults section of docs/semantics.md: the behaviour's error condition becomes true
@@ -283,7 +263,8 @@ class SubsystemEngine:
     def _evaluate(self, time: int, predicate: CompiledPredicate, what: str) -> bool:
         try:
             return bool(predicate(self.inputs, self.new_data, self.timed_out, self.memory, self.predicates))
-        except Exception as error:
+        except Exception as raised:
+            error = explain(raised)
             self.report_fault(time, "predicate", f"evaluating {what} raised {type(error).__name__}: {error}")
             return False
 
@@ -305,7 +286,8 @@ class SubsystemEngine:
                 terminal = behaviour.terminal_condition(
                     self.inputs, self.new_data, self.timed_out, self.memory, self.predicates
                 )
-            except Exception as failure:
+            except Exception as raised:
+                failure = explain(raised)
                 what = f"the terminal condition of `{behaviour.name}/bb`"
                 self.report_fault(time, "predicate", f"evaluating {what} raised {type(failure).__name__}: {failure}")
                 terminal = False

@@ -7,8 +7,8 @@ that drifts.
 
 Each iteration of a subsystem (docs/semantics.md):
 
-    START   at t: execute_and_send(); if every obligatory buffer of the state has a
-            message, RECEIVE at once; else wait — a message arriving wakes it (RESUME),
+    START   at t: steps 1-3 of the iteration; if every obligatory buffer of the state
+            has a message, receive and decide at once (`SubsystemEngine.iterate`); else wait — a message arriving wakes it (RESUME),
             or the state's timeout expires (TIMEOUT) and `timeout(x/ib)` becomes true
     then    receive(), decide(); the next START is one period after this START, or at
             once if the wait made the iteration longer than its period (an overrun).
@@ -202,11 +202,16 @@ class Scheduler:
 
     def _start(self, engine: SubsystemEngine, time: int) -> int | None:
         """One iteration from START; the time of the next START, or None while the engine waits."""
-        engine.execute_and_send(time)
+        if engine.iterate(time):
+            if self.record_memory and engine.name in self.record_memory:
+                self.recorder.memory_snapshot(time, engine.name, engine.memory)
+            period = engine.period
+            if period is None:
+                return time
+            following = time + period
+            return following if following > time else time
         state = engine.state
         assert state is not None
-        if not state.obligatory or engine.obligatory_ready():
-            return self._finish(engine, time, timed_out=False)
         engine.waiting = True
         token = self._tokens[engine.name] = self._tokens[engine.name] + 1
         if state.timeout is not None:

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Iterator, Mapping
+from dataclasses import dataclass
 from typing import Any, NoReturn
 
 from earl.model.elements import System
@@ -36,7 +37,20 @@ _INTEGER_RANGES: dict[str, tuple[int, int]] = {
     "uint64": (0, 2**64 - 1),
 }
 _REAL_TYPES = ("double", "float32", "float64")
-_FLOAT_ONLY = {float}
+_FLOAT_ONLY = frozenset({float})
+
+
+@dataclass(frozen=True)
+class QuickTest:
+    """A test that a written value is valid exactly as it is: a float that is not NaN, a bool, an int in
+    range, a tuple (or list) of floats of the declared size. The engine writes it inline after each
+    call (earl/runtime/iteration.py) and calls the type's full coercer only when it fails, which
+    then converts (an int to a float) or refuses with a precise message."""
+
+    kind: str  # "real" | "boolean" | "integer" | "real_array"
+    low: int = 0
+    high: int = 0
+    size: int | None = None
 
 
 class Record(dict[str, Any]):
@@ -171,17 +185,20 @@ class TypeSystem:
             size = _fixed_size(resolved)
             if isinstance(element, PrimitiveType) and element.name in _REAL_TYPES:
                 # the common case of robot data (positions, currents): a tuple of floats, checked in one pass
+                only_floats = _FLOAT_ONLY.issuperset
+
                 def real_array(value: Any) -> Value:
-                    if type(value) is tuple:
+                    kind = type(value)
+                    if kind is tuple:
                         items = value
-                    elif type(value) is list:
+                    elif kind is list:
                         items = tuple(value)
                     elif hasattr(value, "tolist") and getattr(value, "ndim", 0) == 1:
                         items = tuple(value.tolist())
                     else:
                         return self.coerce(value, data_type, where)
                     # all floats (checked in C) and no NaN (a NaN makes the sum NaN); else the slow, precise path
-                    if (size is None or len(items) == size) and set(map(type, items)) <= _FLOAT_ONLY:
+                    if (size is None or len(items) == size) and only_floats(map(type, items)):
                         total = sum(items)
                         if total == total:
                             return items
@@ -192,6 +209,23 @@ class TypeSystem:
         if isinstance(resolved, StructType):
             return self._struct_coercer(resolved, data_type, where)
         return lambda value: self.coerce(value, data_type, where)
+
+    def quick_test(self, data_type: DataType) -> QuickTest | None:
+        """How the values user code writes most of this type pass as they are, tested inline (see QuickTest)."""
+        resolved = self.resolve(data_type)
+        if isinstance(resolved, PrimitiveType):
+            if resolved.name in _REAL_TYPES:
+                return QuickTest("real")
+            if resolved.name == "boolean":
+                return QuickTest("boolean")
+            if resolved.name in _INTEGER_RANGES:
+                low, high = _INTEGER_RANGES[resolved.name]
+                return QuickTest("integer", low, high)
+        if isinstance(resolved, ArrayType):
+            element = self.resolve(resolved.element)
+            if isinstance(element, PrimitiveType) and element.name in _REAL_TYPES:
+                return QuickTest("real_array", size=_fixed_size(resolved))
+        return None
 
     def record_class(self, struct: str) -> type[Record]:
         """The Record subclass of one struct: a value of that class was checked already and passes at once."""

@@ -13,17 +13,22 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterator, Mapping
 from types import MappingProxyType
-from typing import Any
+from typing import Any, NoReturn
 
 from earl.model.expressions import ElementReference
 from earl.model.kinds import Kind
 from earl.model.types import DataType
 from earl.runtime.names import reference_index, reference_key
-from earl.runtime.values import TypeSystem, Value
+from earl.runtime.values import QuickTest, TypeSystem, Value
 
 
 class UndeclaredAccess(AttributeError):
     """A function touched something its declaration in the spec does not list."""
+
+    def __init__(self, message: str, *, write: bool) -> None:
+        super().__init__(message)
+        #: a write (the fault `undeclared-write`), else a read (`undeclared-read`)
+        self.write = write
 
 
 class FamilyInputs:
@@ -41,7 +46,8 @@ class FamilyInputs:
         except KeyError:
             raise UndeclaredAccess(
                 f"`{self._name}[{index}]` is not among the members this function reads "
-                f"({', '.join(str(i) for i in self._members)})"
+                f"({', '.join(str(i) for i in self._members)})",
+                write=False,
             ) from None
         return store[key]
 
@@ -67,11 +73,17 @@ class Inputs:
     """The declared reads of one function, as they were when its stage began.
 
     Before each call the runtime copies the current value of every declared single
-    read into this object's attributes (`refresh`), so `inputs.x` is a plain attribute
-    read; families are live views over the same snapshot.
+    read into this object's attributes (`_earl_refresh`), so `inputs.x` is a plain
+    attribute read; families are live views over the same snapshot. The object's own
+    bookkeeping lives in slots named `_earl_…`, out of the way of any name of a spec.
+
+    The class has no `__getattr__` on purpose: with one, CPython cannot specialise
+    `inputs.x` into its fast attribute read, and every read of every function pays. A
+    read of an undeclared name raises Python's own AttributeError, which the runtime
+    rewords when it records the fault (`explain`).
     """
 
-    __slots__ = ("__dict__", "_full", "_function", "_singles")
+    __slots__ = ("__dict__", "_earl_full", "_earl_function", "_earl_refresh", "_earl_singles")
 
     def __init__(
         self,
@@ -80,42 +92,73 @@ class Inputs:
         families: dict[str, FamilyInputs],
         full: dict[str, tuple[dict[str, Any], str]],
     ) -> None:
-        self._function = function
-        self._singles = singles
-        self._full = full
+        self._earl_function = function
+        self._earl_singles = singles
+        self._earl_full = full
+        self._earl_refresh = _compile_refresh(self.__dict__, singles)
         self.__dict__.update(families)
 
-    def refresh(self) -> None:
-        values = self.__dict__
-        for name, store, key in self._singles:
-            values[name] = store[key]
-
-    def __getattr__(self, name: str) -> Any:  # only for names that are not declared reads
-        declared = sorted({n for n, _, _ in self._singles} | {n for n in self.__dict__})
-        raise UndeclaredAccess(
-            f"`{self._function}` does not declare that it reads `{name}`; it reads: {', '.join(declared) or 'nothing'}"
+    def _earl_undeclared(self, name: str) -> UndeclaredAccess:
+        declared = sorted({n for n, _, _ in self._earl_singles} | {n for n in self.__dict__})
+        return UndeclaredAccess(
+            f"`{self._earl_function}` does not declare that it reads `{name}`; "
+            f"it reads: {', '.join(declared) or 'nothing'}",
+            write=False,
         )
 
     def __getitem__(self, name: str) -> Any:
-        entry = self._full.get(name)
+        entry = self._earl_full.get(name)
         if entry is not None:
             store, key = entry
             return store[key]
-        return getattr(self, name)
+        if name in self.__dict__:
+            return self.__dict__[name]
+        raise self._earl_undeclared(name)
 
     def __dir__(self) -> list[str]:
-        return sorted({n for n, _, _ in self._singles} | set(self.__dict__))
+        return sorted({n for n, _, _ in self._earl_singles} | set(self.__dict__))
+
+
+def _compile_refresh(values: dict[str, Any], singles: list[tuple[str, dict[str, Any], str]]) -> Callable[[], None]:
+    """One straight-line function copying each declared read into `values`: it runs before every call.
+
+    Generated rather than a loop over `singles` because it runs for every function in every
+    iteration; the names are passed as constants through `repr`, never spliced in as code.
+    """
+    stores: list[dict[str, Any]] = []
+    lines = ["def refresh():"]
+    for name, store, key in singles:
+        if not any(store is known for known in stores):
+            stores.append(store)
+        position = next(i for i, known in enumerate(stores) if known is store)
+        lines.append(f"    values[{name!r}] = store_{position}[{key!r}]")
+    if len(lines) == 1:
+        lines.append("    pass")
+    namespace: dict[str, Any] = {"values": values} | {f"store_{i}": store for i, store in enumerate(stores)}
+    exec("\n".join(lines), namespace)
+    return namespace["refresh"]  # type: ignore[no-any-return]
 
 
 class _Target:
     """One declared write: its key, its type, and the dictionary of the call's writes it goes to."""
 
-    __slots__ = ("coerce", "data_type", "is_memory", "key", "store")
+    __slots__ = ("attribute", "coerce", "data_type", "is_memory", "key", "quick", "store")
 
     def __init__(
-        self, key: str, is_memory: bool, data_type: DataType, coerce: Callable[[Any], Value], store: dict[str, Any]
+        self,
+        key: str,
+        attribute: str | None,
+        is_memory: bool,
+        data_type: DataType,
+        coerce: Callable[[Any], Value],
+        store: dict[str, Any],
+        quick: QuickTest | None = None,
     ) -> None:
         self.key = key
+        #: how a value passes as it is, tested inline by the engine; else `coerce` decides
+        self.quick = quick
+        #: the name a function writes it by (`outputs.x = …`), when it is not a family member
+        self.attribute = attribute
         self.is_memory = is_memory
         self.data_type = data_type
         self.coerce = coerce
@@ -132,20 +175,22 @@ class FamilyOutputs:
         self._outputs = outputs
         self._members = members
 
-    def _target(self, index: int) -> _Target:
+    def _target(self, index: int, write: bool) -> _Target:
         try:
             return self._members[index]
         except KeyError:
             raise UndeclaredAccess(
-                f"`{self._outputs._function}` does not declare that it writes `{self._name}[{index}]` "
-                f"(it writes members {', '.join(str(i) for i in self._members)})"
+                f"`{self._outputs._earl_function}` does not declare that it writes `{self._name}[{index}]` "
+                f"(it writes members {', '.join(str(i) for i in self._members)})",
+                write=write,
             ) from None
 
     def __setitem__(self, index: int, value: Any) -> None:
-        self._outputs._write(self._target(index), value)
+        target = self._target(index, write=True)
+        target.store[target.key] = target.coerce(value)
 
     def __getitem__(self, index: int) -> Value:
-        return self._outputs._current(self._target(index))
+        return self._outputs._earl_current(self._target(index, write=False))
 
     def __len__(self) -> int:
         return len(self._members)
@@ -155,69 +200,89 @@ class FamilyOutputs:
 
 
 class Outputs:
-    """The declared writes of one function; values are checked against their types as they are written.
+    """The declared writes of one function, checked against their declarations and types.
 
-    A call's writes are collected in `memory_written` (`/mo`) and `sent` (`/ob`); the engine
-    applies them when the stage ends, and discards them when the function failed.
+    `outputs.x = value` is a plain attribute store, as cheap as writing any Python object:
+    the engine takes the call's attributes when the function returns
+    (earl/runtime/iteration.py), refusing an undeclared name and checking each value
+    against its type. Family members
+    (`outputs.x[K] = …`) and `outputs["x/mo"] = …` are checked as they are written. The
+    checked writes are collected in `_earl_memory_written` (`/mo`) and `_earl_sent` (`/ob`);
+    the engine applies them when the stage ends and discards them when the function failed.
+
+    The object's own bookkeeping lives in slots named `_earl_…`, so that no name of a spec
+    (`sent`, `clear`, …) can collide with it. Each function gets its own subclass, whose
+    class attributes are its families (`outputs.windingCurrent` is found without any
+    `__getattr__`, which would slow down every attribute store, see `Inputs`). Reading
+    back a single write is `outputs["x"]`.
     """
 
-    __slots__ = ("_fields", "_function", "_memory", "memory_written", "sent")
+    __slots__ = (
+        "__dict__",
+        "_earl_families",
+        "_earl_function",
+        "_earl_memory",
+        "_earl_memory_written",
+        "_earl_sent",
+        "_earl_targets",
+    )
 
     def __init__(self, function: str, memory: dict[str, Any]) -> None:
-        object.__setattr__(self, "_function", function)
-        object.__setattr__(self, "_memory", memory)
-        object.__setattr__(self, "_fields", {})
-        object.__setattr__(self, "memory_written", {})
-        object.__setattr__(self, "sent", {})
+        self._earl_function = function
+        self._earl_memory = memory
+        #: single writes by the name a function uses, and by their `x/mo`, `x/ob` spelling
+        self._earl_targets: dict[str, _Target] = {}
+        self._earl_families: dict[str, FamilyOutputs] = {}
+        self._earl_memory_written: dict[str, Any] = {}
+        self._earl_sent: dict[str, Any] = {}
 
-    def _declare(self, name: str, entry: _Target | FamilyOutputs) -> None:
-        self._fields[name] = entry
+    def _earl_single_writes(self) -> list[tuple[str, _Target]]:
+        """The writes a function makes by attribute (`outputs.x = …`), by that name."""
+        return [(name, target) for name, target in self._earl_targets.items() if target.attribute == name]
 
-    def clear(self) -> None:
-        self.memory_written.clear()
-        self.sent.clear()
+    def _earl_clear(self) -> None:
+        self.__dict__.clear()
+        self._earl_memory_written.clear()
+        self._earl_sent.clear()
 
-    def _write(self, target: _Target, value: Any) -> None:
-        target.store[target.key] = target.coerce(value)
+    def _earl_refuse(self, name: str, write: bool = True) -> NoReturn:
+        if name in self._earl_families:
+            raise UndeclaredAccess(f"`{name}` is a family: write one member, e.g. `outputs.{name}[1] = …`", write=write)
+        declared = [name for name, _ in self._earl_single_writes()] + list(self._earl_families)
+        raise UndeclaredAccess(
+            f"`{self._earl_function}` does not declare that it writes `{name}`; it writes: "
+            f"{', '.join(declared) or 'nothing'}",
+            write=write,
+        )
 
-    def _current(self, target: _Target) -> Value:
+    def _earl_current(self, target: _Target) -> Value:
         """What the function wrote so far in this call; else memory's value before the stage."""
+        if target.attribute is not None and target.attribute in self.__dict__:
+            return self.__dict__[target.attribute]
         if target.key in target.store:
             return target.store[target.key]
-        return self._memory.get(target.key) if target.is_memory else None
-
-    def _entry(self, name: str) -> _Target | FamilyOutputs:
-        try:
-            return self._fields[name]  # type: ignore[no-any-return]
-        except KeyError:
-            raise UndeclaredAccess(
-                f"`{self._function}` does not declare that it writes `{name}`; it writes: "
-                f"{', '.join(n for n in self._fields if '/' not in n) or 'nothing'}"
-            ) from None
-
-    def __setattr__(self, name: str, value: Any) -> None:
-        entry = self._fields.get(name)
-        if type(entry) is _Target:
-            entry.store[entry.key] = entry.coerce(value)
-            return
-        if entry is None:
-            self._entry(name)  # raises, naming what the function does write
-        raise UndeclaredAccess(f"`{name}` is a family: write one member, e.g. `outputs.{name}[1] = …`")
-
-    def __getattr__(self, name: str) -> Any:
-        entry = self._entry(name)
-        if isinstance(entry, FamilyOutputs):
-            return entry
-        return self._current(entry)
+        return self._earl_memory.get(target.key) if target.is_memory else None
 
     def __setitem__(self, name: str, value: Any) -> None:
-        self.__setattr__(name, value)
+        target = self._earl_targets.get(name)
+        if target is None:
+            self._earl_refuse(name)
+        if target.attribute is not None:  # type: ignore[union-attr]
+            self.__dict__.pop(target.attribute, None)  # type: ignore[union-attr]  # the later write wins
+        target.store[target.key] = target.coerce(value)  # type: ignore[union-attr]
 
     def __getitem__(self, name: str) -> Any:
-        return self.__getattr__(name)
+        """`outputs["x/mo"]`, `outputs["x"]`: what the call wrote so far, else memory's value before the stage."""
+        target = self._earl_targets.get(name)
+        if target is not None:
+            return self._earl_current(target)
+        family = self._earl_families.get(name)
+        if family is not None:
+            return family
+        self._earl_refuse(name, write=False)
 
     def __dir__(self) -> list[str]:
-        return [n for n in self._fields if "/" not in n]
+        return [name for name, _ in self._earl_single_writes()] + list(self._earl_families)
 
 
 class Context:
@@ -299,26 +364,58 @@ def build_outputs(
     memory_values: dict[str, Any],
     data_type_of: Callable[[ElementReference], DataType],
 ) -> Outputs:
-    outputs = Outputs(function, memory_values)
+    # a class of its own: its families become class attributes below
+    outputs: Outputs = type("Outputs", (Outputs,), {"__slots__": ()})(function, memory_values)
     families: dict[str, dict[int, _Target]] = {}
+    targets = outputs._earl_targets
     for reference in writes:
         is_memory = reference.kind is not Kind.OUTPUT_BUFFER
         key = reference_key(reference)
-        data_type = data_type_of(reference)
+        spelled = f"{key}/{'mo' if is_memory else 'ob'}"
+        index = reference_index(reference)
+        # a memory and an output buffer may share a name: then only `outputs["x/ob"]` reaches the second
+        attribute = reference.name if index is None and reference.name not in targets else None
         target = _Target(
             key,
+            attribute,
             is_memory,
-            data_type,
-            types.coercer(data_type, f"{key}/{'mo' if is_memory else 'ob'}"),
-            outputs.memory_written if is_memory else outputs.sent,
+            data_type_of(reference),
+            types.coercer(data_type_of(reference), spelled),
+            outputs._earl_memory_written if is_memory else outputs._earl_sent,
+            types.quick_test(data_type_of(reference)),
         )
-        outputs._declare(f"{key}/{'mo' if is_memory else 'ob'}", target)
-        index = reference_index(reference)
-        if index is None:
-            if reference.name not in outputs._fields:
-                outputs._declare(reference.name, target)
-        else:
+        targets[spelled] = target
+        if attribute is not None:
+            targets[attribute] = target
+        if index is not None:
             families.setdefault(reference.name, {})[index] = target
     for name, members in families.items():
-        outputs._declare(name, FamilyOutputs(name, outputs, dict(sorted(members.items()))))
+        family = outputs._earl_families[name] = FamilyOutputs(name, outputs, dict(sorted(members.items())))
+        setattr(type(outputs), name, family)
     return outputs
+
+
+def explain(error: BaseException) -> BaseException:
+    """A function's error as the fault records it: Python's AttributeError on a view, in the spec's words.
+
+    `inputs.x` for an undeclared `x` raises AttributeError (the views have no `__getattr__`,
+    see `Inputs`); this says which function did not declare what, and what it does declare.
+    """
+    if isinstance(error, AttributeError) and not isinstance(error, UndeclaredAccess):
+        view = getattr(error, "obj", None)
+        name = getattr(error, "name", None)
+        if isinstance(name, str) and not name.startswith("_earl_"):
+            if isinstance(view, Inputs):
+                return view._earl_undeclared(name)
+            if isinstance(view, Outputs):
+                if view._earl_targets.get(name) is not None:
+                    return UndeclaredAccess(
+                        f"`{view._earl_function}` read `outputs.{name}` before writing it; "
+                        f'`outputs["{name}"]` reads what it holds (memory\'s value before the stage)',
+                        write=False,
+                    )
+                try:
+                    view._earl_refuse(name, write=False)
+                except UndeclaredAccess as refused:
+                    return refused
+    return error

@@ -17,6 +17,10 @@ def trip(inputs, outputs, context):
         outputs.recoveries = 99  # declared by recover/pf, not by trip/pf
     if mode == 3:
         outputs.trips = "many"
+    if mode == 4:
+        outputs.trips = inputs.recoveries  # read by recover/pf, not by trip/pf
+    if mode == 5:
+        outputs.trips = [1, 2]  # a list where an int is declared
 
 
 def recover(inputs, outputs, context):

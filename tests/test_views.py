@@ -1,0 +1,148 @@
+"""What a partial transition function sees (docs/runtime.md): `outputs` taken and checked when the
+call returns, read back with `outputs["x"]`, families, names that could collide with the views' own
+bookkeeping, and the quick type tests the compiled iteration writes inline (earl/runtime/iteration.py)."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+import earl
+
+SPEC = """\
+system views
+
+param MODE: int = 0
+
+viewer/a {
+    cs {
+        period 1 ms
+
+        sent/m: int = 7
+        clear/m: int = 0
+        level/m: double = 0.5
+        joints/m: double[3] = [0.0, 0.0, 0.0]
+        current[K in 1..2]/m: double = 0.0
+        seen/m: double = 0.0
+        faulted/m: boolean = false
+
+        false/pp = false
+
+        write/pf(sent/mi, level/mi -> sent/mo, clear/mo, level/mo, joints/mo, current[*]/mo, seen/mo) = python "viewing:write"
+
+        run/bb {
+            tf = {write/pf}
+            tc = false/pp
+        }
+
+        fsm {
+            initial run
+            state run: run/bb
+        }
+    }
+}
+
+r/r {
+    viewer/a
+}
+"""
+
+CODE = """\
+import math
+
+LOG = []
+
+
+def write(inputs, outputs, context):
+    mode = context.parameters["MODE"]
+    before = outputs["level"]  # memory's value before the stage: nothing written yet
+    outputs.level = before + 1.0
+    LOG.append((before, outputs["level"], outputs.level, outputs["sent/mo"]))
+    outputs.sent = inputs.sent + 1
+    outputs.clear = outputs["clear"] + 2
+    outputs.current[2] = 1.5
+    outputs.seen = outputs.current[2]
+    if mode == 0:
+        outputs.joints = [1, 2.5, 3]  # ints where doubles are declared: converted
+    elif mode == 1:
+        outputs.joints = (0.1, math.nan, 0.3)
+    elif mode == 2:
+        outputs.joints = [True, 0.0, 0.0]
+    elif mode == 3:
+        outputs.joints = [0.1, 0.2]
+    elif mode == 4:
+        outputs.current = [1.0, 2.0]
+    elif mode == 5:
+        import numpy
+        outputs.joints = numpy.array([0.5, 0.25, 0.125])
+    elif mode == 6:
+        outputs.level = math.nan
+"""
+
+
+def run(tmp_path: Path, mode: int) -> tuple[Any, list[Any]]:
+    (tmp_path / "system.earl").write_text(SPEC)
+    (tmp_path / "viewing.py").write_text(CODE)
+    sim = earl.simulate(earl.load(tmp_path / "system.earl"), parameters={"MODE": mode})
+    sim.advance_to(0.0015)
+    import viewing  # type: ignore[import-not-found]  # on sys.path once the run bound it
+
+    log = list(viewing.LOG)
+    sim.close()
+    return sim, log
+
+
+@pytest.fixture(autouse=True)
+def _forget_module() -> Any:
+    import sys
+
+    yield
+    sys.modules.pop("viewing", None)
+
+
+def test_writes_are_taken_when_the_call_returns_and_read_back_by_item(tmp_path: Path) -> None:
+    sim, log = run(tmp_path, 0)
+    assert sim.faults == []
+    memory = sim.state_of("viewer/a.cs").memory
+    # names a view keeps for itself elsewhere (`sent`, `clear`) are plain names of the spec here
+    assert memory["sent"] == 9 and memory["clear"] == 4
+    assert memory["level"] == 2.5
+    assert memory["joints"] == (1.0, 2.5, 3.0) and all(type(j) is float for j in memory["joints"])
+    assert memory["current[1]"] == 0.0 and memory["current[2]"] == 1.5
+    assert memory["seen"] == 1.5
+    # outputs["level"]: memory's value before anything was written, then what was written
+    assert log[0] == (0.5, 1.5, 1.5, 7) and log[1] == (1.5, 2.5, 2.5, 8)
+
+
+@pytest.mark.parametrize(
+    ("mode", "kind", "message"),
+    [
+        (1, "type", "joints/mo[1] is NaN"),
+        (2, "type", "joints/mo[0] must be a number (double), not"),
+        (3, "type", "joints/mo must have 3 elements"),
+        (4, "undeclared-write", "`current` is a family: write one member"),
+        (6, "type", "level/mo is NaN"),
+    ],
+)
+def test_a_value_the_quick_test_rejects_gets_the_precise_message(
+    tmp_path: Path, mode: int, kind: str, message: str
+) -> None:
+    sim, _ = run(tmp_path, mode)
+    assert sim.faults, "the bad write was not refused"
+    fault = sim.faults[0]
+    assert (fault.kind, fault.function) == (kind, "write")
+    assert message in fault.message
+    memory = sim.state_of("viewer/a.cs").memory
+    # a call that failed wrote nothing, not even what it wrote before the bad value
+    assert memory["sent"] == 7 and memory["level"] == 0.5 and memory["joints"] == (0.0, 0.0, 0.0)
+
+
+def test_a_numpy_array_is_accepted_and_stored_as_a_tuple_of_floats(tmp_path: Path) -> None:
+    sim, _ = run(tmp_path, 5)
+    assert sim.faults == []
+    joints = sim.state_of("viewer/a.cs").memory["joints"]
+    assert joints == (0.5, 0.25, 0.125) and type(joints) is tuple
+    assert not any(math.isnan(j) for j in joints)
