@@ -122,13 +122,15 @@ class Bench:
                 Inputs(windingCurrent=self.controller_memory[k]["windingCurrent"]), command_out, ctx
             )
             self.to_drive[k] = msg(command_out.written["motorCommand"])
-            state_out = Outputs("motorControllerState")
+            # as in the spec: the finger controller reports on fingerState, a joint's on motorControllerState
+            state = "fingerState" if k == finger else "motorControllerState"
+            state_out = Outputs(state)
             motor_controller.output_state(
                 Inputs(currentMotorPos=self.controller_memory[k]["currentMotorPos"], emergencyStop=False),
                 state_out,
                 ctx,
             )
-            self.to_cs[k] = msg(state_out.written["motorControllerState"])
+            self.to_cs[k] = msg(state_out.written[state])
         if t % 2 == 0:
             self._manipulator()
         if t % 10 == 0:

@@ -19,11 +19,12 @@ compiler), not from a hand-made solver.
 
 from __future__ import annotations
 
+import importlib
+import sys
 from collections.abc import Iterator
 from dataclasses import dataclass
-from typing import Any
-
-from dd.autoref import BDD, Function
+from types import ModuleType
+from typing import TYPE_CHECKING, Any
 
 from earl.check.context import CheckContext, subsystem_name
 from earl.check.registry import Finding, rule
@@ -32,6 +33,31 @@ from earl.model.elements import FSM, Subsystem, Transition
 from earl.model.expressions import BooleanOperation, Expression, Literal, Not, Read, evaluate_constant, walk
 from earl.model.kinds import Kind
 from earl.model.text import expression_text
+
+
+def _import_dd_without_networkx() -> ModuleType:
+    """`dd.autoref`, imported while `import networkx` fails.
+
+    dd imports networkx only to draw BDDs as graphs, which earl never does, and falls back
+    quietly when it is missing; importing it takes a quarter of a second of every `earl check`
+    and `earl run`. Only dd's own import sees it missing: the entry is removed again, so user
+    code that imports networkx later gets it as usual.
+    """
+    absent = "networkx" not in sys.modules
+    if absent:
+        sys.modules["networkx"] = None  # type: ignore[assignment]  # makes `import networkx` raise ImportError
+    try:
+        return importlib.import_module("dd.autoref")
+    finally:
+        if absent and "networkx" in sys.modules and sys.modules["networkx"] is None:
+            del sys.modules["networkx"]
+
+
+if TYPE_CHECKING:
+    from dd.autoref import BDD, Function
+else:
+    _autoref = _import_dd_without_networkx()
+    BDD, Function = _autoref.BDD, _autoref.Function
 
 
 @dataclass(frozen=True)

@@ -9,21 +9,26 @@ Exit codes (documented in README and docs/cli.md):
 from __future__ import annotations
 
 import argparse
+import importlib
 import sys
 from collections.abc import Sequence
 
 from earl import __version__
-from earl.cli import (
-    check_command,
-    diagram_command,
-    doc_command,
-    export_command,
-    fmt_command,
-    launch_command,
-    rules_command,
-    run_command,
-    trace_command,
-)
+
+#: every command, in the order `earl --help` lists them, and the module that implements it
+COMMANDS = {
+    "check": "earl.cli.check_command",
+    "diagram": "earl.cli.diagram_command",
+    "doc": "earl.cli.doc_command",
+    "export": "earl.cli.export_command",
+    "fmt": "earl.cli.fmt_command",
+    "launch": "earl.cli.launch_command",
+    "rules": "earl.cli.rules_command",
+    "run": "earl.cli.run_command",
+    "trace": "earl.cli.trace_command",
+}
+#: commands a module above registers besides its own (`earl plot` is `earl trace plot`)
+ALIASES = {"plot": "trace"}
 
 EXIT_OK = 0
 EXIT_INVALID = 1
@@ -59,7 +64,8 @@ class _Parser(argparse.ArgumentParser):
         raise SystemExit(EXIT_USAGE)
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(only: str | None = None) -> argparse.ArgumentParser:
+    """The whole command line, or with `only` just that command's (see `main`)."""
     parser = _Parser(
         prog="earl",
         description=DESCRIPTION,
@@ -68,21 +74,29 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"earl {__version__}")
     commands = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
-    check_command.register(commands)
-    diagram_command.register(commands)
-    doc_command.register(commands)
-    export_command.register(commands)
-    fmt_command.register(commands)
-    launch_command.register(commands)
-    rules_command.register(commands)
-    run_command.register(commands)
-    trace_command.register(commands)
+    for name, module in COMMANDS.items():
+        if only is None or name == only:
+            importlib.import_module(module).register(commands)
     return parser
 
 
+def _command_named(argv: Sequence[str]) -> str | None:
+    """The command `argv` names, when it is the first word that is not an option (`earl run …`)."""
+    for word in argv:
+        if not word.startswith("-"):
+            word = ALIASES.get(word, word)
+            return word if word in COMMANDS else None
+        if word in ("-h", "--help", "--version"):
+            return None
+    return None
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = build_parser()
-    arguments = parser.parse_args(argv)
+    words = sys.argv[1:] if argv is None else list(argv)
+    # Only the command being run is imported: the others pull in the renderer, the SysML
+    # exporter and more, which would add half a second to every `earl run`.
+    parser = build_parser(_command_named(words))
+    arguments = parser.parse_args(words)
     if arguments.command is None:
         parser.print_help()
         return EXIT_USAGE
