@@ -562,8 +562,8 @@ READING_CASES: list[tuple[str, str, str, int, int, str]] = [
         "the initial state exists",
         "EARL-R031",
         edit((FSM_BODY, FSM_BODY.replace("initial run", "initial walk"))),
-        14,
-        9,
+        15,
+        21,
         "the initial state `walk` is not a state of this FSM",
     ),
     (
@@ -1007,3 +1007,10 @@ def test_a_condition_reading_unwritten_memory_is_reported() -> None:
     assert "(the initial state of a1/a.cs)" in finding.message
     fixed = edit(("z/m: double\n", "z/m: double = 0.0\n"), text=text)
     assert findings(fixed, "EARL-W041") == []
+
+
+def test_a_subsystem_declared_twice_is_reported_once_not_again_by_each_link_to_it() -> None:
+    twice = BASE.replace("a1/a {\n    cs {", "a1/a {\n    cs {\n    }\n    cs {")
+    with pytest.raises(EarlError) as raised:
+        earl.loads(twice, "spec.earl")
+    assert [d.code for d in raised.value.diagnostics] == ["EARL-R002"]

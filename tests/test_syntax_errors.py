@@ -531,12 +531,23 @@ NAMES = [
         hint="did you mean `idle`?",
     ),
     Malformed(
+        "unknown_state_in_transition_with_no_near_name",
+        _in_cs(
+            "        false/pp = false\n        b/bb {\n            tf = {}\n            tc = false/pp\n        }\n        fsm {\n            initial idle\n            state idle: b/bb\n            idle -> grasp when false/pp\n        }\n"
+        ),
+        17,
+        13,
+        "EARL-R032",
+        "transition `idle,grasp/t` names the state `grasp`, which this FSM does not declare",
+        hint="its states are `idle`; declare `state grasp: BEHAVIOUR/bb` to add one",
+    ),
+    Malformed(
         "initial_not_a_state",
         _in_cs(
             "        false/pp = false\n        b/bb {\n            tf = {}\n            tc = false/pp\n        }\n        fsm {\n            initial start\n            state idle: b/bb\n        }\n"
         ),
-        14,
-        9,
+        15,
+        21,
         "EARL-R031",
         "the initial state `start` is not a state of this FSM",
         hint="add `state start: start/bb`",

@@ -110,6 +110,8 @@ class _AgentTable:
     family: IndexRange | None
     scope: Scope
     subsystems: dict[tuple[str, Kind], tuple[_SubsystemTable, IndexRange | None]] = field(default_factory=dict)
+    #: subsystems declared more than once (EARL-R002): a link to one may mean either declaration
+    declared_twice: set[tuple[str, Kind]] = field(default_factory=set)
 
 
 class Resolver:
@@ -402,6 +404,7 @@ class Resolver:
                 self.duplicate(
                     f"{what} of `{agent.name}/a`", subsystem.location, table.subsystems[key][0].subsystem.location
                 )
+                table.declared_twice.add(key)
                 continue
             sub_scope = dict(inner)
             sub_family = self.family_range(subsystem.family, inner)
@@ -518,7 +521,7 @@ class Resolver:
         if fsm.initial not in states:
             self.error(
                 f"the initial state `{fsm.initial}` is not a state of this FSM",
-                fsm.location,
+                fsm.initial_location or fsm.location,
                 "EARL-R031",
                 did_you_mean(fsm.initial, states) or f"add `state {fsm.initial}: {fsm.initial}/bb`",
             )
@@ -529,7 +532,13 @@ class Resolver:
                         f"transition `{transition.name}/t` names the state `{end}`, which this FSM does not declare",
                         transition.location,
                         "EARL-R032",
-                        did_you_mean(end, states),
+                        did_you_mean(end, states)
+                        or (
+                            f"its states are {', '.join(f'`{name}`' for name in states)}; "
+                            f"declare `state {end}: BEHAVIOUR/bb` to add one"
+                            if states
+                            else f"declare `state {end}: BEHAVIOUR/bb` first"
+                        ),
                     )
             self.expression(transition.condition.expression, table, scope, owner)
         for assumption in fsm.assumptions:
@@ -814,6 +823,8 @@ class Resolver:
         self._indices(end.subsystem, sub_family, scope, star=False)
         buffers = sub_table.lookup(kind)
         declared = buffers.get(end.buffer.name)
+        if declared is None and key in table.declared_twice:
+            return  # the buffer may be the other declaration's: EARL-R002 already says what to fix
         if declared is None:
             other = Kind.INPUT_BUFFER if kind is Kind.OUTPUT_BUFFER else Kind.OUTPUT_BUFFER
             hint = did_you_mean(end.buffer.name, buffers)

@@ -470,8 +470,8 @@ class ElementBuilder:
 
     # ------------------------------------------------------------------ FSM
     def fsm(self, meta: Meta, children: list[Any]) -> FSM:
-        initial, *items = children
-        fsm = FSM(initial, location=self._loc(meta))
+        (initial, initial_location), *items = children
+        fsm = FSM(initial, location=self._loc(meta), initial_location=initial_location)
         for item in items:
             if isinstance(item, State):
                 fsm.states.append(item)
@@ -481,8 +481,8 @@ class ElementBuilder:
                 fsm.assumptions.append(item)
         return fsm
 
-    def initial_state(self, meta: Meta, children: list[Token]) -> str:
-        return str(children[0])
+    def initial_state(self, meta: Meta, children: list[Token]) -> tuple[str, SourceLocation]:
+        return str(children[0]), self._loc(children[0])
 
     def state(self, meta: Meta, children: list[Any]) -> State:
         name, behaviour, *group = children

@@ -266,6 +266,8 @@ class FSM:
     assumptions: list[Assumption] = field(default_factory=list)
     location: SourceLocation | None = location_field()
     comments: Comments = comments_field()
+    #: where `initial NAME` names the initial state, for messages about it
+    initial_location: SourceLocation | None = location_field()
 
     def state_named(self, name: str) -> State | None:
         return next((state for state in self.states if state.name == name), None)

@@ -361,7 +361,7 @@ class _Context:
         ]
 
     def fsm(self, fsm: FSM) -> FSM:
-        result = FSM(fsm.initial, location=fsm.location)
+        result = FSM(fsm.initial, location=fsm.location, initial_location=fsm.initial_location)
         result.states = [
             State(
                 s.name,

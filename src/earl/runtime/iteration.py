@@ -62,21 +62,22 @@ def compile_execute(
         # builtins too, as closure variables (see below)
         **{builtin.__name__: builtin for builtin in (type, tuple, list, float, bool, int, len, sum, map, next, iter)},
     }
-    lines = ["def execute(time):", "    sent = {}"]
+    # `sent` is made only when something is sent; a stage's own dictionary is made once and reused
+    lines = ["def execute(time):", "    sent = None"]
     number = 0
-    for stage in stages:
+    for position, stage in enumerate(stages):
         single = len(stage) == 1
-        if not single:
-            lines.append("    stage = {}")
         # one function alone in its stage writes memory at once: there is nobody to isolate
-        target = "memory" if single else "stage"
+        target = "memory" if single else f"stage_{position}"
+        if not single:
+            namespace[target] = {}
         for call in stage:
             n = number
             number += 1
             lines += _call(n, call, target, namespace)
         if not single:
             # the stage's writes become visible only now: no function saw another's (Eq. 7-8)
-            lines += ["    if stage:", "        memory.update(stage)"]
+            lines += [f"    if {target}:", f"        memory.update({target})", f"        {target}.clear()"]
     lines.append("    return sent")
     # `execute` is made inside a factory whose parameters are everything it uses, so that each
     # is a closure variable (as fast to read as a local) rather than a global (a dictionary)
@@ -147,12 +148,21 @@ def _call(n: int, call: Call, target: str, namespace: dict[str, Any]) -> list[st
         f"            {target}.update(written_{n})",
         f"            written_{n}.clear()",
         f"        if sends_{n}:",
+        "            if sent is None:",
+        "                sent = {}",
         f"            sent.update(sends_{n})",
         f"            sends_{n}.clear()",
     ]
     for value, (_, write) in zip(values, writes, strict=True):
-        destination = target if write.is_memory else "sent"
-        lines += [f"        if {value} is not MISSING:", f"            {destination}[{write.key!r}] = {value}"]
+        lines.append(f"        if {value} is not MISSING:")
+        if write.is_memory:
+            lines.append(f"            {target}[{write.key!r}] = {value}")
+        else:
+            lines += [
+                "            if sent is None:",
+                "                sent = {}",
+                f"            sent[{write.key!r}] = {value}",
+            ]
     return lines
 
 

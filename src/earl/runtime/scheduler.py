@@ -128,17 +128,10 @@ class Scheduler:
                 self._wait_until(time, engine, kind)
             if kind == _START:
                 following = self._start(engine, time)
-                # The engine alone is due before anything else: run it on without the queue
-                # (same order as through the queue, only cheaper).
-                while (
-                    following is not None
-                    and following <= until
-                    and advance is None
-                    and not realtime
-                    and (not queue or following < queue[0][0])
-                ):
-                    self.now = following
-                    following = self._start(engine, following)
+                if following is not None and advance is None and not realtime:
+                    # The engine alone is due before anything else: run it on without the queue
+                    # (same order as through the queue, only cheaper).
+                    following = self._run_alone(engine, following, min(until, queue[0][0] - 1) if queue else until)
                 if following is not None:
                     self._push(following, engine, _START)
             elif kind == _RESUME:
@@ -210,6 +203,11 @@ class Scheduler:
                 return time
             following = time + period
             return following if following > time else time
+        self._wait(engine, time)
+        return None
+
+    def _wait(self, engine: SubsystemEngine, time: int) -> None:
+        """The engine waits for its obligatory buffers, until its state's timeout at most."""
         state = engine.state
         assert state is not None
         engine.waiting = True
@@ -217,6 +215,29 @@ class Scheduler:
         if state.timeout is not None:
             self._push(time + state.timeout, engine, _TIMEOUT, token)
         return None
+
+    def _run_alone(self, engine: SubsystemEngine, following: int, last: int) -> int | None:
+        """Iterations of one engine due at `following`, … up to `last` (ns) while nothing else is due.
+
+        The loop of a system with one subsystem (and of a fast one among slow ones), so it is
+        `_start` written out for the common case: a period, no memory to record after each
+        iteration.
+        """
+        period = engine.period
+        if period is None or period <= 0 or (self.record_memory and engine.name in self.record_memory):
+            next_start: int | None = following
+            while next_start is not None and next_start <= last:
+                self.now = next_start
+                next_start = self._start(engine, next_start)
+            return next_start
+        iterate = engine.iterate
+        while following <= last:
+            self.now = following
+            if not iterate(following):
+                self._wait(engine, following)
+                return None
+            following += period
+        return following
 
     def _delivered(self, engine: SubsystemEngine) -> None:
         """A message reached a waiting engine: wake it now if its obligatory buffers are all filled."""
