@@ -146,3 +146,23 @@ def test_a_numpy_array_is_accepted_and_stored_as_a_tuple_of_floats(tmp_path: Pat
     joints = sim.state_of("viewer/a.cs").memory["joints"]
     assert joints == (0.5, 0.25, 0.125) and type(joints) is tuple
     assert not any(math.isnan(j) for j in joints)
+
+
+def test_a_struct_field_reads_as_an_attribute_and_a_field_named_like_a_dict_method_by_item() -> None:
+    from earl.model.types import TypeReference
+    from earl.runtime.values import TypeSystem
+
+    system = earl.loads(
+        "system s\n\nstruct Reading {\n    motorPos: double\n    items: int\n    note: string?\n}\n", "types.earl"
+    )
+    types = TypeSystem(system)
+    reading = types.coercer(TypeReference("Reading"), "reading/ib")({"motorPos": 0.5, "items": 3})
+    assert reading.motorPos == 0.5 and reading.note is None
+    assert reading["items"] == 3 and callable(reading.items)  # dict's own method is not hidden
+    with pytest.raises(AttributeError, match="has no field `speed`"):
+        _ = reading.speed
+    with pytest.raises(TypeError, match="cannot be changed in place"):
+        reading.motorPos = 1.0
+    assert reading.replace(motorPos=1.0).motorPos == 1.0
+    default = types.default(TypeReference("Reading"))
+    assert default.motorPos == 0.0 and type(default) is type(reading)

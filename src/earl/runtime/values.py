@@ -15,8 +15,9 @@ double is declared) into that form, or says exactly what does not fit the type.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass
+from operator import itemgetter
 from typing import Any, NoReturn
 
 from earl.model.elements import System
@@ -128,7 +129,8 @@ class TypeSystem:
             size = _fixed_size(resolved)
             value = () if size is None else tuple(self.default(resolved.element) for _ in range(size))
         else:
-            value = Record({f.name: (None if f.optional else self.default(f.data_type)) for f in resolved.fields})
+            record = self.record_class(resolved.name, [f.name for f in resolved.fields])
+            value = record({f.name: (None if f.optional else self.default(f.data_type)) for f in resolved.fields})
         if key is not None:
             self._defaults[key] = value
         return value
@@ -162,7 +164,7 @@ class TypeSystem:
                     continue
                 raise ValueTypeError(f"{where}: the field `{name}` of `{resolved.name}` is missing")
             result[name] = self.coerce(value[name], declared.data_type, f"{where}.{name}")
-        return self.record_class(resolved.name)(result)
+        return self.record_class(resolved.name, [f.name for f in resolved.fields])(result)
 
     def coercer(self, data_type: DataType, where: str) -> Callable[[Any], Value]:
         """`coerce` for one type, with a fast path for the values user code writes most (floats, ints, Booleans)."""
@@ -227,11 +229,21 @@ class TypeSystem:
                 return QuickTest("real_array", size=_fixed_size(resolved))
         return None
 
-    def record_class(self, struct: str) -> type[Record]:
-        """The Record subclass of one struct: a value of that class was checked already and passes at once."""
+    def record_class(self, struct: str, fields: Iterable[str] = ()) -> type[Record]:
+        """The Record subclass of one struct: a value of that class was checked already and passes at once.
+
+        Each field is a class attribute reading its item (`msg.motorPos` is `msg["motorPos"]`),
+        so a field read never reaches `Record.__getattr__`: getting there costs Python an
+        AttributeError it builds and drops, ten times the read itself. A field named like a
+        method of dict (`items`, `keys`) is left to `msg["items"]`, as before.
+        """
         found = self._record_classes.get(struct)
         if found is None:
-            found = self._record_classes[struct] = type(struct, (Record,), {"__slots__": ()})
+            namespace: dict[str, Any] = {"__slots__": ()}
+            for name in fields:
+                if not hasattr(Record, name):
+                    namespace[name] = property(itemgetter(name), doc=f"the field `{name}` of `{struct}`")
+            found = self._record_classes[struct] = type(struct, (Record,), namespace)
         return found
 
     def _struct_coercer(self, struct: StructType, data_type: DataType, where: str) -> Callable[[Any], Value]:
@@ -241,7 +253,7 @@ class TypeSystem:
         in range) and calls the field's own checker otherwise; anything unusual goes to `coerce`,
         which says precisely what is wrong.
         """
-        cls = self.record_class(struct.name)
+        cls = self.record_class(struct.name, [f.name for f in struct.fields])
         names: dict[str, Any] = {"cls": cls, "dict": dict, "float": float, "bool": bool, "int": int}
         names["slow"] = lambda value: self.coerce(value, data_type, where)
         lines = [
