@@ -22,6 +22,7 @@ from __future__ import annotations
 import traceback
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any, Protocol
 
 from earl.runtime.binding import UserFunction
@@ -194,11 +195,7 @@ class SubsystemEngine:
             kind = "type"
         else:
             kind = "exception"
-        trace = "".join(
-            traceback.format_exception(
-                type(raised), raised, raised.__traceback__.tb_next if raised.__traceback__ else None
-            )
-        )
+        trace = _user_traceback(raised)
         self.report_fault(time, kind, f"`{function}/pf` raised {type(error).__name__}: {error}", function, trace)
         # Faults section of docs/semantics.md: the behaviour's error condition becomes true
         self._error_in_iteration = True
@@ -320,3 +317,26 @@ class SubsystemEngine:
 
     def snapshot(self) -> dict[str, Any]:
         return dict(self.memory)
+
+
+def _user_traceback(error: BaseException) -> str:
+    """The traceback of a function's error from its own code down, without the runtime's frames.
+
+    A value of the wrong type or an undeclared name set on `outputs` is found by the runtime
+    after the call returned: such an error has no frame of user code, and gets no traceback
+    (its message names the function and the write).
+    """
+    frames = traceback.extract_tb(error.__traceback__)
+    user = [frame for frame in frames if not _is_runtime_frame(frame.filename)]
+    if not user:
+        return ""
+    lines = ["Traceback (most recent call last):\n", *traceback.format_list(user)]
+    return "".join(lines + traceback.format_exception_only(type(error), error))
+
+
+def _is_runtime_frame(filename: str) -> bool:
+    return filename == "<string>" or filename.startswith(_RUNTIME_DIRECTORY)
+
+
+#: earl's runtime package: its frames (and the generated `execute`) are not the user's
+_RUNTIME_DIRECTORY = str(Path(__file__).resolve().parent)
