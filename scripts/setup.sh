@@ -45,3 +45,7 @@ if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ]; then
     "$VENV/bin/python" -m pip install --quiet -e ".[dev]"
     touch "$stamp"
 fi
+# Byte-compile earl and the examples, as pip does for a regular install (an editable one does not):
+# Python then starts from the cached bytecode even where PYTHONDONTWRITEBYTECODE is set, which saves
+# compiling ~100 modules (an eighth of a second) at every `earl` command. Stale files are recompiled.
+"$VENV/bin/python" -m compileall -q -j 0 src examples >/dev/null
