@@ -176,7 +176,7 @@ class SubsystemEngine:
 
     def _send(self, time: int, sent: dict[str, Any]) -> None:
         # a recorder that looks at no message (no trace) is not called for each of them
-        record = self.recorder.message_sent if getattr(self.recorder, "wants_messages", True) else None
+        record = self.recorder.message_sent if self.recorder.wants_messages else None
         destinations = self.destinations
         for key, value in sent.items():
             for destination in destinations.get(key, ()):

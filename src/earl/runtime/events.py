@@ -39,6 +39,9 @@ class SubsystemStatistics:
 class Recorder:
     """Receives the events of a run; this base class ignores them all."""
 
+    #: whether `message_sent` should be called at all (messages are the most frequent event)
+    wants_messages: bool = True
+
     def state_changed(self, time: int, subsystem: str, source: str | None, destination: str, transition: str) -> None:
         pass
 
@@ -70,15 +73,14 @@ class Recorders(Recorder):
         self.recorders = recorders
         # messages are the most frequent event: call only the recorders that look at them
         self._message_recorders = [r for r in recorders if type(r).message_sent is not Recorder.message_sent]
-
-    @property
-    def wants_messages(self) -> bool:
-        return bool(self._message_recorders)
+        #: read by the engine at every send: a plain attribute, kept up to date by `add`
+        self.wants_messages = bool(self._message_recorders)
 
     def add(self, recorder: Recorder) -> None:
         self.recorders.append(recorder)
         if type(recorder).message_sent is not Recorder.message_sent:
             self._message_recorders.append(recorder)
+            self.wants_messages = True
 
     def state_changed(self, time: int, subsystem: str, source: str | None, destination: str, transition: str) -> None:
         for recorder in self.recorders:
