@@ -168,7 +168,7 @@ class RobotModel:
             largest = float(np.max(np.abs(step)))
             if largest > max_step:
                 step *= max_step / largest
-            q = np.clip(q + step, self.lower, self.upper)
+            q = np.minimum(np.maximum(q + step, self.lower), self.upper)  # np.clip, without its overhead
         return q
 
     # ------------------------------------------------------------ dynamics

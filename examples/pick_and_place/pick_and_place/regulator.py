@@ -94,5 +94,6 @@ def regulate(
     saturated = np.abs(current) > limit
     winding_up = saturated & (np.sign(current) == np.sign(error))
     state.integral = np.where(winding_up, state.integral, integral)
-    clipped: Vector = np.clip(current, -limit, limit)
+    # np.minimum/np.maximum rather than np.clip, whose argument handling costs more than the clip on six joints
+    clipped: Vector = np.minimum(np.maximum(current, -limit), limit)
     return clipped

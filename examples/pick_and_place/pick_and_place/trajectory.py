@@ -8,6 +8,7 @@ the given limit, and never shorter than `MINIMUM_DURATION`.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import mujoco
@@ -112,8 +113,10 @@ def slerp(q0: Vector, q1: Vector, s: float) -> Vector:
     rotation = np.empty(3)
     mujoco.mju_quat2Vel(rotation, difference, 1.0)
     partial = np.empty(4)
-    angle = float(np.linalg.norm(rotation)) * s
-    axis = rotation / np.linalg.norm(rotation) if angle > 0 else np.array([1.0, 0.0, 0.0])
+    # math.sqrt of a dot product: np.linalg.norm costs more than the rest of this function on a 3-vector
+    length = math.sqrt(float(rotation @ rotation))
+    angle = length * s
+    axis = rotation / length if angle > 0 else np.array([1.0, 0.0, 0.0])
     mujoco.mju_axisAngle2Quat(partial, axis, angle)
     result = np.empty(4)
     mujoco.mju_mulQuat(result, partial, q0)
