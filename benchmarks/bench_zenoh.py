@@ -3,11 +3,14 @@
     .venv/bin/python benchmarks/bench_zenoh.py
 
 Two OS processes on 127.0.0.1 (this one and an echo child), peer mode, explicit endpoints.
-For 64 B and 4 KiB messages (a `double[6]` and a `double[454]` with earl's 8-byte type
-fingerprint; raw Zenoh sends byte strings of exactly the same length):
+For 64 B and 4 KiB messages (a `double[7]` and a `double[511]`: 67 B and 4100 B on the wire
+with earl's 8-byte type fingerprint and msgpack ext header; raw Zenoh sends byte strings of
+exactly the length earl's codec writes):
 
 - latency: ping-pong; one-way latency = round trip / 2; p50 and p99 over the samples;
-  each figure is the median of REPEATS runs that alternate earl and its peers;
+  each figure is the median of REPEATS runs; every repeat runs earl and its two peers, in an
+  order rotated from one repeat to the next so that none always runs first or last (the
+  spread over the repeats is in the results too);
 - throughput: the sender publishes as fast as it can for a fixed time; the receiver counts
   what it received and for how long (messages per second at the receiver).
 
@@ -39,17 +42,20 @@ import zenoh
 
 import earl
 from earl.model.expand import expand
+from earl.model.types import TypeReference
 from earl.runtime.builder import build_network
 from earl.runtime.engine import Destination, SubsystemEngine
 from earl.runtime.events import Recorder
+from earl.runtime.values import TypeSystem
+from earl.transport.codec import LinkCodec
 from earl.transport.zenoh_transport import ZenohTransport, default_config
 
 HERE = Path(__file__).resolve().parent
 RESULTS = HERE / "results" / "zenoh.json"
-SIZES = {"64 B": 6, "4 KiB": 454}  # doubles per message: 8 + 1 + 9*6 = 63 B, 8 + 3 + 9*454 = 4097 B
+SIZES = {"64 B": 7, "4 KiB": 511}  # doubles per message: 8 + 3 + 8*7 = 67 B, 8 + 4 + 8*511 = 4100 B
 ROUND_TRIPS = 1000
-#: each measurement is repeated, alternating earl and its peers, and the median of each figure kept
-REPEATS = 3
+#: each measurement is repeated, rotating the order of earl and its peers, and the median of each figure kept
+REPEATS = 5
 WARM_UP = 200
 THROUGHPUT_SECONDS = 1.5
 
@@ -348,6 +354,14 @@ def _figures(samples: list[float], count: float, seconds: float, sent: int) -> d
     }
 
 
+def wire_size(doubles: int) -> int:
+    """The length of a `double[doubles]` message as earl's codec writes it."""
+    types = TypeSystem(
+        expand(earl.loads(f"system size\ntype M = double[{doubles}]\nx/a {{ cs {{ period 1 ms }} }}\n"), {})
+    )
+    return len(LinkCodec(types, TypeReference("M"), "the bench").encode((0.0,) * doubles))
+
+
 def _medians(runs: list[dict[str, float]]) -> dict[str, float]:
     return {key: statistics.median(run[key] for run in runs) for key in runs[0]}
 
@@ -365,12 +379,17 @@ def main() -> int:
         (directory / "system.earl").write_text(SPEC)
         (directory / "benchcode.py").write_text(CODE)
         for label, doubles in SIZES.items():
-            size = 8 + (1 if doubles < 16 else 3) + 9 * doubles
+            size = wire_size(doubles)
             runs: dict[str, list[dict[str, float]]] = {"raw": [], "handed": [], "earl": []}
-            for _ in range(REPEATS):
-                runs["raw"].append(measure_raw(size, handover=False))
-                runs["handed"].append(measure_raw(size, handover=True))
-                runs["earl"].append(measure_earl(directory, doubles))
+            measure = {
+                "raw": lambda size=size: measure_raw(size, handover=False),
+                "handed": lambda size=size: measure_raw(size, handover=True),
+                "earl": lambda doubles=doubles: measure_earl(directory, doubles),
+            }
+            order = list(measure)
+            for repeat in range(REPEATS):
+                for name in order[repeat % 3 :] + order[: repeat % 3]:
+                    runs[name].append(measure[name]())
             raw, handed, mine = (_medians(runs[name]) for name in ("raw", "handed", "earl"))
             latency_ratio = mine["latency_p50_us"] / raw["latency_p50_us"]
             p99_ratio = mine["latency_p99_us"] / raw["latency_p99_us"]
@@ -380,6 +399,10 @@ def main() -> int:
                 "earl": mine,
                 "raw_zenoh": raw,
                 "raw_zenoh_with_handover": handed,
+                "earl_latency_p50_ratio_per_repeat": [
+                    e["latency_p50_us"] / r["latency_p50_us"] for e, r in zip(runs["earl"], runs["raw"], strict=True)
+                ],
+                "runs": runs,
                 "latency_p50_ratio": latency_ratio,
                 "latency_p99_ratio": p99_ratio,
                 "throughput_ratio": throughput_ratio,

@@ -3,6 +3,9 @@ type fingerprints, the key expressions, the deployment file (docs/distributed.md
 
 from __future__ import annotations
 
+import struct
+import threading
+import time
 from pathlib import Path
 from typing import Any
 
@@ -13,8 +16,16 @@ import earl
 from earl.model.expand import expand
 from earl.model.types import TypeReference
 from earl.runtime.values import Record, TypeSystem
-from earl.transport.codec import FingerprintMismatch, LinkCodec, MalformedMessage, describe, fingerprint
+from earl.transport.codec import (
+    REAL_ARRAY_EXT,
+    FingerprintMismatch,
+    LinkCodec,
+    MalformedMessage,
+    describe,
+    fingerprint,
+)
 from earl.transport.deployment import DeploymentError, read_deployment
+from earl.transport.inbox import Inbox
 from earl.transport.keys import alive_key, escape, link_key, unescape
 
 PINGPONG = Path(__file__).parent / "distributed_specs" / "pingpong"
@@ -160,22 +171,156 @@ def test_a_deployment_must_cover_the_agents_of_the_system(tmp_path: Path) -> Non
         deployment.group_of(["receiver/a"])
 
 
-@pytest.mark.parametrize("size", [0, 1, 6, 454])
-def test_arrays_of_doubles_are_written_exactly_as_msgpack_writes_them(size: int) -> None:
+def packed(values: Any) -> bytes:
+    """msgpack of an array of reals as earl writes it: an ext of packed little-endian float64."""
+    return bytes(msgpack.packb(msgpack.ExtType(REAL_ARRAY_EXT, struct.pack(f"<{len(values)}d", *values))))
+
+
+@pytest.mark.parametrize("size", [0, 1, 7, 511])
+def test_arrays_of_doubles_travel_as_packed_little_endian_doubles(size: int) -> None:
     types = type_system(f"system wire\ntype Joints = double[{size}]\n")
     codec = LinkCodec(types, TypeReference("Joints"), "a test")
     value = tuple(float(i) * -1.5 for i in range(size))
     payload = codec.encode(value)
-    assert payload == codec.fingerprint + msgpack.packb(value)
+    assert payload == codec.fingerprint + packed(value)
+    assert 8 * size < len(payload) - 8 <= 8 * size + 6  # 8 bytes an element and the ext's header
     decoded = codec.decode(payload)
     assert decoded == value and type(decoded) is tuple
-    # the general path reads what another msgpack writer sends: ints where doubles are declared
+    # the general path reads what another msgpack writer sends: an array, ints where doubles are declared
     assert codec.decode(codec.fingerprint + msgpack.packb(list(range(size)))) == tuple(float(i) for i in range(size))
-    if size:
+    if not size:
+        return
+    extremes = (float("inf"), float("-inf"), 1e308, -5e-324, *value[4:])
+    assert codec.decode(codec.encode(extremes[:size])) == extremes[:size]
+    bad_nan = struct.pack("<d", float("nan"))
+    negative_nan = bytes.fromhex("ffffffffffffffff")  # a NaN with the sign and every payload bit set
+    for nan in (bad_nan, negative_nan):
         with pytest.raises(MalformedMessage, match="NaN"):
-            codec.decode(codec.fingerprint + msgpack.packb([float("nan")] * size))
+            codec.decode(payload[: len(payload) - 8] + nan)
+    with pytest.raises(MalformedMessage, match="NaN"):
+        codec.decode(codec.fingerprint + msgpack.packb([float("nan")] * size))
+    with pytest.raises(MalformedMessage):
+        codec.decode(codec.fingerprint + msgpack.packb(["x"] * size))
+    header = len(payload) - 8 * size
+    malformed = [
+        payload[:-1],  # one byte short
+        payload + b"\x00",  # one byte too many
+        codec.fingerprint + packed((*value, 1.0)),  # one element too many
+        payload[: header - 1] + bytes([payload[header - 1] + 1]) + payload[header:],  # an unknown ext type
+        codec.fingerprint + msgpack.packb(msgpack.ExtType(REAL_ARRAY_EXT, b"\x00" * (8 * size - 3))),  # not 8k bytes
+    ]
+    for wrong in malformed:
         with pytest.raises(MalformedMessage):
-            codec.decode(codec.fingerprint + msgpack.packb(["x"] * size))
+            codec.decode(wrong)
+    other = LinkCodec(type_system(f"system wire\ntype Joints = double[{size + 1}]\n"), TypeReference("Joints"), "t")
+    with pytest.raises(FingerprintMismatch):
+        codec.decode(other.encode((0.5,) * (size + 1)))
+    with pytest.raises(FingerprintMismatch):
+        codec.decode(b"\x00" * 8 + payload[8:])
+
+
+EVERY_KIND = """
+system kinds
+type Matrix = double[3][2]
+struct Pose { position: double[3]  orientation: float32[4] }
+struct Sample {
+    flag: boolean  small: int8  count: uint16  big: int64  plain: int
+    ratio: float32  value: double  exact: float64
+    name: string  blob: bytes
+    pose: Pose  maybe: Pose?  joints: double[2]?  ranges: float32[]  ids: uint8[]
+    matrix: Matrix  path: Pose[]  grid: int[2][2]  names: string[]
+}
+"""
+
+
+def test_every_kind_of_data_type_round_trips_with_its_arrays_of_reals_packed() -> None:
+    types = type_system(EVERY_KIND)
+    codec = LinkCodec(types, TypeReference("Sample"), "a test")
+    pose = {"position": [1.0, 2.0, 3.0], "orientation": [0.0, 0.0, 0.0, 1.0]}
+    value = types.coerce(
+        {
+            "flag": True,
+            "small": -8,
+            "count": 65535,
+            "big": -(2**63),
+            "plain": 7,
+            "ratio": 0.5,
+            "value": -1.25,
+            "exact": 1e-300,
+            "name": "zażółć",
+            "blob": b"\x00\xff",
+            "pose": pose,
+            "maybe": None,
+            "joints": [0.1, 0.2],
+            "ranges": [],
+            "ids": [0, 255],
+            "matrix": [[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]],
+            "path": [pose, {**pose, "position": [4.0, 5.0, 6.0]}],
+            "grid": [[1, 2], [3, 4]],
+            "names": ["a", ""],
+        },
+        TypeReference("Sample"),
+    )
+    payload = codec.encode(value)
+    decoded = codec.decode(payload)
+    assert decoded == value
+    assert isinstance(decoded, Record) and isinstance(decoded.pose, Record) and decoded.maybe is None
+    assert all(isinstance(p, Record) for p in decoded.path) and type(decoded.path) is tuple
+    assert type(decoded.matrix) is tuple and all(type(row) is tuple for row in decoded.matrix)
+    # on the wire: every array of reals, however deep, is one packed ext; other arrays stay msgpack arrays
+    wire = msgpack.unpackb(payload[8:], raw=False)
+    assert wire["joints"] == msgpack.ExtType(REAL_ARRAY_EXT, struct.pack("<2d", 0.1, 0.2))
+    assert wire["ranges"] == msgpack.ExtType(REAL_ARRAY_EXT, b"")
+    assert [type(row) for row in wire["matrix"]] == [msgpack.ExtType] * 2
+    assert wire["path"][1]["position"] == msgpack.ExtType(REAL_ARRAY_EXT, struct.pack("<3d", 4.0, 5.0, 6.0))
+    assert wire["ids"] == [0, 255] and wire["grid"] == [[1, 2], [3, 4]] and wire["maybe"] is None
+    # the optional fields present, then a NaN deep inside: refused, with where it is
+    present = types.coerce({**value, "maybe": pose, "joints": None}, TypeReference("Sample"))
+    assert codec.decode(codec.encode(present)) == present
+    wire["path"][0]["position"] = msgpack.ExtType(REAL_ARRAY_EXT, struct.pack("<3d", 0.0, float("nan"), 0.0))
+    with pytest.raises(MalformedMessage, match=r"path\[0\]\.position\[1\] is NaN"):
+        codec.decode(codec.fingerprint + msgpack.packb(wire))
+    wire["path"][0]["position"] = msgpack.ExtType(REAL_ARRAY_EXT, struct.pack("<2d", 0.0, 0.0))
+    with pytest.raises(MalformedMessage, match="3 elements"):
+        codec.decode(codec.fingerprint + msgpack.packb(wire))
+    wire["path"][0]["position"] = msgpack.ExtType(9, b"\x00" * 24)
+    with pytest.raises(MalformedMessage, match="ext type 9"):
+        codec.decode(codec.fingerprint + msgpack.packb(wire))
+    wire["path"] = []
+    wire["ids"] = msgpack.ExtType(REAL_ARRAY_EXT, struct.pack("<2d", 0.5, 1.5))  # reals where uint8 are declared
+    with pytest.raises(MalformedMessage, match="ids"):
+        codec.decode(codec.fingerprint + msgpack.packb(wire))
+
+
+def test_the_inbox_wakes_its_sleeper_and_hands_over_in_arrival_order() -> None:
+    inbox = Inbox()
+    got: list[tuple[int, Any]] = []
+
+    def action(time: int, value: Any) -> None:
+        got.append((time, value))
+
+    inbox.put(action, "before")  # a signal sent before anyone sleeps is not lost
+    inbox.wait(30.0)
+    assert inbox.pending
+    inbox.drain(5)
+    assert got == [(5, "before")] and not inbox.pending
+    inbox.wait(0.01)  # nothing pending, and the drained message's signal was consumed: it just times out
+    assert not inbox.pending
+    producers = [threading.Thread(target=lambda n=n: [inbox.put(action, (n, k)) for k in range(200)]) for n in range(3)]
+    for producer in producers:
+        producer.start()
+    received: list[Any] = []
+    started = time.monotonic()
+    while len(received) < 600 and time.monotonic() - started < 60:
+        inbox.wait(30.0)
+        got.clear()
+        inbox.drain(6)
+        received.extend(value for _, value in got)
+    for producer in producers:
+        producer.join()
+    assert len(received) == 600
+    for n in range(3):  # each producer's messages arrive in its order
+        assert [k for m, k in received if m == n] == list(range(200))
 
 
 @pytest.mark.parametrize(

@@ -192,6 +192,10 @@ class Scheduler:
                 return True
             if remaining > 300_000:
                 inbox.wait((remaining - 200_000) * 1e-9)
+            else:
+                # the last stretch is polled, as a timed wait overshoots; yielding the GIL on each turn
+                # lets a Zenoh callback deliver meanwhile instead of waiting out the switch interval
+                wall.sleep(0)
 
     def _start(self, engine: SubsystemEngine, time: int) -> int | None:
         """One iteration from START; the time of the next START, or None while the engine waits."""

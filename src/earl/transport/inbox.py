@@ -22,11 +22,15 @@ Action = Callable[[int, Any], None]
 class Inbox:
     """A thread-safe hand-over queue from Zenoh callbacks to the scheduler."""
 
-    __slots__ = ("_event", "_items")
+    __slots__ = ("_items", "_signal")
 
     def __init__(self) -> None:
         self._items: deque[tuple[Action, Any]] = deque()
-        self._event = threading.Event()
+        # A bare lock as a binary semaphore, held while nothing is signalled: waking a sleeper is
+        # one release and sleeping one acquire, both in C, where threading.Event runs a Condition
+        # in Python (a waiter lock allocated per wait) on both sides of every message.
+        self._signal = threading.Lock()
+        self._signal.acquire()
 
     def put(self, action: Action, value: Any) -> None:
         """From any thread: run `action(time, value)` in the scheduler's thread at its next drain."""
@@ -35,7 +39,10 @@ class Inbox:
         items.append((action, value))
         # only a consumer that found the inbox empty can be asleep: waking it once is enough
         if idle:
-            self._event.set()
+            try:  # noqa: SIM105 (a try costs nothing when nothing is raised; contextlib.suppress costs a call)
+                self._signal.release()
+            except RuntimeError:  # signalled already by another thread
+                pass
 
     @property
     def pending(self) -> bool:
@@ -44,11 +51,11 @@ class Inbox:
     def wait(self, seconds: float) -> None:
         """Sleep at most `seconds`, less if something arrives."""
         if not self._items:
-            self._event.wait(seconds)
+            self._signal.acquire(timeout=seconds)  # taken: the signal is consumed; timed out: nothing came
 
     def drain(self, time: int) -> None:
         """In the scheduler's thread: run every action that arrived, in arrival order."""
-        self._event.clear()
+        self._signal.acquire(blocking=False)  # a signal for what is drained now must not wake the next wait
         items = self._items
         while items:
             action, value = items.popleft()
