@@ -180,7 +180,16 @@ class SubsystemEngine:
         destinations = self.destinations
         for key, value in sent.items():
             for destination in destinations.get(key, ()):
-                destination.channel.deliver(value)
+                channel = destination.channel
+                if type(channel) is Channel and channel.capacity is None:
+                    # the latest-value buffer, written out: `Channel.deliver` for the common case
+                    queue = channel.queue
+                    if queue:
+                        queue[0] = value
+                    else:
+                        queue.append(value)
+                else:
+                    channel.deliver(value)
                 if record is not None:
                     record(time, destination.link, value)
                 engine = destination.engine
@@ -237,11 +246,14 @@ class SubsystemEngine:
             if queue:
                 inputs[key] = queue.popleft()
                 new_data[key] = True
-            else:
+                # a FIFO can only have overflowed when something arrived
+                if channel.overflowed:
+                    channel.overflowed = False
+                    self.report_fault(
+                        time, "overflow", f"the FIFO of `{key}/ib` overflowed ({channel.dropped} dropped)"
+                    )
+            elif new_data[key]:
                 new_data[key] = False
-            if channel.overflowed:
-                channel.overflowed = False
-                self.report_fault(time, "overflow", f"the FIFO of `{key}/ib` overflowed ({channel.dropped} dropped)")
         if state.obligatory or self._timeouts_set:
             flags = self.timed_out
             obligatory = state.obligatory
