@@ -57,7 +57,11 @@ ROUND_TRIPS = 1000
 #: each measurement is repeated, rotating the order of earl and its peers, and the median of each figure kept
 REPEATS = 5
 WARM_UP = 200
+#: round trips of one peer in a row before the next peer's: short enough to share the machine's moods
+BLOCK = 50
 THROUGHPUT_SECONDS = 1.5
+#: the first element of the message that ends an earl echo (-1.0 and -2.0 mark the throughput phase)
+QUIT = -3.0
 
 SPEC = """\
 system bench
@@ -160,6 +164,8 @@ def earl_echo(directory: Path, doubles: int, listen: str, connect: str) -> None:
             try:
                 value = end.receive(10.0)
             except TimeoutError:
+                return
+            if value and value[0] == QUIT:
                 return
             if value and value[0] < 0:  # the throughput phase: count, do not answer
                 _count_throughput(end, value)
@@ -283,22 +289,24 @@ def percentile(samples: list[float], fraction: float) -> float:
     return ordered[min(len(ordered) - 1, int(fraction * len(ordered)))]
 
 
-def measure_earl(directory: Path, doubles: int) -> dict[str, float]:
-    mine, theirs = free_ports(2)
-    listen, connect = f"tcp/127.0.0.1:{mine}", f"tcp/127.0.0.1:{theirs}"
-    echo = child(["earl-echo", str(directory), str(doubles), connect, listen])
-    end = EarlEnd(directory, "ping/a", doubles, listen, connect)
-    try:
-        end.transport.wait_for_peers(10)
-        time.sleep(0.5)
-        value = tuple(float(i) for i in range(doubles))
-        samples = []
-        for round_trip in range(WARM_UP + ROUND_TRIPS):
-            started = time.perf_counter()
-            end.sink.deliver(value)
-            end.receive(5.0)
-            if round_trip >= WARM_UP:
-                samples.append((time.perf_counter() - started) / 2)
+class EarlPeer:
+    """earl's link, both ways: this process's ping/a and an echo/a child."""
+
+    def __init__(self, directory: Path, doubles: int) -> None:
+        mine, theirs = free_ports(2)
+        listen, connect = f"tcp/127.0.0.1:{mine}", f"tcp/127.0.0.1:{theirs}"
+        self.echo = child(["earl-echo", str(directory), str(doubles), connect, listen])
+        self.end = EarlEnd(directory, "ping/a", doubles, listen, connect)
+        self.end.transport.wait_for_peers(10)
+        self.value = tuple(float(i) for i in range(doubles))
+
+    def round_trip(self) -> None:
+        self.end.sink.deliver(self.value)
+        self.end.receive(5.0)
+
+    def throughput(self) -> tuple[float, float, int]:
+        """(messages the echo counted, over how many seconds, messages sent)."""
+        end, value = self.end, self.value
         marker = (-1.0, *value[1:])
         stop_at = time.perf_counter() + THROUGHPUT_SECONDS
         sent = 0
@@ -307,29 +315,32 @@ def measure_earl(directory: Path, doubles: int) -> dict[str, float]:
             sent += 1
         end.sink.deliver((-2.0, *value[1:]))
         report = end.receive(15.0)
-        count, seconds = report[0], report[1]
-        return _figures(samples, count, seconds, sent)
-    finally:
-        end.close()
-        echo.wait(20)
+        return report[0], report[1], sent
+
+    def close(self) -> None:
+        self.end.sink.deliver((QUIT, *self.value[1:]))
+        self.echo.wait(20)
+        self.end.close()
 
 
-def measure_raw(size: int, handover: bool) -> dict[str, float]:
-    mine, theirs = free_ports(2)
-    listen, connect = f"tcp/127.0.0.1:{mine}", f"tcp/127.0.0.1:{theirs}"
-    echo = child(["raw-echo", str(size), connect, listen, "handover" if handover else "callback"])
-    end = RawEnd(listen, connect, "raw/back", "raw/out")
-    try:
-        time.sleep(1.0)
-        payload = bytes(size)
-        samples = []
-        for round_trip in range(WARM_UP + ROUND_TRIPS):
-            started = time.perf_counter()
-            end.publisher.put(payload)
-            end.receive(5.0)
-            if round_trip >= WARM_UP:
-                samples.append((time.perf_counter() - started) / 2)
-        marker = b"T" + bytes(size - 1)
+class RawPeer:
+    """Raw Zenoh pub/sub of byte strings as long as earl's messages, to an echo child."""
+
+    def __init__(self, size: int, handover: bool) -> None:
+        mine, theirs = free_ports(2)
+        listen, connect = f"tcp/127.0.0.1:{mine}", f"tcp/127.0.0.1:{theirs}"
+        self.echo = child(["raw-echo", str(size), connect, listen, "handover" if handover else "callback"])
+        self.end = RawEnd(listen, connect, "raw/back", "raw/out")
+        self.size = size
+        self.payload = bytes(size)
+
+    def round_trip(self) -> None:
+        self.end.publisher.put(self.payload)
+        self.end.receive(5.0)
+
+    def throughput(self) -> tuple[float, float, int]:
+        end = self.end
+        marker = b"T" + bytes(self.size - 1)
         stop_at = time.perf_counter() + THROUGHPUT_SECONDS
         sent = 0
         while time.perf_counter() < stop_at:
@@ -338,11 +349,34 @@ def measure_raw(size: int, handover: bool) -> dict[str, float]:
         time.sleep(0.3)
         end.publisher.put(b"E")
         report = json.loads(end.receive(15.0)[1:])
-        end.publisher.put(b"Q")
-        return _figures(samples, report["count"], report["seconds"], sent)
-    finally:
-        end.session.close()  # type: ignore[no-untyped-call]
-        echo.wait(20)
+        return report["count"], report["seconds"], sent
+
+    def close(self) -> None:
+        self.end.publisher.put(b"Q")
+        self.end.session.close()  # type: ignore[no-untyped-call]
+        self.echo.wait(20)
+
+
+Peer = EarlPeer | RawPeer
+
+
+def measure_together(peers: dict[str, Peer], order: list[str]) -> dict[str, dict[str, float]]:
+    """One repeat: the peers' round trips interleaved in blocks, so that all of them meet the same
+    moments of a noisy machine; then each one's throughput, in `order`."""
+    time.sleep(0.5)  # the links settle
+    for name in order:
+        for _ in range(WARM_UP):
+            peers[name].round_trip()
+    samples: dict[str, list[float]] = {name: [] for name in peers}
+    clock = time.perf_counter
+    for block in range(ROUND_TRIPS // BLOCK):
+        for name in order[block % len(order) :] + order[: block % len(order)]:
+            round_trip, taken = peers[name].round_trip, samples[name]
+            for _ in range(BLOCK):
+                started = clock()
+                round_trip()
+                taken.append((clock() - started) / 2)
+    return {name: _figures(samples[name], *peers[name].throughput()) for name in order}
 
 
 def _figures(samples: list[float], count: float, seconds: float, sent: int) -> dict[str, float]:
@@ -381,15 +415,20 @@ def main() -> int:
         for label, doubles in SIZES.items():
             size = wire_size(doubles)
             runs: dict[str, list[dict[str, float]]] = {"raw": [], "handed": [], "earl": []}
-            measure = {
-                "raw": lambda size=size: measure_raw(size, handover=False),
-                "handed": lambda size=size: measure_raw(size, handover=True),
-                "earl": lambda doubles=doubles: measure_earl(directory, doubles),
-            }
-            order = list(measure)
+            names = list(runs)
             for repeat in range(REPEATS):
-                for name in order[repeat % 3 :] + order[: repeat % 3]:
-                    runs[name].append(measure[name]())
+                order = names[repeat % 3 :] + names[: repeat % 3]
+                peers: dict[str, Peer] = {}
+                try:
+                    for name in order:
+                        peers[name] = (
+                            EarlPeer(directory, doubles) if name == "earl" else RawPeer(size, handover=name == "handed")
+                        )
+                    for name, figures in measure_together(peers, order).items():
+                        runs[name].append(figures)
+                finally:
+                    for peer in peers.values():
+                        peer.close()
             raw, handed, mine = (_medians(runs[name]) for name in ("raw", "handed", "earl"))
             latency_ratio = mine["latency_p50_us"] / raw["latency_p50_us"]
             p99_ratio = mine["latency_p99_us"] / raw["latency_p99_us"]

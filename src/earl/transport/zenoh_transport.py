@@ -123,13 +123,16 @@ class _Input:
         self.codec = codec
         self.statistics = statistics
         self.channel = engine.channels[buffer]
+        # bound once: every message goes through these on Zenoh's thread
+        self._decode = codec.decode
+        self._hand_over = transport.inbox.put
+        self._arrive = self.arrive
 
     # ---------------------------------------------------------------- on Zenoh's thread
     def on_sample(self, sample: zenoh.Sample) -> None:
         """Never raises: a bad message is counted (and the first one of each kind reported)."""
         try:
-            payload = sample.payload.to_bytes()
-            value = self.codec.decode(payload)
+            value = self._decode(sample.payload.to_bytes())
         except FingerprintMismatch as mismatch:
             self.statistics.refused += 1
             if self.statistics.refused == 1:
@@ -142,7 +145,7 @@ class _Input:
             self._malformed(f"{type(error).__name__}: {error}")
             return
         self.statistics.messages += 1
-        self.transport.inbox.put(self.arrive, value)
+        self._hand_over(self._arrive, value)  # last: the scheduler wakes as this thread lets go of the GIL
 
     def _malformed(self, why: str) -> None:
         self.statistics.malformed += 1
