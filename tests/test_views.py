@@ -166,3 +166,94 @@ def test_a_struct_field_reads_as_an_attribute_and_a_field_named_like_a_dict_meth
     assert reading.replace(motorPos=1.0).motorPos == 1.0
     default = types.default(TypeReference("Reading"))
     assert default.motorPos == 0.0 and type(default) is type(reading)
+
+
+SHARED_NAMES_SPEC = """\
+system shared
+
+twin/a {
+    cs {
+        period 1 ms
+
+        level/ib: double
+        level/ob: double
+        level/m: double = 1.0
+        seen/m: double = 0.0
+
+        false/pp = false
+
+        both/pf(level/ib, level/mi -> level/mo, level/ob, seen/mo) = python "sharing:both"
+
+        run/bb {
+            tf = {both/pf}
+            tc = false/pp
+        }
+
+        fsm {
+            initial run
+            state run: run/bb
+        }
+    }
+
+    echo/ve {
+        period 1 ms
+
+        level/ib: double
+        level/ob: double
+
+        false/pp = false
+
+        copy/pf(level/ib -> level/ob) = python "sharing:copy"
+
+        run/bb {
+            tf = {copy/pf}
+            tc = false/pp
+        }
+
+        fsm {
+            initial run
+            state run: run/bb
+        }
+    }
+
+    link cs,echo: cs.level -> echo/ve.level
+    link echo,cs: echo/ve.level -> cs.level
+}
+
+r/r {
+    twin/a
+}
+"""
+
+SHARED_NAMES_CODE = """\
+def both(inputs, outputs, context):
+    # an input buffer, a memory and an output buffer all named `level`: the attribute is the first
+    # declared of each direction, the others are reached by their full names
+    outputs.level = inputs["level/mi"] + 1.0
+    outputs["level/ob"] = inputs["level/mi"] * 10.0
+    outputs.seen = inputs["level/ib"]
+
+
+def copy(inputs, outputs, context):
+    outputs.level = inputs.level
+"""
+
+
+def test_a_memory_and_an_output_buffer_of_one_name_are_written_by_attribute_and_by_full_name(
+    tmp_path: Path,
+) -> None:
+    (tmp_path / "system.earl").write_text(SHARED_NAMES_SPEC)
+    (tmp_path / "sharing.py").write_text(SHARED_NAMES_CODE)
+    # a ve without its re breaks a rule of the manual, not of the runtime: the checker is not the subject here
+    sim = earl.simulate(earl.load(tmp_path / "system.earl"), check=False)
+    try:
+        sim.advance_to(0.0035)
+        assert sim.faults == []
+        cs = sim.state_of("twin/a.cs")
+        # iterations at 0, 1, 2 and 3 ms: memory 1 -> 2 -> 3 -> 4 -> 5; each sends ten times what it read
+        assert cs.memory["level"] == 5.0
+        # cs's 10 (0 ms) is relayed by the echo at 1 ms, received by cs after its 2 ms iteration, read at 3 ms
+        assert cs.memory["seen"] == 10.0
+        assert sim.state_of("twin/a.echo/ve").inputs["level"] == 40.0
+    finally:
+        sim.close()
