@@ -64,6 +64,7 @@ class RobotModel:
         self._configured: tuple[float, ...] | None = None
         self._dynamics = False
         self._bias = np.zeros(self.model.nv)
+        self._identity = np.eye(n)
 
     def _joint(self, k: int) -> int:
         return int(mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_JOINT, arm.joint_name(k)))
@@ -160,12 +161,12 @@ class RobotModel:
             if float(error @ error) < 1e-14:
                 break
             jac = self.jacobian(q) * _WEIGHTS[:, None]
-            step = np.linalg.solve(jac.T @ jac + damping**2 * np.eye(self.n), jac.T @ error)
+            step = _solve_positive_definite(jac.T @ jac + damping**2 * self._identity, jac.T @ error)
             if self.n > 6:
                 # a redundant arm: in the Jacobian's null space, turn the roll joints back towards zero
                 null_space = np.eye(self.n) - np.linalg.pinv(jac, rcond=1e-3) @ jac
                 step += null_space @ (POSTURE_GAIN * self.roll_joints * (self.posture - q))
-            largest = float(np.max(np.abs(step)))
+            largest = float(np.abs(step).max())
             if largest > max_step:
                 step *= max_step / largest
             q = np.minimum(np.maximum(q + step, self.lower), self.upper)  # np.clip, without its overhead
@@ -212,3 +213,16 @@ def tool_down_orientation(yaw: float) -> Vector:
     half = yaw / 2.0
     # Rz(yaw) = (cos h, 0, 0, sin h); Ry(π) = (0, 0, 1, 0); their product:
     return np.array([0.0, -math.sin(half), math.cos(half), 0.0])
+
+
+def _solve_positive_definite(matrix: Vector, vector: Vector) -> Vector:
+    """x with matrix·x = vector, for a symmetric positive definite matrix (JᵀWJ + λ²I is one).
+
+    MuJoCo's own Cholesky factorisation: on a 6 × 6 system it takes a tenth of
+    np.linalg.solve's time, most of which is argument handling.
+    """
+    factor = np.array(matrix, dtype=float, order="C")  # a copy: it is factorised in place
+    mujoco.mju_cholFactor(factor, 0.0)
+    solution = np.empty(len(vector))
+    mujoco.mju_cholSolve(solution, factor, np.ascontiguousarray(vector, dtype=float))
+    return solution

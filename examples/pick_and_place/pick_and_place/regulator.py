@@ -75,25 +75,49 @@ def regulate(
     period: float,
     limit: Vector,
 ) -> Vector:
-    """The winding currents for one iteration; updates `state`."""
-    error = desired - measured  # Eq. (3)
+    """The winding currents for one iteration; updates `state`.
+
+    Written joint by joint over Python floats, as the manual writes it: on six joints that
+    takes a third of the time of the same arithmetic as NumPy array operations, each of
+    which costs more to dispatch than to compute.
+    """
+    motor = measured.tolist()
     if state.previous is None or state.velocity.shape != measured.shape:
-        state.velocity = np.zeros_like(measured)
+        velocity = [0.0] * len(motor)
     else:
-        raw = (measured - state.previous) / period
         alpha = period / (period + VELOCITY_FILTER)
-        state.velocity = state.velocity + alpha * (raw - state.velocity)
+        velocity = [
+            v + alpha * ((m - p) / period - v)  # low-passed finite difference of the encoder
+            for v, m, p in zip(state.velocity.tolist(), motor, state.previous.tolist(), strict=True)
+        ]
+    integrals: list[float] = []
+    currents: list[float] = []
+    for kp, ki, kd, target, target_velocity, position, speed, integral, forward, most in zip(
+        gains.proportional.tolist(),
+        gains.integral.tolist(),
+        gains.derivative.tolist(),
+        desired.tolist(),
+        desired_velocity.tolist(),
+        motor,
+        velocity,
+        state.integral.tolist(),
+        feedforward.tolist(),
+        limit.tolist(),
+        strict=True,
+    ):
+        error = target - position  # Eq. (3)
+        grown = integral + error * period
+        current = kp * error + ki * grown + kd * (target_velocity - speed) + forward  # Eq. (2) and the two additions
+        # anti-windup: the integral stays put while the current is saturated in the direction the error pushes
+        winding_up = abs(current) > most and _sign(current) == _sign(error)
+        integrals.append(integral if winding_up else grown)
+        currents.append(min(max(current, -most), most))
+    state.velocity = np.array(velocity)
     state.previous = measured.copy()
-    integral = state.integral + error * period
-    current = (
-        gains.proportional * error  # Eq. (2), the proportional term
-        + gains.integral * integral  # Eq. (2), the integral term
-        + gains.derivative * (desired_velocity - state.velocity)
-        + feedforward
-    )
-    saturated = np.abs(current) > limit
-    winding_up = saturated & (np.sign(current) == np.sign(error))
-    state.integral = np.where(winding_up, state.integral, integral)
-    # np.minimum/np.maximum rather than np.clip, whose argument handling costs more than the clip on six joints
-    clipped: Vector = np.minimum(np.maximum(current, -limit), limit)
-    return clipped
+    state.integral = np.array(integrals)
+    return np.array(currents)
+
+
+def _sign(value: float) -> int:
+    """np.sign for one float: -1, 0 or 1."""
+    return (value > 0.0) - (value < 0.0)
