@@ -100,7 +100,8 @@ class RobotModel:
     def _configure(self, q: Vector, qd: Vector | None = None) -> None:
         """Positions (and, given velocities, everything dynamics needs) for the joints at `q`."""
         dynamics = qd is not None
-        key = (*q, *qd) if qd is not None else tuple(q)
+        # Python floats (tolist), not NumPy scalars: building and comparing the key is then cheap
+        key = tuple(q.tolist() + qd.tolist()) if qd is not None else tuple(q.tolist())
         if key == self._configured and (self._dynamics or not dynamics):
             return
         m, d = self.model, self.data
