@@ -30,6 +30,8 @@ Vector = NDArray[np.float64]
 ORIENTATION_WEIGHT = 0.2
 #: how fast a redundant arm's null-space motion returns the posture (fraction per IK step)
 POSTURE_GAIN = 0.05
+#: multiplies a unit quaternion (w, x, y, z) into its conjugate, the inverse rotation
+_CONJUGATE = np.array([1.0, -1.0, -1.0, -1.0])
 _WEIGHTS = np.array([1.0, 1.0, 1.0, ORIENTATION_WEIGHT, ORIENTATION_WEIGHT, ORIENTATION_WEIGHT])
 
 
@@ -130,16 +132,16 @@ class RobotModel:
     def jacobian(self, q: Vector) -> Vector:
         """6 × N: the grasp point's linear and angular velocity per motor joint velocity."""
         self._configure(np.asarray(q, dtype=float))
-        jacp = np.zeros((3, self.model.nv))
-        jacr = np.zeros((3, self.model.nv))
-        mujoco.mj_jacSite(self.model, self.data, jacp, jacr, self.site)
-        result: Vector = np.vstack([jacp, jacr]) @ self.coupling
+        # MuJoCo writes the linear rows and the angular rows straight into one 6 × nv array
+        full = np.empty((6, self.model.nv))
+        mujoco.mj_jacSite(self.model, self.data, full[:3], full[3:], self.site)
+        result: Vector = full @ self.coupling
         return result
 
     def pose_error(self, target: Pose, q: Vector) -> Vector:
         """[position error; rotation vector taking the current orientation to the target], world frame."""
         current = self.forward(q)
-        conjugate = current.orientation * np.array([1.0, -1.0, -1.0, -1.0])
+        conjugate = current.orientation * _CONJUGATE
         difference = np.empty(4)
         mujoco.mju_mulQuat(difference, target.orientation, conjugate)
         rotation = np.empty(3)

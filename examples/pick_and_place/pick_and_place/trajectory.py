@@ -105,9 +105,13 @@ class CartesianTrajectory:
         return position, slerp(self.start_orientation, self.goal_orientation, s)
 
 
+#: multiplies a unit quaternion (w, x, y, z) into its conjugate, the inverse rotation
+_CONJUGATE = np.array([1.0, -1.0, -1.0, -1.0])
+
+
 def slerp(q0: Vector, q1: Vector, s: float) -> Vector:
     """The rotation a fraction `s` of the way from q0 to q1, at constant angular speed."""
-    conjugate = q0 * np.array([1.0, -1.0, -1.0, -1.0])
+    conjugate = q0 * _CONJUGATE
     difference = np.empty(4)
     mujoco.mju_mulQuat(difference, q1, conjugate)
     rotation = np.empty(3)
