@@ -232,3 +232,60 @@ def test_the_real_time_scheduler_paces_by_the_wall_clock_and_measures_lateness()
     assert len(lateness.samples) == 6  # 0, 10, …, 50 ms
     assert all(sample >= 0 for sample in lateness.samples)
     assert [(t, b) for t, s, _, b in events.states if s == "counter/a.cs"] == [(0, "counting"), (20 * MS, "finished")]
+
+
+LONE_WAITER = """\
+system lone
+
+waiter/a {
+    cs {
+        period 1 ms
+
+        ping/ib: int
+
+        misses/m: int = 0
+
+        missed/pp = timeout(ping/ib)
+        false/pp = false
+
+        count/pf(misses/mi -> misses/mo) = python "waiting:count"
+
+        wait/bb {
+            tf = {count/pf}
+            tc = missed/pp
+        }
+
+        fsm {
+            initial wait
+            state wait: wait/bb { obligatory ping/ib  timeout 3 ms }
+
+            wait -> wait when missed/pp
+        }
+    }
+}
+
+r/r {
+    waiter/a
+}
+"""
+
+
+def test_a_lone_subsystem_that_waits_for_a_buffer_times_out_on_time(tmp_path: Path) -> None:
+    # One engine alone runs in the scheduler's tight loop (`_run_alone`); a wait must leave it
+    # for the timeout event exactly as the general loop does: start, wait 3 ms, start again.
+    (tmp_path / "system.earl").write_text(LONE_WAITER)
+    (tmp_path / "waiting.py").write_text(
+        "def count(inputs, outputs, context):\n    outputs.misses = inputs.misses + 1\n"
+    )
+    events = Events()
+    # nothing sends `ping`: a rule of the manual the checker enforces, not the subject here
+    sim = earl.simulate(earl.load(tmp_path / "system.earl"), recorders=[events], check=False)
+    try:
+        sim.advance_to(0.0100)
+        waiter = sim.state_of("waiter/a.cs")
+        # iterations start at 0, 3, 6 and 9 ms; each waits 3 ms and times out
+        assert waiter.memory["misses"] == 4
+        assert [t for t, _, _, _ in events.states][1:] == [3 * MS, 6 * MS, 9 * MS]
+        assert waiter.timed_out == {"ping": True}
+    finally:
+        sim.close()
