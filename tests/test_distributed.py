@@ -207,8 +207,8 @@ def test_a_killed_sender_leaves_its_receiver_holding_and_a_restarted_one_resumes
     stale = [t for topic, t, data in events if topic == "/earl/faults" and data["kind"] == "stale"]
     assert len(stale) >= 1
     changes = [(t, data["to"]) for topic, t, data in events if topic == "receiver/a.cs/fsm"]
-    # stale input: timeout(ping/ib) holds, the receiver holds; the pings of the restarted sender bring it back
-    assert any(t >= stale[0] and state == "holding" for t, state in changes), changes
+    # stale input: stale(ping/ib) holds, the receiver waits in `gone`; the restarted sender's pings bring it back
+    assert any(t >= stale[0] and state == "gone" for t, state in changes), changes
     back = [t for t, state in changes if state == "listen" and t > stale[0]]
     assert back, changes
     assert received(second.output, "receiver,sender") > 50, second.output

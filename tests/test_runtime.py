@@ -289,3 +289,27 @@ def test_a_lone_subsystem_that_waits_for_a_buffer_times_out_on_time(tmp_path: Pa
         assert waiter.timed_out == {"ping": True}
     finally:
         sim.close()
+
+
+def test_stale_reads_the_set_of_buffers_whose_remote_sender_is_gone(tmp_path: Path) -> None:
+    # The transport marks a buffer stale by adding it to the engine's `stale` set (in place); the
+    # compiled predicates read that very set. In one process nothing is ever stale.
+    spec = LONE_WAITER.replace("missed/pp = timeout(ping/ib)", "missed/pp = stale(ping/ib)").replace(
+        "state wait: wait/bb { obligatory ping/ib  timeout 3 ms }", "state wait: wait/bb"
+    )
+    (tmp_path / "system.earl").write_text(spec)
+    (tmp_path / "waiting.py").write_text(
+        "def count(inputs, outputs, context):\n    outputs.misses = inputs.misses + 1\n"
+    )
+    events = Events()
+    sim = earl.simulate(earl.load(tmp_path / "system.earl"), recorders=[events], check=False)
+    try:
+        sim.advance_to(0.0025)
+        assert [b for _, _, _, b in events.states] == ["wait"]  # never stale: no transition
+        engine = sim.network.by_name["waiter/a.cs"]
+        engine.stale.add("ping")
+        sim.advance_to(0.0035)
+        assert [(t, b) for t, _, _, b in events.states][1:] == [(3 * MS, "wait")]
+        assert sim.state_of("waiter/a.cs").timed_out == {"ping": True}  # a stale buffer also times out
+    finally:
+        sim.close()

@@ -616,6 +616,15 @@ NAMES = [
         hint="did you mean `newData`?",
     ),
     Malformed(
+        "stale_of_a_memory",
+        _in_cs("        m/m: int = 0\n        p/pp = stale(m/mi)\n"),
+        10,
+        22,
+        "EARL-R042",
+        "`stale(…)` applies to an Input Buffer, e.g. `stale(manipulatorCommand/ib)`",
+        hint=None,
+    ),
+    Malformed(
         "link_unknown_buffer",
         "system s\n\nr/r {\n    a/a\n}\n\na/a {\n    cs {\n        out/ob: double\n    }\n    d/ve {\n        in/ib: double\n    }\n    link cs,d: cs.out -> d/ve.inn\n}\n",
         14,

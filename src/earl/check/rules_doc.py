@@ -45,7 +45,7 @@ ENFORCED_BY_THE_LANGUAGE: tuple[tuple[str, str], ...] = (
         "a Partial Transition Function reads `ib`/`mi` and writes `mo`/`ob` (Figure 6)",
         "EARL-R021 for a read of `/ob` or `/mo`, or a write of `/ib` or `/mi`",
     ),
-    ("`newData` applies only to Input Buffers (Table 4)", "EARL-R042"),
+    ("`newData` (and `timeout`, `stale`) applies only to Input Buffers (Table 4)", "EARL-R042"),
     (
         "kind suffixes match the element (§3: `manip/a`, `jointMove/bb`)",
         "the grammar: every declaration and reference carries its kind; a suffix that names no kind allowed "

@@ -147,8 +147,8 @@ class ExpressionWriter:
     def _call(self, call: Call) -> str:
         arguments = []
         for argument in call.arguments:
-            if call.function == "timeout" and isinstance(argument, Read) and not argument.path:
-                # timeout() is about the buffer itself, not its message.
+            if call.function in ("timeout", "stale") and isinstance(argument, Read) and not argument.path:
+                # timeout() and stale() are about the buffer itself, not its message.
                 arguments.append(self.resolve(argument.target))
             else:
                 arguments.append(self.text(argument))

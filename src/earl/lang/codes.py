@@ -61,7 +61,7 @@ READING_CODES: dict[str, str] = {
     "EARL-R032": "a transition naming an undeclared state",
     "EARL-R040": "an unknown function",
     "EARL-R041": "a function called with the wrong number of arguments",
-    "EARL-R042": "`newData`/`timeout` applied to something other than an Input Buffer",
+    "EARL-R042": "`newData`/`timeout`/`stale` applied to something other than an Input Buffer",
     "EARL-R043": "a field read from a primitive predicate",
     "EARL-R044": "a field read from something that is not a struct",
     "EARL-R045": "a field the struct does not have",

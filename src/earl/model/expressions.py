@@ -104,7 +104,7 @@ class Read:
 @quick_init
 @dataclass(frozen=True, slots=True)
 class Call:
-    """A built-in function: `newData(manipulatorCommand/ib.jointPosSetpoint)`, `timeout(x/ib)`."""
+    """A built-in function: `newData(manipulatorCommand/ib.jointPosSetpoint)`, `timeout(x/ib)`, `stale(x/ib)`."""
 
     function: str
     arguments: tuple[Expression, ...]
@@ -176,6 +176,8 @@ BUILTIN_FUNCTIONS: dict[str, int] = {
     "newData": 1,
     # true when an obligatory input buffer was not filled before its timeout
     "timeout": 1,
+    # true while the agent that feeds the input buffer from another process is gone (docs/distributed.md)
+    "stale": 1,
 }
 
 #: The call that stands for a primitive predicate computed by Python code (see PrimitivePredicate).

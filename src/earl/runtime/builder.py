@@ -193,7 +193,9 @@ def _engine(
             engine.memory[key] = types.constant(memory.initial_value, memory.data_type, f"the initial value of {key}/m")
     for predicate in subsystem.primitive_predicates:
         if predicate.implementation is None:  # Python ones are bound with the functions
-            engine.predicates[predicate.name] = compile_predicate(predicate.expression, f"{name} {predicate.name}/pp")
+            engine.predicates[predicate.name] = compile_predicate(
+                predicate.expression, f"{name} {predicate.name}/pp", engine.stale
+            )
     return engine
 
 
@@ -256,12 +258,16 @@ def _behaviour(
         error_condition = (
             None
             if behaviour.error_condition is None
-            else compile_predicate(behaviour.error_condition.expression, f"{engine.name} {behaviour.name}/bb ec")
+            else compile_predicate(
+                behaviour.error_condition.expression, f"{engine.name} {behaviour.name}/bb ec", engine.stale
+            )
         )
         behaviours[behaviour.name] = BehaviourRuntime(
             behaviour.name,
             stages,
-            compile_predicate(behaviour.terminal_condition.expression, f"{engine.name} {behaviour.name}/bb tc"),
+            compile_predicate(
+                behaviour.terminal_condition.expression, f"{engine.name} {behaviour.name}/bb tc", engine.stale
+            ),
             error_condition,
             never_ends=error_condition is None and _constant_false(behaviour.terminal_condition.expression, subsystem),
         )
@@ -308,6 +314,7 @@ def _behaviour(
                     compile_predicate(
                         transition.condition.expression,
                         f"{engine.name} {transition.source},{transition.destination}/t",
+                        engine.stale,
                     ),
                 )
                 for _, transition in leaving

@@ -128,7 +128,8 @@ class SubsystemEngine:
         self._error_in_iteration = False
         self._stuck = False
         self._timeouts_set = False
-        #: input buffers whose remote sender is gone (docs/distributed.md): `timeout(x/ib)` reads true
+        #: input buffers whose remote sender is gone (docs/distributed.md): `stale(x/ib)` and
+        #: `timeout(x/ib)` read true; changed in place only (predicates hold this very set)
         self.stale: set[str] = set()
         #: set by the scheduler: called when a message reaches an obligatory buffer this engine waits for
         self.on_delivery: Callable[[SubsystemEngine], None] | None = None
@@ -263,7 +264,7 @@ class SubsystemEngine:
                 any_set = any_set or flag
             self._timeouts_set = any_set
         if self.stale:
-            # a stale buffer reads as timed out until its sender returns (the language has no stale() yet)
+            # a stale buffer also reads as timed out until its sender returns; `stale(x/ib)` tells it apart
             for key in self.stale:
                 self.timed_out[key] = True
             self._timeouts_set = True

@@ -8,13 +8,15 @@ expression's own operators can run.
 
 A compiled predicate is called as `predicate(inputs, new_data, timed_out, memory, predicates)`:
 the subsystem's dictionaries of input-buffer values, newData flags, timeout flags,
-memory values, and its compiled primitive predicates by name.
+memory values, and its compiled primitive predicates by name. `stale(x/ib)` reads the
+subsystem's set of stale input buffers, given when the predicate is compiled.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
+from collections.abc import Set as AbstractSet
 from typing import Any
 
 from earl.model.expressions import (
@@ -47,11 +49,17 @@ class PredicateCompileError(ValueError):
     """The expression cannot be run (it was not expanded, or names something the runtime lacks)."""
 
 
-def compile_predicate(expression: Expression, description: str) -> CompiledPredicate:
-    """A function computing `expression`; `description` names it in tracebacks (`manip/a.cs emergencyStop/pp`)."""
+def compile_predicate(
+    expression: Expression, description: str, stale: AbstractSet[str] = frozenset()
+) -> CompiledPredicate:
+    """A function computing `expression`; `description` names it in tracebacks (`manip/a.cs emergencyStop/pp`).
+
+    `stale` is the subsystem's set of input buffers whose remote sender is gone, which
+    `stale(x/ib)` reads; the transport changes the set in place while the run goes on.
+    """
     source = f"lambda {_ARGUMENTS}: {_source(expression)}"
     code = compile(source, f"<earl predicate {description}>", "eval")
-    function: CompiledPredicate = eval(code, {"__builtins__": {}})
+    function: CompiledPredicate = eval(code, {"__builtins__": {}, "stale": stale})
     return function
 
 
@@ -131,4 +139,6 @@ def _call(call: Call) -> str:
         return f"(nd[{key}] and ib[{key}]{_path(argument)} is not None)"
     if call.function == "timeout":
         return f"to[{key}]"
+    if call.function == "stale":
+        return f"({key} in stale)"
     raise PredicateCompileError(f"unknown function `{call.function}`")
