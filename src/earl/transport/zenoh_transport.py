@@ -10,8 +10,8 @@ A `ZenohTransport` serves the links of one process whose other end runs elsewher
 
 Liveliness: the process declares one token per agent it runs.  When the token of an
 agent that feeds one of our input buffers disappears, those buffers go *stale* —
-`newData()` stays false (nothing arrives) and `timeout(x/ib)` reads true — until the
-token comes back; nothing is restarted.
+`newData()` stays false (nothing arrives), `stale(x/ib)` and `timeout(x/ib)` read true —
+until the token comes back; nothing is restarted.
 """
 
 from __future__ import annotations
@@ -293,7 +293,7 @@ class ZenohTransport:
                 self.log(f"earl run: {agent} is alive: {name} {listed} receive {again}from it")
             else:
                 engine.stale.update(remote.buffer for remote in remotes)
-                message = f"{agent} disappeared: {listed} are stale (newData false, timeout true) until it returns"
+                message = f"{agent} disappeared: {listed} are stale (newData false, stale and timeout true) until it returns"
                 engine.report_fault(time, "stale", message)
                 self.log(f"earl run: {name}: {message}")
         if alive:
