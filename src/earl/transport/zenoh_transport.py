@@ -293,7 +293,9 @@ class ZenohTransport:
                 self.log(f"earl run: {agent} is alive: {name} {listed} receive {again}from it")
             else:
                 engine.stale.update(remote.buffer for remote in remotes)
-                message = f"{agent} disappeared: {listed} are stale (newData false, stale and timeout true) until it returns"
+                message = (
+                    f"{agent} disappeared: {listed} are stale (newData false, stale and timeout true) until it returns"
+                )
                 engine.report_fault(time, "stale", message)
                 self.log(f"earl run: {name}: {message}")
         if alive:
