@@ -59,8 +59,22 @@ _FAULT_SCHEMA = {
 _RUN_SCHEMA = {"type": "object", "title": "earl.Run"}
 
 
+#: one encoder for the whole run: `json.dumps` with these options would build one per message
+_ENCODER = json.JSONEncoder(separators=(",", ":"), ensure_ascii=False, allow_nan=False, check_circular=False)
+
+
 def _encode(value: Any) -> bytes:
-    return json.dumps(value, separators=(",", ":"), ensure_ascii=False, allow_nan=False).encode()
+    """A run-time value (or a dict of them) as JSON.
+
+    Run-time values are JSON as they are (tuples become arrays, Records objects), except
+    bytes and infinite floats: those two make the encoder raise, and only then is the
+    value converted by `to_json`. A message is written for every send, so the common case
+    must not walk the value in Python first.
+    """
+    try:
+        return _ENCODER.encode(value).encode()
+    except (TypeError, ValueError):
+        return _ENCODER.encode(to_json(value)).encode()
 
 
 class TraceWriter(Recorder):
@@ -148,8 +162,7 @@ class TraceWriter(Recorder):
             channel = self._link_channel(link)
         if channel is None:
             return
-        payload = to_json(value) if isinstance(value, Record) else {"value": to_json(value)}
-        self._write(channel, time, payload)
+        self._write(channel, time, value if isinstance(value, Record) else {"value": value})
 
     def _link_channel(self, link: str) -> int | None:
         topic = f"link/{link}"
@@ -179,7 +192,7 @@ class TraceWriter(Recorder):
                 {"type": "object", "title": f"{subsystem}.m", "properties": properties},
                 {"subsystem": subsystem},
             )
-        self._write(channel, time, {key: to_json(value) for key, value in memory.items()})
+        self._write(channel, time, memory)
 
     def fault(self, fault: Fault) -> None:
         channel = self._channel("/earl/faults", "earl.Fault", _FAULT_SCHEMA, {})
