@@ -205,10 +205,10 @@ class Outputs:
     `outputs.x = value` is a plain attribute store, as cheap as writing any Python object:
     the engine takes the call's attributes when the function returns
     (earl/runtime/iteration.py), refusing an undeclared name and checking each value
-    against its type. Family members
-    (`outputs.x[K] = …`) and `outputs["x/mo"] = …` are checked as they are written. The
-    checked writes are collected in `_earl_memory_written` (`/mo`) and `_earl_sent` (`/ob`);
-    the engine applies them when the stage ends and discards them when the function failed.
+    against its type. Family members (`outputs.x[K] = …`) and `outputs["x/mo"] = …` are
+    checked as they are written. The checked writes are collected in
+    `_earl_memory_written` (`/mo`) and `_earl_sent` (`/ob`); the engine applies them when
+    the stage ends and discards them when the function failed.
 
     The object's own bookkeeping lives in slots named `_earl_…`, so that no name of a spec
     (`sent`, `clear`, …) can collide with it. Each function gets its own subclass, whose
@@ -267,9 +267,9 @@ class Outputs:
         target = self._earl_targets.get(name)
         if target is None:
             self._earl_refuse(name)
-        if target.attribute is not None:  # type: ignore[union-attr]
-            self.__dict__.pop(target.attribute, None)  # type: ignore[union-attr]  # the later write wins
-        target.store[target.key] = target.coerce(value)  # type: ignore[union-attr]
+        if target.attribute is not None:
+            self.__dict__.pop(target.attribute, None)  # the later write wins
+        target.store[target.key] = target.coerce(value)
 
     def __getitem__(self, name: str) -> Any:
         """`outputs["x/mo"]`, `outputs["x"]`: what the call wrote so far, else memory's value before the stage."""
