@@ -181,16 +181,7 @@ class SubsystemEngine:
         destinations = self.destinations
         for key, value in sent.items():
             for destination in destinations.get(key, ()):
-                channel = destination.channel
-                if type(channel) is Channel and channel.capacity is None:
-                    # the latest-value buffer, written out: `Channel.deliver` for the common case
-                    queue = channel.queue
-                    if queue:
-                        queue[0] = value
-                    else:
-                        queue.append(value)
-                else:
-                    channel.deliver(value)
+                destination.channel.deliver(value)
                 if record is not None:
                     record(time, destination.link, value)
                 engine = destination.engine

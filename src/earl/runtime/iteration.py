@@ -25,7 +25,7 @@ from collections.abc import Callable, Sequence
 from typing import Any, Protocol
 
 from earl.runtime.binding import UserFunction
-from earl.runtime.values import QuickTest
+from earl.runtime.values import QUICK_TEST_NAMES, QuickTest
 from earl.runtime.views import Context, Inputs, Outputs
 
 #: `execute(time)`: runs the stages; returns what the iteration sends, by output buffer, or None
@@ -58,9 +58,9 @@ def compile_execute(
         "fault": fault,
         "Exception": Exception,
         "MISSING": _MISSING,
-        "only_floats": frozenset({float}).issuperset,
-        # builtins too, as closure variables (see below)
-        **{builtin.__name__: builtin for builtin in (type, tuple, list, float, bool, int, len, sum, map, next, iter)},
+        # what the quick tests use, and the builtins, as closure variables (see below)
+        **QUICK_TEST_NAMES,
+        **{builtin.__name__: builtin for builtin in (next, iter)},
     }
     # `sent` is made only when something is sent; a stage's own dictionary is made once and reused
     lines = ["def execute(time):", "    sent = None"]
@@ -177,22 +177,5 @@ def _store_name(store: dict[str, Any], namespace: dict[str, Any]) -> str:
 
 
 def _checked(value: str, coerce: str, quick: QuickTest | None) -> list[str]:
-    """Lines leaving `value` checked: the quick test inline, the type's full coercer only when it fails."""
-    if quick is None:
-        return [f"{value} = {coerce}({value})"]
-    if quick.kind == "real":
-        test = f"type({value}) is float and {value} == {value}"  # not NaN
-    elif quick.kind == "boolean":
-        test = f"type({value}) is bool"
-    elif quick.kind == "integer":
-        test = f"type({value}) is int and {quick.low!r} <= {value} <= {quick.high!r}"
-    else:  # real_array: a tuple of floats, checked in C; a NaN makes the sum NaN
-        size = "" if quick.size is None else f" and len({value}) == {quick.size!r}"
-        return [
-            f"if type({value}) is list:",
-            f"    {value} = tuple({value})",
-            f"if not (type({value}) is tuple{size} and only_floats(map(type, {value})) "
-            f"and (total := sum({value})) == total):",
-            f"    {value} = {coerce}({value})",
-        ]
-    return [f"if not ({test}):", f"    {value} = {coerce}({value})"]
+    """Lines leaving `value` checked: the type's quick test inline, its full coercer only when it fails."""
+    return [f"{value} = {coerce}({value})"] if quick is None else quick.lines(value, coerce)

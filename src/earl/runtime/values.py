@@ -41,17 +41,60 @@ _REAL_TYPES = ("double", "float32", "float64")
 _FLOAT_ONLY = frozenset({float})
 
 
+#: what the lines of `QuickTest.lines` use, for the namespace they are compiled in
+QUICK_TEST_NAMES: dict[str, Any] = {
+    "only_floats": _FLOAT_ONLY.issuperset,
+    **{builtin.__name__: builtin for builtin in (type, tuple, list, len, sum, map, getattr)},
+}
+
+
 @dataclass(frozen=True)
 class QuickTest:
     """A test that a written value is valid exactly as it is: a float that is not NaN, a bool, an int in
-    range, a tuple (or list) of floats of the declared size. The engine writes it inline after each
-    call (earl/runtime/iteration.py) and calls the type's full coercer only when it fails, which
-    then converts (an int to a float) or refuses with a precise message."""
+    range, a tuple of floats of the declared size (a list or a 1-D NumPy array is made one first).
+
+    One test, used in two places: `TypeSystem.coercer` compiles it into the coercer's fast
+    path, and the engine writes it inline after each call (earl/runtime/iteration.py). Both
+    call the type's full check only when it fails, which then converts (an int to a float)
+    or refuses with a precise message.
+    """
 
     kind: str  # "real" | "boolean" | "integer" | "real_array"
     low: int = 0
     high: int = 0
     size: int | None = None
+
+    def lines(self, value: str, slow: str) -> list[str]:
+        """Python lines leaving the variable `value` checked; `slow(value)` is called only when the test fails."""
+        if self.kind == "real":
+            test = f"type({value}) is float and {value} == {value}"  # not NaN
+        elif self.kind == "boolean":
+            test = f"type({value}) is bool"
+        elif self.kind == "integer":
+            test = f"type({value}) is int and {self.low!r} <= {value} <= {self.high!r}"
+        else:  # real_array: a tuple of floats, checked in C; a NaN makes the sum NaN
+            size = "" if self.size is None else f" and len({value}) == {self.size!r}"
+            return [
+                f"if type({value}) is not tuple:",
+                f"    if type({value}) is list:",
+                f"        {value} = tuple({value})",
+                f"    elif getattr({value}, 'ndim', None) == 1:",
+                f"        {value} = tuple({value}.tolist())",
+                f"if not (type({value}) is tuple{size} and only_floats(map(type, {value})) "
+                f"and (total := sum({value})) == total):",
+                f"    {value} = {slow}({value})",
+            ]
+        return [f"if not ({test}):", f"    {value} = {slow}({value})"]
+
+    def compile(self, slow: Callable[[Any], Value]) -> Callable[[Any], Value]:
+        """A coercer: the test, then `slow` for what fails it."""
+        source = "\n".join(
+            ["def check(value):", *(f"    {line}" for line in self.lines("value", "slow")), "    return value"]
+        )
+        namespace: dict[str, Any] = {**QUICK_TEST_NAMES, "slow": slow}
+        exec(source, namespace)  # generated from the test's own kind and bounds, no text of a spec
+        function: Callable[[Any], Value] = namespace["check"]
+        return function
 
 
 class Record(dict[str, Any]):
@@ -167,47 +210,14 @@ class TypeSystem:
         return self.record_class(resolved.name, [f.name for f in resolved.fields])(result)
 
     def coercer(self, data_type: DataType, where: str) -> Callable[[Any], Value]:
-        """`coerce` for one type, with a fast path for the values user code writes most (floats, ints, Booleans)."""
+        """`coerce` for one type, with the type's quick test as a fast path (floats, ints, Booleans, real arrays)."""
         resolved = self.resolve(data_type)
-        if isinstance(resolved, PrimitiveType):
-            name = resolved.name
-            if name in _REAL_TYPES:
-                return lambda value: (
-                    value if type(value) is float and value == value else _coerce_primitive(value, name, where)
-                )
-            if name == "boolean":
-                return lambda value: value if type(value) is bool else _coerce_primitive(value, name, where)
-            if name in _INTEGER_RANGES:
-                low, high = _INTEGER_RANGES[name]
-                return lambda value: (
-                    value if type(value) is int and low <= value <= high else _coerce_primitive(value, name, where)
-                )
-        if isinstance(resolved, ArrayType):
-            element = self.resolve(resolved.element)
-            size = _fixed_size(resolved)
-            if isinstance(element, PrimitiveType) and element.name in _REAL_TYPES:
-                # the common case of robot data (positions, currents): a tuple of floats, checked in one pass
-                only_floats = _FLOAT_ONLY.issuperset
-
-                def real_array(value: Any) -> Value:
-                    kind = type(value)
-                    if kind is tuple:
-                        items = value
-                    elif kind is list:
-                        items = tuple(value)
-                    elif hasattr(value, "tolist") and getattr(value, "ndim", 0) == 1:
-                        items = tuple(value.tolist())
-                    else:
-                        return self.coerce(value, data_type, where)
-                    # all floats (checked in C) and no NaN (a NaN makes the sum NaN); else the slow, precise path
-                    if (size is None or len(items) == size) and only_floats(map(type, items)):
-                        total = sum(items)
-                        if total == total:
-                            return items
-                    return self.coerce(value, data_type, where)
-
-                return real_array
-            return lambda value: self.coerce(value, data_type, where)
+        quick = self.quick_test(data_type)
+        if quick is not None:
+            if isinstance(resolved, PrimitiveType):
+                name = resolved.name
+                return quick.compile(lambda value: _coerce_primitive(value, name, where))
+            return quick.compile(lambda value: self.coerce(value, data_type, where))
         if isinstance(resolved, StructType):
             return self._struct_coercer(resolved, data_type, where)
         return lambda value: self.coerce(value, data_type, where)
