@@ -15,7 +15,7 @@ import pytest
 import earl
 from earl.model.expand import expand
 from earl.model.types import TypeReference
-from earl.runtime.values import Record, TypeSystem
+from earl.runtime.values import Reals, Record, TypeSystem
 from earl.transport.codec import (
     REAL_ARRAY_EXT,
     FingerprintMismatch,
@@ -64,7 +64,8 @@ def test_a_message_round_trips_as_records_and_tuples() -> None:
     decoded = codec.decode(codec.encode(value))
     assert decoded == value
     assert isinstance(decoded, Record) and isinstance(decoded.pose, Record)
-    assert type(decoded.joints) is tuple and type(decoded.counts) is tuple
+    # arrays of reals arrive as Reals, the tuple earl knows it checked; other arrays as tuples
+    assert type(decoded.joints) is Reals and type(decoded.counts) is tuple
     assert decoded.raw == b"\x00\xff" and decoded.label == "zażółć"
     absent = types.coerce({**value, "joints": None, "pose": None}, COMMAND)
     assert codec.decode(codec.encode(absent)).joints is None
@@ -185,7 +186,7 @@ def test_arrays_of_doubles_travel_as_packed_little_endian_doubles(size: int) -> 
     assert payload == codec.fingerprint + packed(value)
     assert 8 * size < len(payload) - 8 <= 8 * size + 6  # 8 bytes an element and the ext's header
     decoded = codec.decode(payload)
-    assert decoded == value and type(decoded) is tuple
+    assert decoded == value and type(decoded) is Reals
     # the general path reads what another msgpack writer sends: an array, ints where doubles are declared
     assert codec.decode(codec.fingerprint + msgpack.packb(list(range(size)))) == tuple(float(i) for i in range(size))
     if not size:
@@ -266,7 +267,7 @@ def test_every_kind_of_data_type_round_trips_with_its_arrays_of_reals_packed() -
     assert decoded == value
     assert isinstance(decoded, Record) and isinstance(decoded.pose, Record) and decoded.maybe is None
     assert all(isinstance(p, Record) for p in decoded.path) and type(decoded.path) is tuple
-    assert type(decoded.matrix) is tuple and all(type(row) is tuple for row in decoded.matrix)
+    assert type(decoded.matrix) is tuple and all(type(row) is Reals for row in decoded.matrix)
     # on the wire: every array of reals, however deep, is one packed ext; other arrays stay msgpack arrays
     wire = msgpack.unpackb(payload[8:], raw=False)
     assert wire["joints"] == msgpack.ExtType(REAL_ARRAY_EXT, struct.pack("<2d", 0.1, 0.2))

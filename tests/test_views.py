@@ -11,6 +11,7 @@ from typing import Any
 import pytest
 
 import earl
+from earl.runtime.values import Reals
 
 SPEC = """\
 system views
@@ -140,11 +141,11 @@ def test_a_value_the_quick_test_rejects_gets_the_precise_message(
     assert memory["sent"] == 7 and memory["level"] == 0.5 and memory["joints"] == (0.0, 0.0, 0.0)
 
 
-def test_a_numpy_array_is_accepted_and_stored_as_a_tuple_of_floats(tmp_path: Path) -> None:
+def test_a_numpy_array_is_accepted_and_stored_as_reals(tmp_path: Path) -> None:
     sim, _ = run(tmp_path, 5)
     assert sim.faults == []
     joints = sim.state_of("viewer/a.cs").memory["joints"]
-    assert joints == (0.5, 0.25, 0.125) and type(joints) is tuple
+    assert joints == (0.5, 0.25, 0.125) and type(joints) is Reals  # a tuple of floats, checked
     assert not any(math.isnan(j) for j in joints)
 
 
@@ -257,3 +258,24 @@ def test_a_memory_and_an_output_buffer_of_one_name_are_written_by_attribute_and_
         assert sim.state_of("twin/a.echo/ve").inputs["level"] == 40.0
     finally:
         sim.close()
+
+
+def test_a_checked_array_of_reals_passes_again_at_once_but_only_at_its_size() -> None:
+    """Reals remember that earl checked them: written again they pass with one comparison, yet the
+    size is still tested, and a plain tuple, list or NumPy array is checked element by element."""
+    from earl.runtime.values import QuickTest
+
+    refused: list[Any] = []
+
+    def slow(value: Any) -> Any:
+        refused.append(value)
+        return "refused"
+
+    check = QuickTest("real_array", size=3).compile(slow)
+    checked = check((1.0, 2.0, 3.0))
+    assert type(checked) is Reals and checked == (1.0, 2.0, 3.0)
+    assert check(checked) is checked  # the same object, not tested again
+    assert type(check([1.0, 2.0, 3.0])) is Reals
+    assert check(Reals((1.0, 2.0))) == "refused"  # a checked double[2] is no double[3]
+    assert check((1.0, float("nan"), 3.0)) == "refused" and check((1, 2.0, 3.0)) == "refused"
+    assert len(refused) == 3

@@ -20,6 +20,7 @@ sleeps until each event is due on the wall clock and measures how late it starts
 from __future__ import annotations
 
 import heapq
+import threading
 import time as wall
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -43,14 +44,23 @@ class Lateness:
 class Inbox(Protocol):
     """Messages from other processes, received on another thread (docs/distributed.md, "Scheduling")."""
 
+    #: held by the thread that runs the scheduler's work; the scheduler releases it while it sleeps
+    owner: threading.Lock
+
     @property
     def pending(self) -> bool: ...
 
     def wait(self, seconds: float) -> None:
         """Sleep at most `seconds`; return early when something arrives."""
 
+    def wake(self) -> None:
+        """End a `wait` now."""
+
     def drain(self, time: int) -> None:
-        """Deliver what arrived, in this (the scheduler's) thread, at run time `time`."""
+        """Deliver what arrived, at run time `time` (the owner lock held)."""
+
+    def serve_with(self, serve: Callable[[Callable[[int, Any], None], Any], None] | None) -> None:
+        """Let the thread that receives a message run `serve(action, value)` when the owner lock is free."""
 
 
 class Scheduler:
@@ -85,6 +95,15 @@ class Scheduler:
         self.started = False
         #: messages from other processes; only real-time runs have one
         self.inbox = inbox
+        # what a message served on the receiving thread needs of the current `advance_to`
+        self._until = 0
+        self._should_stop: Callable[[], bool] | None = None
+        #: the run time the scheduler's thread sleeps until, -1 while it is awake (owner lock held)
+        self._sleeping_until = -1
+        #: whether the scheduler's thread holds the inbox's owner lock
+        self._owning = False
+        #: what went wrong while serving a message on the receiving thread, raised in the scheduler's
+        self._failure: BaseException | None = None
 
     # ------------------------------------------------------------------ start
     def start(self) -> None:
@@ -147,55 +166,123 @@ class Scheduler:
     def _advance_with_inbox(self, until: int, inbox: Inbox, should_stop: Callable[[], bool] | None) -> None:
         """Real time with messages from other processes: wait on the wall clock for the next event *or* a
         message, whichever comes first, so that a remote message wakes a subsystem waiting for it at once.
-        Unlike the local loop it waits until `until` itself, since the next event may be a message."""
+        Unlike the local loop it waits until `until` itself, since the next event may be a message.
+
+        While this thread sleeps, a message may be served on the thread that received it (`_serve`),
+        which can change the event queue: the loop therefore looks at the queue afresh after every wait."""
+        self._until, self._should_stop = until, should_stop
         queue = self._queue
         pop = heapq.heappop
-        advance = self._advance
-        tokens = self._tokens
-        while True:
-            if should_stop is not None and should_stop():
-                return
-            if inbox.pending:
-                # a message arriving now is handled at the wall-clock instant it was received
-                self.now = max(self.now, min(self.clock() - self._wall_start, until))
-                inbox.drain(self.now)
-            due = queue[0][0] if queue and queue[0][0] <= until else until
-            if not self._sleep_until(due, inbox):
-                continue  # something arrived first
-            if not queue or queue[0][0] > until:
-                break
-            time, _, _, kind, engine, token = pop(queue)
-            self.now = time
-            if advance is not None and time > self._environment_time:
-                self._environment_time = time
-                advance(time * 1e-9)
-            if kind == _START:
-                self._record_lateness(time, engine)
-                following = self._start(engine, time)
-                if following is not None:
-                    self._push(following, engine, _START)
-            elif engine.waiting and token == tokens[engine.name]:
-                self._push(self._finish(engine, time, timed_out=kind == _TIMEOUT), engine, _START)
-        self.now = max(self.now, until)
-        if advance is not None and self.now > self._environment_time:
-            self._environment_time = self.now
-            advance(self.now * 1e-9)
+        clock = self.clock
+        inbox.owner.acquire()
+        self._owning = True
+        if self._advance is None:
+            # Only a process without an environment serves messages on the receiving thread: a
+            # plant's offscreen renderer (EGL, OSMesa) works only on the thread that created it.
+            inbox.serve_with(self._serve)
+        try:
+            while True:
+                if self._failure is not None:
+                    failure, self._failure = self._failure, None
+                    raise failure
+                if should_stop is not None and should_stop():
+                    return
+                if inbox.pending:
+                    # a message arriving now is handled at the wall-clock instant it was received
+                    self.now = max(self.now, min(clock() - self._wall_start, until))
+                    inbox.drain(self.now)
+                due = queue[0][0] if queue and queue[0][0] <= until else until
+                if clock() - self._wall_start < due:
+                    self._sleep_until(due, inbox)
+                    continue
+                if not queue or queue[0][0] > until:
+                    break
+                time, _, _, kind, engine, token = pop(queue)
+                self._run_event(time, kind, engine, token)
+            self.now = max(self.now, until)
+            if self._advance is not None and self.now > self._environment_time:
+                self._environment_time = self.now
+                self._advance(self.now * 1e-9)
+        finally:
+            if self._owning:
+                self._owning = False
+                inbox.owner.release()
 
-    def _sleep_until(self, time: int, inbox: Inbox) -> bool:
-        """Wait until run time `time` on the wall clock; False as soon as a message is pending."""
+    def close(self) -> None:
+        """No message is served on a receiving thread any more (and none is being served on return)."""
+        if self.inbox is not None:
+            self.inbox.serve_with(None)
+
+    def _run_event(self, time: int, kind: int, engine: SubsystemEngine, token: int) -> None:
+        """One event of a real-time run with an inbox, on whichever thread holds the owner lock."""
+        self.now = time
+        advance = self._advance
+        if advance is not None and time > self._environment_time:
+            self._environment_time = time
+            advance(time * 1e-9)
+        if kind == _START:
+            self._record_lateness(time, engine)
+            following = self._start(engine, time)
+            if following is not None:
+                self._push(following, engine, _START)
+        elif engine.waiting and token == self._tokens[engine.name]:
+            self._push(self._finish(engine, time, timed_out=kind == _TIMEOUT), engine, _START)
+
+    def _serve(self, action: Callable[[int, Any], None], value: Any) -> None:
+        """On the thread that received a message, while the scheduler's thread sleeps (the owner lock
+        held): deliver it at the wall-clock instant of its arrival and run every event due by then —
+        typically the subsystem that waited for it, whose answer thus leaves without a thread switch."""
+        inbox = self.inbox
+        assert inbox is not None
+        try:
+            arrived = min(self.clock() - self._wall_start, self._until)
+            if arrived > self.now:
+                self.now = arrived
+            time = self.now
+            inbox.drain(time)  # what came before, first
+            action(time, value)
+            should_stop = self._should_stop
+            queue = self._queue
+            while queue and queue[0][0] <= time and (should_stop is None or not should_stop()):
+                event_time, _, _, kind, engine, token = heapq.heappop(queue)
+                self._run_event(event_time, kind, engine, token)
+            if queue and queue[0][0] < self._sleeping_until:
+                self._wake_sleeper()  # it sleeps until a later event than the one now first
+        except BaseException as failure:  # raised again in the scheduler's thread, where the run is
+            self._failure = failure
+            self._wake_sleeper()
+
+    def _wake_sleeper(self) -> None:
+        inbox = self.inbox
+        assert inbox is not None
+        self._sleeping_until = -1  # read by the sleeper: its deadline is no longer the one to keep
+        inbox.wake()
+
+    def _sleep_until(self, time: int, inbox: Inbox) -> None:
+        """Wait until run time `time` on the wall clock, or until a message is pending or served.
+
+        The owner lock is free meanwhile, so that a message can be served on its receiving thread."""
         due = self._wall_start + time
-        while True:
-            if inbox.pending:
-                return False
-            remaining = due - self.clock()
-            if remaining <= 0:
-                return True
-            if remaining > 300_000:
-                inbox.wait((remaining - 200_000) * 1e-9)
-            else:
-                # the last stretch is polled, as a timed wait overshoots; yielding the GIL on each turn
-                # lets a Zenoh callback deliver meanwhile instead of waiting out the switch interval
-                wall.sleep(0)
+        self._sleeping_until = time
+        self._owning = False
+        inbox.owner.release()
+        try:
+            while self._sleeping_until == time:
+                if inbox.pending:
+                    return
+                remaining = due - self.clock()
+                if remaining <= 0:
+                    return
+                if remaining > 300_000:
+                    inbox.wait((remaining - 200_000) * 1e-9)
+                else:
+                    # the last stretch is polled, as a timed wait overshoots; yielding the GIL on each turn
+                    # lets a Zenoh callback deliver meanwhile instead of waiting out the switch interval
+                    wall.sleep(0)
+        finally:
+            inbox.owner.acquire()
+            self._owning = True
+            self._sleeping_until = -1
 
     def _start(self, engine: SubsystemEngine, time: int) -> int | None:
         """One iteration from START; the time of the next START, or None while the engine waits."""

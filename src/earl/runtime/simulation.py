@@ -168,6 +168,7 @@ class Simulation:
         if self.closed:
             return
         self.closed = True
+        self.scheduler.close()
         self.statistics.close(self.scheduler.now)
         if self.trace is not None:
             iterations = {engine.name: engine.total_iterations for engine in self.network.engines}

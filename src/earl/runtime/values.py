@@ -41,8 +41,21 @@ _REAL_TYPES = ("double", "float32", "float64")
 _FLOAT_ONLY = frozenset({float})
 
 
+class Reals(tuple[float, ...]):
+    """A checked value of an array of reals (`double[6]`): a tuple of floats, none of them NaN.
+
+    It is a plain tuple to user code, JSON and msgpack. It only remembers that earl checked
+    it, so that the same value written again — forwarded from an input buffer to memory, or
+    from memory to an output buffer — passes its type test with one comparison, where
+    testing the elements costs about 20 ns each (11 µs for a `double[511]`).
+    """
+
+    __slots__ = ()
+
+
 #: what the lines of `QuickTest.lines` use, for the namespace they are compiled in
 QUICK_TEST_NAMES: dict[str, Any] = {
+    "Reals": Reals,
     "only_floats": _FLOAT_ONLY.issuperset,
     **{builtin.__name__: builtin for builtin in (type, tuple, list, len, sum, map, getattr)},
 }
@@ -72,17 +85,20 @@ class QuickTest:
             test = f"type({value}) is bool"
         elif self.kind == "integer":
             test = f"type({value}) is int and {self.low!r} <= {value} <= {self.high!r}"
-        else:  # real_array: a tuple of floats, checked in C; a NaN makes the sum NaN
+        else:  # real_array: Reals were checked before; a tuple is, in C (a NaN makes the sum NaN)
             size = "" if self.size is None else f" and len({value}) == {self.size!r}"
+            wrong_size = "" if self.size is None else f" or len({value}) != {self.size!r}"
             return [
-                f"if type({value}) is not tuple:",
+                f"if type({value}) is not Reals{wrong_size}:",
                 f"    if type({value}) is list:",
                 f"        {value} = tuple({value})",
                 f"    elif getattr({value}, 'ndim', None) == 1:",
                 f"        {value} = tuple({value}.tolist())",
-                f"if not (type({value}) is tuple{size} and only_floats(map(type, {value})) "
-                f"and (total := sum({value})) == total):",
-                f"    {value} = {slow}({value})",
+                f"    if type({value}) is tuple{size} and only_floats(map(type, {value})) "
+                f"and (total := sum({value})) == total:",
+                f"        {value} = Reals({value})",
+                "    else:",
+                f"        {value} = {slow}({value})",
             ]
         return [f"if not ({test}):", f"    {value} = {slow}({value})"]
 
@@ -171,6 +187,8 @@ class TypeSystem:
         elif isinstance(resolved, ArrayType):
             size = _fixed_size(resolved)
             value = () if size is None else tuple(self.default(resolved.element) for _ in range(size))
+            if self._holds_reals(resolved):
+                value = Reals(value)
         else:
             record = self.record_class(resolved.name, [f.name for f in resolved.fields])
             value = record({f.name: (None if f.optional else self.default(f.data_type)) for f in resolved.fields})
@@ -190,7 +208,8 @@ class TypeSystem:
             size = _fixed_size(resolved)
             if size is not None and len(items) != size:
                 raise ValueTypeError(f"{where} must have {size} elements ({type_text(data_type)}), not {len(items)}")
-            return tuple(self.coerce(item, resolved.element, f"{where}[{i}]") for i, item in enumerate(items))
+            items = [self.coerce(item, resolved.element, f"{where}[{i}]") for i, item in enumerate(items)]
+            return Reals(items) if self._holds_reals(resolved) else tuple(items)
         if not isinstance(value, Mapping):
             _mismatch(value, data_type, where)
         fields = {f.name: f for f in resolved.fields}
@@ -222,6 +241,10 @@ class TypeSystem:
             return self._struct_coercer(resolved, data_type, where)
         return lambda value: self.coerce(value, data_type, where)
 
+    def _holds_reals(self, array: ArrayType) -> bool:
+        element = self.resolve(array.element)
+        return isinstance(element, PrimitiveType) and element.name in _REAL_TYPES
+
     def quick_test(self, data_type: DataType) -> QuickTest | None:
         """How the values user code writes most of this type pass as they are, tested inline (see QuickTest)."""
         resolved = self.resolve(data_type)
@@ -233,10 +256,8 @@ class TypeSystem:
             if resolved.name in _INTEGER_RANGES:
                 low, high = _INTEGER_RANGES[resolved.name]
                 return QuickTest("integer", low, high)
-        if isinstance(resolved, ArrayType):
-            element = self.resolve(resolved.element)
-            if isinstance(element, PrimitiveType) and element.name in _REAL_TYPES:
-                return QuickTest("real_array", size=_fixed_size(resolved))
+        if isinstance(resolved, ArrayType) and self._holds_reals(resolved):
+            return QuickTest("real_array", size=_fixed_size(resolved))
         return None
 
     def record_class(self, struct: str, fields: Iterable[str] = ()) -> type[Record]:

@@ -7,7 +7,7 @@ from typing import Any
 
 def answer(inputs: Any, outputs: Any, context: Any) -> None:
     ping = inputs.ping
-    if type(ping.stamp) is not tuple:
+    if not isinstance(ping.stamp, tuple):
         raise TypeError(f"an array arrived as {type(ping.stamp).__name__}, not a tuple")
     outputs.received = inputs.received + 1
     outputs.lastPing = ping
