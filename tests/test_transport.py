@@ -15,6 +15,7 @@ import pytest
 import earl
 from earl.model.expand import expand
 from earl.model.types import TypeReference
+from earl.runtime.simulation import Simulation
 from earl.runtime.values import Reals, Record, TypeSystem
 from earl.transport.codec import (
     REAL_ARRAY_EXT,
@@ -442,3 +443,124 @@ def test_launch_refuses_a_deployment_it_cannot_run_before_starting_anything(
     assert main(arguments) == code
     captured = capsys.readouterr()
     assert fragment in captured.err and "started" not in captured.out
+
+
+SERVED_SPEC = """\
+system served
+waiter/a {
+    cs {
+        in/ib: double
+        seen/m: double = 0.0
+        false/pp = false
+        take/pf(in/ib -> seen/mo) = python "served:take"
+        run/bb {
+            tf = {take/pf}
+            tc = false/pp
+        }
+        fsm {
+            initial run
+            state run: run/bb { obligatory in/ib }
+        }
+    }
+}
+servedRobot/r {
+    waiter/a
+}
+"""
+
+SERVED_CODE = """\
+import threading
+
+#: (value read, the thread that ran the function)
+calls = []
+
+
+def take(inputs, outputs, context):
+    calls.append((inputs["in/ib"], threading.current_thread().name))
+    outputs.seen = inputs["in/ib"]
+"""
+
+
+class _InboxOnly:
+    """What a Simulation needs of a transport whose links are all local: its inbox."""
+
+    def __init__(self) -> None:
+        self.inbox = Inbox()
+
+    def start(self) -> None:
+        pass
+
+    def close(self) -> None:
+        pass
+
+
+class _Plant:
+    """An environment: its presence keeps every event on the scheduler's thread."""
+
+    def advance(self, time: float) -> None:
+        pass
+
+
+def _served_run(tmp_path: Path, environment: object, values: list[float]) -> tuple[Any, list[tuple[float, str]]]:
+    (tmp_path / "system.earl").write_text(SERVED_SPEC)
+    (tmp_path / "served.py").write_text(SERVED_CODE)
+    transport = _InboxOnly()
+    simulation = Simulation(
+        earl.load(tmp_path / "system.earl"), environment=environment, realtime=True, transport=transport
+    )
+    import served  # type: ignore[import-not-found]  # bound by the Simulation from tmp_path
+
+    served.calls.clear()
+    engine = simulation.network.engines[0]
+    channel = engine.channels["in"]
+
+    def arrive(time: int, value: Any) -> None:  # what the transport's `_Input.arrive` does
+        channel.deliver(value)
+        if engine.waiting and engine.on_delivery is not None:
+            engine.on_delivery(engine)
+
+    def producer() -> None:  # stands for Zenoh's thread
+        for value in values:
+            time.sleep(0.02)
+            transport.inbox.put(arrive, value)
+
+    thread = threading.Thread(target=producer, name="receiving-thread")
+    thread.start()
+    deadline = time.monotonic() + 20
+    while len(served.calls) < len(values) + 1 and time.monotonic() < deadline:
+        simulation.advance_to(simulation.time + 0.05)
+    thread.join()
+    simulation.close()
+    return simulation, list(served.calls)
+
+
+def test_a_message_is_served_on_its_receiving_thread_while_the_scheduler_sleeps(tmp_path: Path) -> None:
+    _, calls = _served_run(tmp_path, None, [1.0, 2.0, 3.0])
+    # the first call reads the buffer's initial value; each message then wakes the subsystem at once,
+    # and since the scheduler slept, on the thread that received it
+    assert [value for value, _ in calls] == [0.0, 1.0, 2.0, 3.0]
+    assert [thread for _, thread in calls[1:]] == ["receiving-thread"] * 3
+
+
+def test_with_an_environment_every_message_is_handed_over_to_the_scheduler(tmp_path: Path) -> None:
+    _, calls = _served_run(tmp_path, _Plant(), [1.0, 2.0])
+    assert [value for value, _ in calls] == [0.0, 1.0, 2.0]
+    assert {thread for _, thread in calls} == {threading.current_thread().name}
+
+
+def test_what_fails_while_serving_is_raised_in_the_scheduler_thread(tmp_path: Path) -> None:
+    (tmp_path / "system.earl").write_text(SERVED_SPEC)
+    (tmp_path / "served.py").write_text(SERVED_CODE)
+    transport = _InboxOnly()
+    simulation = Simulation(earl.load(tmp_path / "system.earl"), environment=None, realtime=True, transport=transport)
+    simulation.advance_to(0.01)
+
+    def broken(time: int, value: Any) -> None:
+        raise OSError("the disk is full")
+
+    thread = threading.Thread(target=transport.inbox.put, args=(broken, None))
+    thread.start()
+    thread.join()
+    with pytest.raises(OSError, match="the disk is full"):
+        simulation.advance_to(simulation.time + 0.05)
+    simulation.close()
