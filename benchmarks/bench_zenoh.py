@@ -2,26 +2,31 @@
 
     .venv/bin/python benchmarks/bench_zenoh.py
 
-Two OS processes on 127.0.0.1 (this one and an echo child), peer mode, explicit endpoints.
-For 64 B and 4 KiB messages (a `double[7]` and a `double[511]`: 67 B and 4100 B on the wire
-with earl's 8-byte type fingerprint and msgpack ext header; raw Zenoh sends byte strings of
-exactly the length earl's codec writes):
+Two OS processes on 127.0.0.1 (this one, the sender, and a receiver child), peer mode,
+explicit endpoints.  For 64 B and 4 KiB messages (a `double[7]` and a `double[511]`: 67 B
+and 4100 B on the wire with earl's 8-byte type fingerprint and msgpack ext header; raw
+Zenoh sends byte strings of exactly the length earl's codec writes):
 
-- latency: ping-pong; one-way latency = round trip / 2; p50 and p99 over the samples;
-  each figure is the median of REPEATS runs; every repeat runs earl and its two peers, in an
-  order rotated from one repeat to the next so that none always runs first or last (the
-  spread over the repeats is in the results too);
-- throughput: the sender publishes as fast as it can for a fixed time; the receiver counts
-  what it received and for how long (messages per second at the receiver).
+- **latency**, one way: the sender stamps each message with the clock (`time.perf_counter`
+  is CLOCK_MONOTONIC, one clock for every process of a host) just before handing it to
+  the link, and the receiver's own code takes the clock as it first reads it; p50 and p99
+  over the samples.  A message goes every PACE seconds, as a control loop sends, so none
+  waits behind another.  Each figure is the median of REPEATS runs; every repeat runs earl
+  and its two peers interleaved in blocks, in an order rotated from one repeat to the next
+  (the spread over the repeats is in the results too);
+- **throughput**: the sender publishes as fast as it can for a fixed time; the receiver
+  counts what it received and for how long (messages per second at the receiver).
 
-The earl side is the real transport (earl.transport.zenoh_transport) serving links built
-by the real builder: the sender's output goes through the codec and a publisher; the
-receiver decodes and type-checks on Zenoh's thread, hands over through the inbox and
-delivers into the input buffer's channel in its main thread, which is where a subsystem
-would read it (the echo's buffer is a FIFO, so that every delivery is counted: a
-latest-value buffer keeps only the newest).  The raw peer is the least a Python program can do: the echo publishes
-from the subscriber callback, and the pinger wakes on a threading.Event.  Results go to
-benchmarks/results/zenoh.json.  Goals (issue 7): earl latency <= 1.2x raw, throughput >= 0.8x raw.
+The earl receiver is a real earl process: the Python API's `Simulation` in real time over
+the Zenoh transport, as `earl run --transport zenoh --agents echo/a` runs it.  Its
+subsystem waits for `in/ib` (obligatory) and its partial transition function `take/pf`
+reads the stamp, so earl's figure covers the codec on both sides, the transport, the
+scheduler and the engine up to the user's code.  The sender is earl's transport serving
+the link built by the real builder (encode and publish), driven from this process.  The
+raw receiver is the least a Python program can do: it reads the stamp in the subscriber
+callback.  "raw + handover" reads it in the main thread after a hand-over from the callback,
+as a control loop in its own thread must.  Results go to benchmarks/results/zenoh.json.
+Goals (issue 7): earl latency <= 1.2x raw, throughput >= 0.8x raw.
 """
 
 from __future__ import annotations
@@ -29,6 +34,7 @@ from __future__ import annotations
 import json
 import socket
 import statistics
+import struct
 import subprocess
 import sys
 import tempfile
@@ -46,6 +52,7 @@ from earl.model.types import TypeReference
 from earl.runtime.builder import build_network
 from earl.runtime.engine import Destination, SubsystemEngine
 from earl.runtime.events import Recorder
+from earl.runtime.simulation import Simulation
 from earl.runtime.values import TypeSystem
 from earl.transport.codec import LinkCodec
 from earl.transport.zenoh_transport import ZenohTransport, default_config
@@ -53,15 +60,19 @@ from earl.transport.zenoh_transport import ZenohTransport, default_config
 HERE = Path(__file__).resolve().parent
 RESULTS = HERE / "results" / "zenoh.json"
 SIZES = {"64 B": 7, "4 KiB": 511}  # doubles per message: 8 + 3 + 8*7 = 67 B, 8 + 4 + 8*511 = 4100 B
-ROUND_TRIPS = 1000
+#: stamped messages per peer and repeat
+MESSAGES = 1000
+#: seconds between two stamped messages: a 1 kHz control loop's pace
+PACE = 0.001
 #: each measurement is repeated, rotating the order of earl and its peers, and the median of each figure kept
 REPEATS = 5
-WARM_UP = 200
-#: round trips of one peer in a row before the next peer's: short enough to share the machine's moods
+WARM_UP = 100
+#: messages of one peer in a row before the next peer's: short enough to share the machine's moods
 BLOCK = 50
 THROUGHPUT_SECONDS = 1.5
-#: the first element of the message that ends an earl echo (-1.0 and -2.0 mark the throughput phase)
-QUIT = -3.0
+# The first element of a message says what it is: a stamp (> 0, seconds of time.perf_counter),
+# or one of these.
+COUNT, END_COUNT, QUIT, REPORT = -1.0, -2.0, -3.0, -5.0
 
 SPEC = """\
 system bench
@@ -87,20 +98,19 @@ ping/a {
 }
 echo/a {
     cs {
-        period 1 ms
         in/ib: double[K] fifo 1000000
         back/ob: double[K]
         last/m: double[K]
         false/pp = false
-        copy/pf(in/ib -> last/mo) = python "benchcode:copy_in"
-        send/pf(last/mi -> back/ob) = python "benchcode:send_back"
+        take/pf(in/ib -> last/mo) = python "benchcode:take"
+        answer/pf(last/mi -> back/ob) = python "benchcode:answer"
         run/bb {
-            tf = {copy/pf} then {send/pf}
+            tf = {take/pf} then {answer/pf}
             tc = false/pp
         }
         fsm {
             initial run
-            state run: run/bb
+            state run: run/bb { obligatory in/ib }
         }
     }
 }
@@ -115,10 +125,41 @@ benchRobot/r {
 """
 
 CODE = """\
+import time
+
+COUNT, END_COUNT, QUIT, REPORT = -1.0, -2.0, -3.0, -5.0
+done = False
+#: one-way latencies, seconds
+latencies = []
+_count, _first, _last = 0, 0.0, 0.0
+
+
 def copy(i, o, c): o.last = i.back
 def send(i, o, c): o.out = i.last
-def copy_in(i, o, c): o.last = i["in/ib"]
-def send_back(i, o, c): o.back = i.last
+
+
+def take(i, o, c):
+    global done, _count, _first, _last
+    value = i["in/ib"]
+    head = value[0]
+    if head > 0.0:  # stamped when it was sent
+        latencies.append(time.perf_counter() - head)
+    elif head == COUNT:  # the throughput phase: count
+        _last = time.perf_counter()
+        if _count == 0:
+            _first = _last
+        _count += 1
+    elif head == END_COUNT:  # its end: answer with the count and how long it took
+        value = (REPORT, float(_count), _last - _first) + value[3:]
+        _count = 0
+    elif head == QUIT:
+        done = True
+    o.last = value
+
+
+def answer(i, o, c):
+    if i.last[0] == REPORT:
+        o.back = i.last
 """
 
 
@@ -156,40 +197,38 @@ class EarlEnd:
         self.transport.close()
 
 
-def earl_echo(directory: Path, doubles: int, listen: str, connect: str) -> None:
-    end = EarlEnd(directory, "echo/a", doubles, listen, connect)
+def earl_receiver(directory: Path, doubles: int, listen: str, connect: str, out: Path) -> None:
+    """echo/a as `earl run --realtime --transport zenoh --agents echo/a` runs it, through the Python API;
+    the latencies its `take/pf` measured go to `out` (JSON) when the sender says QUIT."""
+    transport = ZenohTransport("bench", ["echo/a"], default_config([listen], [connect]), lambda _: None)
+    try:
+        simulation = Simulation(
+            earl.load(directory / "system.earl"),
+            parameters={"K": doubles},
+            environment=None,
+            realtime=True,
+            agents=["echo/a"],
+            transport=transport,
+        )
+    except BaseException:
+        transport.close()  # else Zenoh's threads keep the process alive
+        raise
+    import benchcode  # type: ignore[import-not-found]  # bound by the Simulation: the module its functions live in
+
     print("ready", flush=True)
     try:
-        while True:
-            try:
-                value = end.receive(10.0)
-            except TimeoutError:
-                return
-            if value and value[0] == QUIT:
-                return
-            if value and value[0] < 0:  # the throughput phase: count, do not answer
-                _count_throughput(end, value)
-                continue
-            end.sink.deliver(value)
+        deadline = 300.0  # seconds of run time: the sender ends it long before
+        while not benchcode.done and simulation.time < deadline:
+            simulation.advance_to(simulation.time + 0.5, lambda: bool(benchcode.done))
     finally:
-        end.close()
-
-
-def _count_throughput(end: EarlEnd, first: Any) -> None:
-    count, started, last = 1, time.perf_counter(), time.perf_counter()
-    while True:
-        try:
-            value = end.receive(1.0)
-        except TimeoutError:
-            break
-        if value[0] == -2.0:  # end marker
-            break
-        count += 1
-        last = time.perf_counter()
-    end.sink.deliver((float(count), last - started) + (0.0,) * (len(first) - 2))
+        simulation.close()
+        out.write_text(json.dumps(benchcode.latencies))
 
 
 # ---------------------------------------------------------------- raw side
+_HEAD = struct.Struct("<d")
+
+
 class RawEnd:
     def __init__(self, listen: str, connect: str, subscribe: str, publish: str) -> None:
         self.session = zenoh.open(default_config([listen], [connect]))
@@ -213,14 +252,18 @@ class RawEnd:
         return self.received.popleft()
 
 
-def raw_echo(size: int, listen: str, connect: str, handover: bool) -> None:
-    """Echo raw bytes; with `handover`, from the main thread (as a control loop must), else from the callback."""
+def raw_receiver(listen: str, connect: str, handover: bool, out: Path) -> None:
+    """Read each message's stamp in the subscriber callback, or (`handover`) in the main thread after a
+    hand-over, as a control loop must; the latencies go to `out` (JSON) at QUIT."""
     session = zenoh.open(default_config([listen], [connect]))
     publisher = session.declare_publisher("raw/back", express=True)
     state: dict[str, Any] = {"count": 0, "first": 0.0, "last": 0.0}
+    latencies: list[float] = []
     done = threading.Event()
     arrived: deque[bytes] = deque()
     wake = threading.Event()
+    clock = time.perf_counter
+    head_of = _HEAD.unpack_from
 
     def on_sample(sample: zenoh.Sample) -> None:
         if handover:
@@ -232,25 +275,24 @@ def raw_echo(size: int, listen: str, connect: str, handover: bool) -> None:
             handle(sample.payload.to_bytes())
 
     def handle(payload: bytes) -> None:
-        if payload[:1] == b"T":  # throughput phase
+        head = head_of(payload)[0]
+        if head > 0.0:
+            latencies.append(clock() - head)
+        elif head == COUNT:
+            state["last"] = clock()
             if state["count"] == 0:
-                state["first"] = time.perf_counter()
+                state["first"] = state["last"]
             state["count"] += 1
-            state["last"] = time.perf_counter()
-            return
-        if payload[:1] == b"E":  # end of the throughput phase
+        elif head == END_COUNT:
             report = json.dumps({"count": state["count"], "seconds": state["last"] - state["first"]}).encode()
-            publisher.put(b"R" + report)
+            publisher.put(report)
             state["count"] = 0
-            return
-        if payload[:1] == b"Q":
+        elif head == QUIT:
             done.set()
-            return
-        publisher.put(payload)  # echo straight from the callback: the least work possible
 
     subscriber = session.declare_subscriber("raw/out", on_sample)
     print("ready", flush=True)
-    deadline = time.monotonic() + 120
+    deadline = time.monotonic() + 300
     while handover and not done.is_set() and time.monotonic() < deadline:
         if not arrived:
             wake.wait(1.0)
@@ -260,6 +302,7 @@ def raw_echo(size: int, listen: str, connect: str, handover: bool) -> None:
     done.wait(max(0.0, deadline - time.monotonic()))
     del subscriber
     session.close()  # type: ignore[no-untyped-call]
+    out.write_text(json.dumps(latencies))
 
 
 # ---------------------------------------------------------------- the measuring side
@@ -290,93 +333,96 @@ def percentile(samples: list[float], fraction: float) -> float:
 
 
 class EarlPeer:
-    """earl's link, both ways: this process's ping/a and an echo/a child."""
+    """earl's link: this process sends from ping/a, an echo/a child receives."""
 
-    def __init__(self, directory: Path, doubles: int) -> None:
+    def __init__(self, directory: Path, doubles: int, scratch: Path) -> None:
         mine, theirs = free_ports(2)
         listen, connect = f"tcp/127.0.0.1:{mine}", f"tcp/127.0.0.1:{theirs}"
-        self.echo = child(["earl-echo", str(directory), str(doubles), connect, listen])
+        self.out = scratch / f"earl-{mine}.json"
+        self.receiver = child(["earl-receiver", str(directory), str(doubles), connect, listen, str(self.out)])
         self.end = EarlEnd(directory, "ping/a", doubles, listen, connect)
         self.end.transport.wait_for_peers(10)
-        self.value = tuple(float(i) for i in range(doubles))
+        self.rest = tuple(float(i + 1) for i in range(doubles - 1))
 
-    def round_trip(self) -> None:
-        self.end.sink.deliver(self.value)
-        self.end.receive(5.0)
+    def send_stamped(self) -> None:
+        self.end.sink.deliver((time.perf_counter(), *self.rest))
 
     def throughput(self) -> tuple[float, float, int]:
-        """(messages the echo counted, over how many seconds, messages sent)."""
-        end, value = self.end, self.value
-        marker = (-1.0, *value[1:])
+        """(messages the receiver counted, over how many seconds, messages sent)."""
+        end, marker = self.end, (COUNT, *self.rest)
         stop_at = time.perf_counter() + THROUGHPUT_SECONDS
         sent = 0
         while time.perf_counter() < stop_at:
             end.sink.deliver(marker)
             sent += 1
-        end.sink.deliver((-2.0, *value[1:]))
+        time.sleep(0.3)  # as for raw Zenoh: the end marker is not lost in a full queue
+        end.sink.deliver((END_COUNT, *self.rest))
         report = end.receive(15.0)
-        return report[0], report[1], sent
+        return report[1], report[2], sent
 
-    def close(self) -> None:
-        self.end.sink.deliver((QUIT, *self.value[1:]))
-        self.echo.wait(20)
+    def close(self) -> list[float]:
+        """The latencies the receiver measured."""
+        self.end.sink.deliver((QUIT, *self.rest))
+        self.receiver.wait(20)
         self.end.close()
+        return list(json.loads(self.out.read_text()))
 
 
 class RawPeer:
-    """Raw Zenoh pub/sub of byte strings as long as earl's messages, to an echo child."""
+    """Raw Zenoh pub/sub of byte strings as long as earl's messages, to a receiver child."""
 
-    def __init__(self, size: int, handover: bool) -> None:
+    def __init__(self, size: int, handover: bool, scratch: Path) -> None:
         mine, theirs = free_ports(2)
         listen, connect = f"tcp/127.0.0.1:{mine}", f"tcp/127.0.0.1:{theirs}"
-        self.echo = child(["raw-echo", str(size), connect, listen, "handover" if handover else "callback"])
+        self.out = scratch / f"raw-{mine}.json"
+        mode = "handover" if handover else "callback"
+        self.receiver = child(["raw-receiver", connect, listen, mode, str(self.out)])
         self.end = RawEnd(listen, connect, "raw/back", "raw/out")
-        self.size = size
-        self.payload = bytes(size)
+        self.rest = bytes(size - _HEAD.size)
 
-    def round_trip(self) -> None:
-        self.end.publisher.put(self.payload)
-        self.end.receive(5.0)
+    def send_stamped(self) -> None:
+        self.end.publisher.put(_HEAD.pack(time.perf_counter()) + self.rest)
 
     def throughput(self) -> tuple[float, float, int]:
         end = self.end
-        marker = b"T" + bytes(self.size - 1)
+        marker = _HEAD.pack(COUNT) + self.rest
         stop_at = time.perf_counter() + THROUGHPUT_SECONDS
         sent = 0
         while time.perf_counter() < stop_at:
             end.publisher.put(marker)
             sent += 1
         time.sleep(0.3)
-        end.publisher.put(b"E")
-        report = json.loads(end.receive(15.0)[1:])
+        end.publisher.put(_HEAD.pack(END_COUNT) + self.rest)
+        report = json.loads(end.receive(15.0))
         return report["count"], report["seconds"], sent
 
-    def close(self) -> None:
-        self.end.publisher.put(b"Q")
+    def close(self) -> list[float]:
+        self.end.publisher.put(_HEAD.pack(QUIT) + self.rest)
+        self.receiver.wait(20)
         self.end.session.close()  # type: ignore[no-untyped-call]
-        self.echo.wait(20)
+        return list(json.loads(self.out.read_text()))
 
 
 Peer = EarlPeer | RawPeer
 
 
-def measure_together(peers: dict[str, Peer], order: list[str]) -> dict[str, dict[str, float]]:
-    """One repeat: the peers' round trips interleaved in blocks, so that all of them meet the same
-    moments of a noisy machine; then each one's throughput, in `order`."""
+def measure_together(peers: dict[str, Peer], order: list[str]) -> dict[str, tuple[float, float, int]]:
+    """One repeat: the peers' stamped messages interleaved in blocks, so that all of them meet the same
+    moments of a noisy machine; then each one's throughput, in `order`.  The latencies are with the
+    receivers, read when they close."""
     time.sleep(0.5)  # the links settle
+    pause = time.sleep
     for name in order:
         for _ in range(WARM_UP):
-            peers[name].round_trip()
-    samples: dict[str, list[float]] = {name: [] for name in peers}
-    clock = time.perf_counter
-    for block in range(ROUND_TRIPS // BLOCK):
+            peers[name].send_stamped()
+            pause(PACE)
+    for block in range(MESSAGES // BLOCK):
         for name in order[block % len(order) :] + order[: block % len(order)]:
-            round_trip, taken = peers[name].round_trip, samples[name]
+            send = peers[name].send_stamped
             for _ in range(BLOCK):
-                started = clock()
-                round_trip()
-                taken.append((clock() - started) / 2)
-    return {name: _figures(samples[name], *peers[name].throughput()) for name in order}
+                send()
+                pause(PACE)
+    return {name: peers[name].throughput() for name in order}
 
 
 def _figures(samples: list[float], count: float, seconds: float, sent: int) -> dict[str, float]:
@@ -402,7 +448,9 @@ def _medians(runs: list[dict[str, float]]) -> dict[str, float]:
 
 def main() -> int:
     results: dict[str, Any] = {
-        "round_trips": ROUND_TRIPS,
+        "messages": MESSAGES,
+        "pace_s": PACE,
+        "latency": "one way: from the sender's call that sends to the receiver's code that reads",
         "throughput_seconds": THROUGHPUT_SECONDS,
         "repeats": REPEATS,
         "sizes": {},
@@ -419,16 +467,20 @@ def main() -> int:
             for repeat in range(REPEATS):
                 order = names[repeat % 3 :] + names[: repeat % 3]
                 peers: dict[str, Peer] = {}
+                latencies: dict[str, list[float]] = {}
                 try:
                     for name in order:
                         peers[name] = (
-                            EarlPeer(directory, doubles) if name == "earl" else RawPeer(size, handover=name == "handed")
+                            EarlPeer(directory, doubles, directory)
+                            if name == "earl"
+                            else RawPeer(size, name == "handed", directory)
                         )
-                    for name, figures in measure_together(peers, order).items():
-                        runs[name].append(figures)
+                    throughputs = measure_together(peers, order)
                 finally:
-                    for peer in peers.values():
-                        peer.close()
+                    for name, peer in peers.items():
+                        latencies[name] = peer.close()[WARM_UP:]
+                for name in order:
+                    runs[name].append(_figures(latencies[name], *throughputs[name]))
             raw, handed, mine = (_medians(runs[name]) for name in ("raw", "handed", "earl"))
             latency_ratio = mine["latency_p50_us"] / raw["latency_p50_us"]
             p99_ratio = mine["latency_p99_us"] / raw["latency_p99_us"]
@@ -468,9 +520,9 @@ def main() -> int:
 
 
 if __name__ == "__main__":
-    if len(sys.argv) > 1 and sys.argv[1] == "earl-echo":
-        earl_echo(Path(sys.argv[2]), int(sys.argv[3]), sys.argv[4], sys.argv[5])
-    elif len(sys.argv) > 1 and sys.argv[1] == "raw-echo":
-        raw_echo(int(sys.argv[2]), sys.argv[3], sys.argv[4], sys.argv[5] == "handover")
+    if len(sys.argv) > 1 and sys.argv[1] == "earl-receiver":
+        earl_receiver(Path(sys.argv[2]), int(sys.argv[3]), sys.argv[4], sys.argv[5], Path(sys.argv[6]))
+    elif len(sys.argv) > 1 and sys.argv[1] == "raw-receiver":
+        raw_receiver(sys.argv[2], sys.argv[3], sys.argv[4] == "handover", Path(sys.argv[5]))
     else:
         raise SystemExit(main())

@@ -245,6 +245,18 @@ class Scheduler:
             queue = self._queue
             while queue and queue[0][0] <= time and (should_stop is None or not should_stop()):
                 event_time, _, _, kind, engine, token = heapq.heappop(queue)
+                if kind == _RESUME and engine.waiting and not (queue and queue[0][0] <= time):
+                    # the subsystem this message woke, with nothing else due: its receive and decide, and
+                    # its next iteration if that is due at once, run without going through the queue
+                    if token == self._tokens[engine.name]:
+                        following: int | None = self._finish(engine, event_time, timed_out=False)
+                        if following is not None and following <= time:
+                            self.now = following
+                            self._record_lateness(following, engine)
+                            following = self._start(engine, following)
+                        if following is not None:
+                            self._push(following, engine, _START)
+                    continue
                 self._run_event(event_time, kind, engine, token)
             if queue and queue[0][0] < self._sleeping_until:
                 self._wake_sleeper()  # it sleeps until a later event than the one now first
