@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass
+from typing import NamedTuple
 
 import mujoco
 import numpy as np
@@ -35,8 +35,7 @@ _CONJUGATE = np.array([1.0, -1.0, -1.0, -1.0])
 _WEIGHTS = np.array([1.0, 1.0, 1.0, ORIENTATION_WEIGHT, ORIENTATION_WEIGHT, ORIENTATION_WEIGHT])
 
 
-@dataclass(frozen=True)
-class Pose:
+class Pose(NamedTuple):
     position: Vector
     #: unit quaternion w, x, y, z
     orientation: Vector
@@ -67,6 +66,15 @@ class RobotModel:
         self._dynamics = False
         self._bias = np.zeros(self.model.nv)
         self._identity = np.eye(n)
+        # Views and copies made once: each `data.qpos` or `model.dof_damping` makes a new view, and
+        # these run several times an iteration.
+        self._qpos = self.data.qpos
+        self._qvel = self.data.qvel
+        self._site_position = self.data.site_xpos[self.site]
+        self._site_rotation = self.data.site_xmat[self.site]
+        self._damping = self.model.dof_damping.copy()
+        self._coupling_transposed = np.ascontiguousarray(self.coupling.T)
+        self._jacobian = np.empty((6, self.model.nv))
 
     def _joint(self, k: int) -> int:
         return int(mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_JOINT, arm.joint_name(k)))
@@ -107,13 +115,13 @@ class RobotModel:
         if key == self._configured and (self._dynamics or not dynamics):
             return
         m, d = self.model, self.data
-        d.qpos[:] = self.coupling @ q
+        self._qpos[:] = self.coupling @ q
         if qd is None:
             mujoco.mj_kinematics(m, d)
             mujoco.mj_comPos(m, d)
         else:
             # only what inverse dynamics needs: the mass matrix and the bias forces (no constraints)
-            d.qvel[:] = self.coupling @ qd
+            self._qvel[:] = self.coupling @ qd
             mujoco.mj_kinematics(m, d)
             mujoco.mj_comPos(m, d)
             mujoco.mj_crb(m, d)
@@ -126,14 +134,14 @@ class RobotModel:
         """The grasp point's pose with the joints at `q`."""
         self._configure(np.asarray(q, dtype=float))
         quaternion = np.empty(4)
-        mujoco.mju_mat2Quat(quaternion, self.data.site_xmat[self.site])
-        return Pose(self.data.site_xpos[self.site].copy(), quaternion)
+        mujoco.mju_mat2Quat(quaternion, self._site_rotation)
+        return Pose(self._site_position.copy(), quaternion)
 
     def jacobian(self, q: Vector) -> Vector:
         """6 × N: the grasp point's linear and angular velocity per motor joint velocity."""
         self._configure(np.asarray(q, dtype=float))
         # MuJoCo writes the linear rows and the angular rows straight into one 6 × nv array
-        full = np.empty((6, self.model.nv))
+        full = self._jacobian
         mujoco.mj_jacSite(self.model, self.data, full[:3], full[3:], self.site)
         result: Vector = full @ self.coupling
         return result
@@ -185,8 +193,8 @@ class RobotModel:
         d = self.data
         acceleration = np.empty(self.model.nv)
         mujoco.mj_mulM(self.model, d, acceleration, self.coupling @ np.asarray(qdd, dtype=float))
-        friction = self.model.dof_damping * (self.coupling @ qd)
-        torques: Vector = self.coupling.T @ (acceleration + self._bias + friction)
+        friction = self._damping * (self.coupling @ qd)
+        torques: Vector = self._coupling_transposed @ (acceleration + self._bias + friction)
         return torques
 
     def joint_inertia(self, q: Vector) -> Vector:

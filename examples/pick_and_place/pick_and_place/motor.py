@@ -8,6 +8,7 @@ driver reports a fault.
 
 from __future__ import annotations
 
+import functools
 from typing import Any
 
 from earl.sim import arm
@@ -36,12 +37,17 @@ def _read(actuator: str, outputs: Any, context: Any) -> None:
     outputs.encoderReading = {"motorPos": plant.encoder(actuator), "driverFault": plant.driver_fault(actuator)}
 
 
+@functools.cache
+def _actuator(joint: int) -> str:
+    return arm.actuator_name(joint)
+
+
 def apply_current(inputs: Any, outputs: Any, context: Any) -> None:
-    _apply(arm.actuator_name(int(context.parameters["joint"])), inputs, outputs, context)
+    _apply(_actuator(context.parameters["joint"]), inputs, outputs, context)
 
 
 def read_encoder(inputs: Any, outputs: Any, context: Any) -> None:
-    _read(arm.actuator_name(int(context.parameters["joint"])), outputs, context)
+    _read(_actuator(context.parameters["joint"]), outputs, context)
 
 
 def apply_finger_current(inputs: Any, outputs: Any, context: Any) -> None:

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import mujoco
@@ -44,15 +44,19 @@ class Encoder:
     joint_address: int
     gear_ratio: float
     counts_per_revolution: int
+    #: motor radians per count
+    resolution: float = field(init=False)
+    # counts per joint radian: read runs every millisecond for every drive
+    _counts_per_joint_radian: float = field(init=False, repr=False)
 
-    @property
-    def resolution(self) -> float:
-        return 2.0 * math.pi / self.counts_per_revolution
+    def __post_init__(self) -> None:
+        resolution = 2.0 * math.pi / self.counts_per_revolution
+        object.__setattr__(self, "resolution", resolution)
+        object.__setattr__(self, "_counts_per_joint_radian", self.gear_ratio / resolution)
 
     def read(self, joint_position: float) -> float:
         """The motor position the encoder reports: whole counts, never more than the true position."""
-        counts = math.floor(joint_position * self.gear_ratio / self.resolution + 1e-9)
-        return counts * self.resolution
+        return math.floor(joint_position * self._counts_per_joint_radian + 1e-9) * self.resolution
 
 
 @dataclass(frozen=True)
@@ -69,6 +73,9 @@ class MujocoPlant:
     def __init__(self, model: mujoco.MjModel, seed: int = 0, keyframe: str | None = None) -> None:
         self.model = model
         self.data = mujoco.MjData(model)
+        # views on the data's own buffers, made once (each `data.ctrl` makes a new view)
+        self._ctrl = self.data.ctrl
+        self._qpos = self.data.qpos
         self._actuators = {model.actuator(i).name: i for i in range(model.nu)}
         self._timestep = float(model.opt.timestep)
         # per actuator (low, high) as Python floats: set_input runs every millisecond for every drive
@@ -159,7 +166,7 @@ class MujocoPlant:
             applied = 0.0
         low, high = self._ranges[index]
         applied = min(max(applied, low), high)
-        self.data.ctrl[index] = applied
+        self._ctrl[index] = applied
         return applied
 
     def applied_input(self, actuator: str) -> float:
@@ -206,7 +213,7 @@ class MujocoPlant:
             raise PlantError(
                 f"no encoder is declared for `{actuator}` (declared: {', '.join(self.encoders) or 'none'})"
             ) from None
-        return encoder.read(float(self.data.qpos[encoder.joint_address]))
+        return encoder.read(float(self._qpos[encoder.joint_address]))
 
     def joint_position(self, joint: str) -> float:
         """The true joint position (for tests and plots; a controller reads encoders)."""
