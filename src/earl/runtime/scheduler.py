@@ -132,9 +132,11 @@ class Scheduler:
             return
         queue = self._queue
         pop = heapq.heappop
+        push = heapq.heappush
         advance = self._advance
         realtime = self.realtime
         tokens = self._tokens
+        record_memory = self.record_memory
         while queue and queue[0][0] <= until:
             if should_stop is not None and should_stop():
                 return
@@ -146,13 +148,21 @@ class Scheduler:
             if realtime:
                 self._wait_until(time, engine, kind)
             if kind == _START:
-                following = self._start(engine, time)
-                if following is not None and advance is None and not realtime:
+                # `_start` and `_push` written out: this is the path of nearly every event
+                if not engine.iterate(time):
+                    self._wait(engine, time)
+                    continue
+                if record_memory and engine.name in record_memory:
+                    self.recorder.memory_snapshot(time, engine.name, engine.memory)
+                period = engine.period
+                following: int | None = time + period if period is not None and period > 0 else time
+                if advance is None and not realtime:
                     # The engine alone is due before anything else: run it on without the queue
                     # (same order as through the queue, only cheaper).
                     following = self._run_alone(engine, following, min(until, queue[0][0] - 1) if queue else until)
                 if following is not None:
-                    self._push(following, engine, _START)
+                    self._sequence += 1
+                    push(queue, (following, engine.order, self._sequence, _START, engine, 0))
             elif kind == _RESUME:
                 if engine.waiting and token == tokens[engine.name]:
                     self._push(self._finish(engine, time, timed_out=False), engine, _START)
