@@ -155,14 +155,16 @@ class Scheduler:
                 if record_memory and engine.name in record_memory:
                     self.recorder.memory_snapshot(time, engine.name, engine.memory)
                 period = engine.period
-                following: int | None = time + period if period is not None and period > 0 else time
+                following = time + period if period is not None and period > 0 else time
                 if advance is None and not realtime:
                     # The engine alone is due before anything else: run it on without the queue
                     # (same order as through the queue, only cheaper).
-                    following = self._run_alone(engine, following, min(until, queue[0][0] - 1) if queue else until)
-                if following is not None:
-                    self._sequence += 1
-                    push(queue, (following, engine.order, self._sequence, _START, engine, 0))
+                    alone = self._run_alone(engine, following, min(until, queue[0][0] - 1) if queue else until)
+                    if alone is None:
+                        continue
+                    following = alone
+                self._sequence += 1
+                push(queue, (following, engine.order, self._sequence, _START, engine, 0))
             elif kind == _RESUME:
                 if engine.waiting and token == tokens[engine.name]:
                     self._push(self._finish(engine, time, timed_out=False), engine, _START)
