@@ -169,6 +169,39 @@ def test_ctrl_c_stops_the_run_cleanly_and_the_trace_stays_readable(tmp_path: Pat
     assert "counting,finished" in summary.stdout
 
 
+def test_a_run_killed_with_sigkill_still_leaves_a_readable_trace(tmp_path: Path) -> None:
+    """The trace's own process finishes the file when the run's process disappears."""
+    trace = tmp_path / "run.mcap"
+    process = subprocess.Popen(
+        [*EARL, "run", str(SPECS / "counter"), "--realtime", "--duration", "60s", "--trace", str(trace)],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    deadline = time.monotonic() + 30
+    while not trace.exists() and time.monotonic() < deadline:
+        time.sleep(0.1)
+    time.sleep(1.0)
+    process.kill()
+    process.wait(timeout=30)
+    summary = earl_cli("trace", "summary", str(trace))
+    deadline = time.monotonic() + 20
+    while summary.returncode != 0 and time.monotonic() < deadline:  # the writer may still be finishing
+        time.sleep(0.2)
+        summary = earl_cli("trace", "summary", str(trace))
+    assert summary.returncode == 0, summary.stderr
+    assert "counter/a.cs" in summary.stdout
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="no /dev/full here")
+def test_a_trace_on_a_full_disk_stops_the_run_with_one_line_and_exit_1() -> None:
+    result = earl_cli(
+        "run", str(SPECS / "counter"), "--duration", "2s", "--trace", "/dev/full", "--record-memory", "all"
+    )
+    assert result.returncode == 1, result.stderr
+    assert "earl run: cannot write the trace /dev/full: No space left on device" in result.stderr
+    assert "Traceback" not in result.stderr
+
+
 def test_run_help_teaches_with_examples() -> None:
     result = earl_cli("run", "--help")
     assert result.returncode == 0

@@ -218,6 +218,30 @@ def test_the_same_spec_and_seed_give_a_byte_identical_trace(tmp_path: Path) -> N
     assert traces[0] != traces[2]  # the display's noise comes from the seeded stream
 
 
+def test_a_trace_written_by_its_own_process_is_the_trace_written_in_process(tmp_path: Path) -> None:
+    """A file trace is written by a second process (trace_process.py); a stream, in this one: same bytes."""
+    import io
+
+    in_process = io.BytesIO()
+    for output in (tmp_path / "background.mcap", in_process):
+        sim, _ = simulate(SPECS / "counter", seed=3, trace=output, record_memory=["all"])
+        sim.advance_to(0.2)
+        sim.close()
+    assert (tmp_path / "background.mcap").read_bytes() == in_process.getvalue()
+
+
+def test_a_trace_that_cannot_be_written_stops_with_one_sentence(tmp_path: Path) -> None:
+    """A full disk (/dev/full) is reported as a TraceWriteError, during the run or when it closes."""
+    from earl.runtime.trace import TraceWriteError
+
+    if not Path("/dev/full").exists():
+        pytest.skip("no /dev/full here")
+    sim, _ = simulate(SPECS / "counter", trace="/dev/full", record_memory=["all"])
+    with pytest.raises(TraceWriteError, match=r"cannot write the trace /dev/full: No space left on device"):
+        sim.advance_to(0.2)
+        sim.close()
+
+
 def test_state_of_an_unknown_subsystem_suggests_the_right_name() -> None:
     sim, _ = simulate(SPECS / "counter")
     with pytest.raises(KeyError, match=r"counter/a\.relay/ve"):

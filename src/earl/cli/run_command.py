@@ -38,8 +38,9 @@ distributed (docs/distributed.md):
 The spec is checked first; its errors stop the run. Only `earl run` imports the Python
 code a spec names (docs/runtime.md).
 
-exit codes: 0 the run completed, 1 invalid spec or the run could not start,
-            2 usage error, 130 interrupted (the trace is closed and readable)
+exit codes: 0 the run completed, 1 invalid spec, the run could not start, or its trace
+            could not be written (a full disk), 2 usage error, 130 interrupted (the trace
+            is closed and readable)
 """
 
 
@@ -225,8 +226,11 @@ def _close(transport: Any) -> None:
 
 
 def _execute(simulation: Any, duration: float, arguments: argparse.Namespace, report: str | None, path: Path) -> int:
+    from earl.runtime.trace import TraceWriteError
+
     console = Console(stderr=True, highlight=False)
     interrupted = False
+    failed: TraceWriteError | None = None
     previous = signal.getsignal(signal.SIGTERM)
 
     def stop(*_: object) -> None:
@@ -255,12 +259,20 @@ def _execute(simulation: Any, duration: float, arguments: argparse.Namespace, re
                 progress.update(progress.task_ids[0], completed=step, simulated=f"{simulation.time:.2f} s")
     except KeyboardInterrupt:
         interrupted = True
+    except TraceWriteError as error:  # a full disk, say: the run stops, what was written stays readable
+        failed = error
     finally:
         if progress is not None:
             progress.stop()
         wall = time.perf_counter() - started
-        simulation.close()
+        try:
+            simulation.close()
+        except TraceWriteError as error:
+            failed = failed or error
         signal.signal(signal.SIGTERM, previous)
+    if failed is not None:
+        print(f"earl run: {failed} (the run reached {simulation.time:.3f} s)", file=sys.stderr)
+        return EXIT_FAILED
     _summary(simulation, wall, arguments)
     if simulation.transport is not None:
         from earl.transport.process import print_link_statistics

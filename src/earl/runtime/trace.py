@@ -12,14 +12,27 @@ Topics (one channel each; log time = run time in ns):
 
 A subsystem is named as everywhere else: `manip/a.cs`, `manip/a.motorController[3]/ve`.
 The same spec and seed give a byte-identical file: nothing in it depends on the wall clock.
+
+`TraceWriter` decides what is written (topics, schemas, which links); a sink writes it.
+A trace written to a file is written by a second process (`trace_process.py`): encoding a
+message as JSON and framing it in MCAP costs about ten times what handing it over costs,
+and a run sends tens of thousands of messages a second, so the run goes on on one core
+while its trace is written on the other.  A stream (`io.BytesIO`) is written in-process.
 """
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
+import pickle
+import struct
+import subprocess
+import sys
+import time
 from fnmatch import fnmatchcase
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, Any, NoReturn
 
 from mcap.writer import CompressionType, Writer
 
@@ -77,6 +90,37 @@ def _encode(value: Any) -> bytes:
         return _ENCODER.encode(to_json(value)).encode()
 
 
+class McapSink:
+    """Writes what a TraceWriter decides into an MCAP file: channels, then messages as JSON."""
+
+    def __init__(self, stream: IO[bytes]) -> None:
+        self.writer = Writer(stream, compression=CompressionType.ZSTD)
+        self.writer.start(profile="", library=f"earl {__version__}")
+        self._schemas: dict[str, int] = {}
+        #: the TraceWriter's channel numbers -> the MCAP writer's
+        self._channels: dict[int, int] = {}
+
+    def channel(
+        self, number: int, topic: str, schema_name: str, schema: dict[str, Any], metadata: dict[str, str]
+    ) -> None:
+        schema_id = self._schemas.get(schema_name)
+        if schema_id is None:
+            schema_id = self._schemas[schema_name] = self.writer.register_schema(
+                name=schema_name, encoding="jsonschema", data=_encode(schema)
+            )
+        self._channels[number] = self.writer.register_channel(
+            topic=topic, message_encoding="json", schema_id=schema_id, metadata=metadata
+        )
+
+    def message(self, channel: int, time: int, sequence: int, value: Any) -> None:
+        self.writer.add_message(
+            self._channels[channel], log_time=time, data=_encode(value), publish_time=time, sequence=sequence
+        )
+
+    def finish(self) -> None:
+        self.writer.finish()  # type: ignore[no-untyped-call]
+
+
 class TraceWriter(Recorder):
     """Writes the events of a run to an MCAP file."""
 
@@ -89,46 +133,34 @@ class TraceWriter(Recorder):
         links: list[str] | None = None,
         link_sources: dict[str, str] | None = None,
     ) -> None:
-        self._file: IO[bytes] | None = None
+        self._sink: McapSink | BackgroundSink
         if isinstance(output, (str, Path)):
-            self._file = open(output, "wb")  # noqa: SIM115 — closed in close()
-            stream: IO[bytes] = self._file
+            self._sink = BackgroundSink(Path(output))
         else:
-            stream = output
-        self.writer = Writer(stream, compression=CompressionType.ZSTD)
-        self.writer.start(profile="", library=f"earl {__version__}")
+            self._sink = McapSink(output)
         self.types = types
         self.link_types = link_types
         self.memory_types = memory_types
         self.link_patterns = links
         self.link_sources = link_sources or {}
-        self._schemas: dict[str, int] = {}
+        #: topic -> channel number; None for a link that is not recorded
         self._channels: dict[str, int | None] = {}
+        #: link -> channel number or None, the same as `_channels` without making the topic's name
+        self._links: dict[str, int | None] = {}
         self._sequence = 0
         self.closed = False
 
     # ------------------------------------------------------------------ plumbing
-    def _schema(self, name: str, schema: dict[str, Any]) -> int:
-        found = self._schemas.get(name)
-        if found is None:
-            found = self._schemas[name] = self.writer.register_schema(
-                name=name, encoding="jsonschema", data=_encode(schema)
-            )
-        return found
-
     def _channel(self, topic: str, schema_name: str, schema: dict[str, Any], metadata: dict[str, str]) -> int:
         found = self._channels.get(topic)
         if found is None:
-            found = self._channels[topic] = self.writer.register_channel(
-                topic=topic, message_encoding="json", schema_id=self._schema(schema_name, schema), metadata=metadata
-            )
+            found = self._channels[topic] = len(self._channels) + 1
+            self._sink.channel(found, topic, schema_name, schema, metadata)
         return found
 
     def _write(self, channel: int, time: int, message: Any) -> None:
         self._sequence += 1
-        self.writer.add_message(
-            channel, log_time=time, data=_encode(message), publish_time=time, sequence=self._sequence
-        )
+        self._sink.message(channel, time, self._sequence, message)
 
     # ------------------------------------------------------------------ events
     def run_started(self, settings: dict[str, Any]) -> None:
@@ -157,9 +189,9 @@ class TraceWriter(Recorder):
         )
 
     def message_sent(self, time: int, link: str, value: Any) -> None:
-        channel = self._channels.get(f"link/{link}", -1)
+        channel = self._links.get(link, -1)
         if channel == -1:
-            channel = self._link_channel(link)
+            channel = self._links[link] = self._link_channel(link)
         if channel is None:
             return
         self._write(channel, time, value if isinstance(value, Record) else {"value": value})
@@ -192,7 +224,7 @@ class TraceWriter(Recorder):
                 {"type": "object", "title": f"{subsystem}.m", "properties": properties},
                 {"subsystem": subsystem},
             )
-        self._write(channel, time, memory)
+        self._write(channel, time, dict(memory))  # a copy: the engine goes on changing its memory
 
     def fault(self, fault: Fault) -> None:
         channel = self._channel("/earl/faults", "earl.Fault", _FAULT_SCHEMA, {})
@@ -218,6 +250,104 @@ class TraceWriter(Recorder):
         self._write(
             self._channel("/earl/run", "earl.Run", _RUN_SCHEMA, {}), end_time, {"event": "end", **(summary or {})}
         )
-        self.writer.finish()  # type: ignore[no-untyped-call]
-        if self._file is not None:
-            self._file.close()
+        self._sink.finish()
+
+
+class TraceWriteError(OSError):
+    """The trace file could not be written (a full disk, a removed directory): the message says why."""
+
+
+class BackgroundSink:
+    """A McapSink in a second process (`python -m earl.runtime.trace_process FILE`), fed in batches.
+
+    The file is created here first, so that a path that cannot be written fails at once, in
+    the caller.  Records and Reals travel as the plain dicts and tuples they encode to.  If
+    this process ends without `finish` (killed), the writer sees its input end and finishes
+    the file, which therefore stays readable.
+    """
+
+    #: messages per batch: large enough to make the hand-over cheap, small enough to stay in flight
+    BATCH = 2048
+    #: a batch goes at the latest this long after the previous one (s): a run in real time sends
+    #: few messages, and a run that is killed loses at most this much of its trace
+    LATEST = 0.2
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+        open(path, "wb").close()  # only to fail now if the file cannot be written
+        self._process = subprocess.Popen(
+            [sys.executable, "-m", "earl.runtime.trace_process", str(path)],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.PIPE,
+        )
+        self._batch: list[tuple[Any, ...]] = []
+        self._due = _clock() + self.LATEST
+        self._finished = False
+
+    def channel(
+        self, number: int, topic: str, schema_name: str, schema: dict[str, Any], metadata: dict[str, str]
+    ) -> None:
+        self._batch.append(("channel", number, topic, schema_name, schema, metadata))
+
+    def message(self, channel: int, time: int, sequence: int, value: Any) -> None:
+        batch = self._batch
+        batch.append((channel, time, sequence, value))
+        if len(batch) >= self.BATCH or _clock() >= self._due:
+            self._send()
+
+    def _send(self) -> None:
+        buffer = io.BytesIO()
+        _PlainPickler(buffer, protocol=pickle.HIGHEST_PROTOCOL).dump(self._batch)
+        self._batch = []
+        self._due = _clock() + self.LATEST
+        data = buffer.getbuffer()
+        stdin = self._process.stdin
+        assert stdin is not None
+        try:
+            stdin.write(_LENGTH.pack(len(data)))
+            stdin.write(data)
+        except (BrokenPipeError, OSError):
+            self._fail()
+
+    def finish(self) -> None:
+        """Send what is left, and wait until the file is complete."""
+        if self._finished:
+            return
+        self._finished = True
+        self._batch.append(("finish",))
+        self._send()
+        stdin = self._process.stdin
+        assert stdin is not None
+        with contextlib.suppress(OSError):  # a writer that failed has closed its end: said below
+            stdin.close()
+        if self._process.wait() != 0:
+            self._fail()
+
+    def _fail(self) -> NoReturn:
+        self._finished = True
+        process = self._process
+        if process.stdin is not None:
+            with contextlib.suppress(OSError):
+                process.stdin.close()
+        process.wait()
+        why = process.stderr.read().decode("utf-8", "replace").strip() if process.stderr is not None else ""
+        raise TraceWriteError(
+            f"cannot write the trace {self.path}: {why or f'its writer stopped (exit code {process.returncode})'}"
+        )
+
+
+#: the length of each pickled batch, before it
+_LENGTH = struct.Struct("<Q")
+_clock = time.monotonic
+
+
+class _PlainPickler(pickle.Pickler):
+    """Pickles Records as the dicts they are as JSON: a Record's class is made at run time and cannot
+    be found by name in another process."""
+
+    def reducer_override(self, obj: Any) -> Any:
+        # called only for instances of subclasses (pickle's own types never reach it); Reals pickle as they are
+        if isinstance(obj, Record):
+            return (dict, (dict(obj),))
+        return NotImplemented

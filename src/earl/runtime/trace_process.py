@@ -1,0 +1,57 @@
+"""The trace writer's own process: `python -m earl.runtime.trace_process FILE` (see trace.py).
+
+It reads length-prefixed pickled batches from its standard input, written by
+`BackgroundSink` in the run's process (trusted: its parent), and applies them to a
+`McapSink`.  Ctrl-C reaches every process of the terminal: this one ignores it and
+finishes the file when the run says so, or when its input ends because the run
+was killed.  A write that fails (a full disk) ends it with exit code 1 and one line on
+standard error, which the run reports.
+"""
+
+from __future__ import annotations
+
+import pickle
+import signal
+import sys
+from typing import BinaryIO
+
+from earl.runtime.trace import _LENGTH, McapSink
+
+
+def _read_exactly(stream: BinaryIO, size: int) -> bytes | None:
+    data = stream.read(size)
+    return data if len(data) == size else None
+
+
+def write(path: str, source: BinaryIO) -> None:
+    with open(path, "wb") as output:
+        sink = McapSink(output)
+        while True:
+            header = _read_exactly(source, _LENGTH.size)
+            data = None if header is None else _read_exactly(source, _LENGTH.unpack(header)[0])
+            if data is None:  # the run ended without saying so (killed): keep what came
+                break
+            for item in pickle.loads(data):
+                kind = item[0]
+                if type(kind) is int:
+                    sink.message(*item)
+                elif kind == "channel":
+                    sink.channel(*item[1:])
+                else:  # "finish"
+                    sink.finish()
+                    return
+        sink.finish()
+
+
+def main(argv: list[str]) -> int:
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        write(argv[0], sys.stdin.buffer)
+    except OSError as error:
+        print(error.strerror or str(error), file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main(sys.argv[1:]))
