@@ -147,8 +147,8 @@ def test_usage_errors_exit_2_with_one_line(arguments: list[str], fragment: str) 
     assert "Traceback" not in result.stderr
 
 
-def test_ctrl_c_stops_the_run_cleanly_and_the_trace_stays_readable(tmp_path: Path) -> None:
-    trace = tmp_path / "run.mcap"
+def realtime_run_under_way(trace: Path) -> subprocess.Popen[str]:
+    """`earl run` of the counter in real time for a minute, a second after its trace appeared."""
     process = subprocess.Popen(
         [*EARL, "run", str(SPECS / "counter"), "--realtime", "--duration", "60s", "--trace", str(trace)],
         stdout=subprocess.PIPE,
@@ -159,6 +159,12 @@ def test_ctrl_c_stops_the_run_cleanly_and_the_trace_stays_readable(tmp_path: Pat
     while not trace.exists() and time.monotonic() < deadline:
         time.sleep(0.1)
     time.sleep(1.0)
+    return process
+
+
+def test_ctrl_c_stops_the_run_cleanly_and_the_trace_stays_readable(tmp_path: Path) -> None:
+    trace = tmp_path / "run.mcap"
+    process = realtime_run_under_way(trace)
     process.send_signal(signal.SIGINT)
     _, stderr = process.communicate(timeout=30)
     assert process.returncode == 130, stderr
@@ -172,17 +178,9 @@ def test_ctrl_c_stops_the_run_cleanly_and_the_trace_stays_readable(tmp_path: Pat
 def test_a_run_killed_with_sigkill_still_leaves_a_readable_trace(tmp_path: Path) -> None:
     """The trace's own process finishes the file when the run's process disappears."""
     trace = tmp_path / "run.mcap"
-    process = subprocess.Popen(
-        [*EARL, "run", str(SPECS / "counter"), "--realtime", "--duration", "60s", "--trace", str(trace)],
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-    )
-    deadline = time.monotonic() + 30
-    while not trace.exists() and time.monotonic() < deadline:
-        time.sleep(0.1)
-    time.sleep(1.0)
+    process = realtime_run_under_way(trace)
     process.kill()
-    process.wait(timeout=30)
+    process.communicate(timeout=30)
     summary = earl_cli("trace", "summary", str(trace))
     deadline = time.monotonic() + 20
     while summary.returncode != 0 and time.monotonic() < deadline:  # the writer may still be finishing
