@@ -4,7 +4,9 @@ Two figures, each the median of RUNS runs:
 
 - the run: `earl.simulate(...)` advancing 13 s of virtual time (physics, controllers, runtime);
 - the whole command: `earl run examples/pick_and_place` as a person types it, from the
-  interpreter's start (reading, checking, building the MuJoCo model) to its last line.
+  interpreter's start (reading, checking, building the MuJoCo model) to its last line;
+- the whole command with the demo's trace: the same with `--trace`, as `make demo` runs it
+  (its plot and picture, drawn after the run, left out), so the trace's cost shows.
 
 The peer is the wall clock itself: real time is 1x.
 
@@ -18,6 +20,7 @@ import os
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -42,10 +45,10 @@ def run_loop() -> dict[str, float]:
     return {"wall_s": wall, "cpu_s": cpu, "placed": float(placed)}
 
 
-def whole_command() -> float:
+def whole_command(*options: str) -> float:
     started = time.perf_counter()
     result = subprocess.run(
-        [sys.executable, "-m", "earl.cli.main", "run", str(EXAMPLE), "--no-progress"],
+        [sys.executable, "-m", "earl.cli.main", "run", str(EXAMPLE), "--no-progress", *options],
         capture_output=True,
         text=True,
         check=False,
@@ -59,10 +62,15 @@ def whole_command() -> float:
 
 def main() -> int:
     loops = [run_loop() for _ in range(RUNS)]
-    commands = [whole_command() for _ in range(RUNS)]
+    commands, traced = [], []
+    with tempfile.TemporaryDirectory() as scratch:
+        for _ in range(RUNS):  # interleaved: both meet the same moods of the machine
+            commands.append(whole_command())
+            traced.append(whole_command("--trace", str(Path(scratch) / "demo.mcap")))
     loop_wall = statistics.median(r["wall_s"] for r in loops)
     loop_cpu = statistics.median(r["cpu_s"] for r in loops)
     command = statistics.median(commands)
+    with_trace = statistics.median(traced)
     results = {
         "simulated_s": DURATION,
         "runs": RUNS,
@@ -75,6 +83,7 @@ def main() -> int:
             "placed_every_run": all(r["placed"] for r in loops),
         },
         "whole_command": {"wall_s": command, "real_time_factor": DURATION / command},
+        "whole_command_with_trace": {"wall_s": with_trace, "real_time_factor": DURATION / with_trace},
         "goal": ">= 5x real time",
     }
     out = HERE / "results" / "pick_and_place.json"
@@ -84,9 +93,11 @@ def main() -> int:
     print(f"{'the run (median of 3)':40} {loop_wall:8.2f} {DURATION / loop_wall:12.1f}")
     print(f"{'the run, CPU time':40} {loop_cpu:8.2f} {DURATION / loop_cpu:12.1f}")
     print(f"{'earl run, the whole command':40} {command:8.2f} {DURATION / command:12.1f}")
+    print(f"{'earl run --trace (as make demo)':40} {with_trace:8.2f} {DURATION / with_trace:12.1f}")
     print(
         f"goal >= 5x: run {'met' if DURATION / loop_wall >= 5 else 'NOT met'}, "
-        f"whole command {'met' if DURATION / command >= 5 else 'NOT met'}"
+        f"whole command {'met' if DURATION / command >= 5 else 'NOT met'}, "
+        f"with the demo's trace {'met' if DURATION / with_trace >= 5 else 'NOT met'}"
     )
     print(f"results: {out}")
     return 0
