@@ -25,6 +25,7 @@ from __future__ import annotations
 import contextlib
 import io
 import json
+import os
 import pickle
 import struct
 import subprocess
@@ -275,11 +276,15 @@ class BackgroundSink:
     def __init__(self, path: Path) -> None:
         self.path = path
         open(path, "wb").close()  # only to fail now if the file cannot be written
+        # the writer imports earl from where this process found it, installed or not
+        package_root = str(Path(__file__).resolve().parents[2])
+        search_path = os.pathsep.join(p for p in (package_root, os.environ.get("PYTHONPATH", "")) if p)
         self._process = subprocess.Popen(
             [sys.executable, "-m", "earl.runtime.trace_process", str(path)],
             stdin=subprocess.PIPE,
             stdout=subprocess.DEVNULL,
             stderr=subprocess.PIPE,
+            env={**os.environ, "PYTHONPATH": search_path},
         )
         self._batch: list[tuple[Any, ...]] = []
         self._due = _clock() + self.LATEST
@@ -331,7 +336,8 @@ class BackgroundSink:
             with contextlib.suppress(OSError):
                 process.stdin.close()
         process.wait()
-        why = process.stderr.read().decode("utf-8", "replace").strip() if process.stderr is not None else ""
+        said = process.stderr.read().decode("utf-8", "replace").strip() if process.stderr is not None else ""
+        why = said.splitlines()[-1] if said else ""  # the last line: the error itself, never a traceback
         raise TraceWriteError(
             f"cannot write the trace {self.path}: {why or f'its writer stopped (exit code {process.returncode})'}"
         )
