@@ -75,12 +75,22 @@ class Recorders(Recorder):
         self._message_recorders = [r for r in recorders if type(r).message_sent is not Recorder.message_sent]
         #: read by the engine at every send: a plain attribute, kept up to date by `add`
         self.wants_messages = bool(self._message_recorders)
+        self._route_messages()
 
     def add(self, recorder: Recorder) -> None:
         self.recorders.append(recorder)
         if type(recorder).message_sent is not Recorder.message_sent:
             self._message_recorders.append(recorder)
             self.wants_messages = True
+            self._route_messages()
+
+    def _route_messages(self) -> None:
+        # One recorder looks at messages (the trace, typically): the engine calls it directly, one
+        # call less for each of the thousands of messages a second a run sends.
+        if len(self._message_recorders) == 1:
+            self.message_sent = self._message_recorders[0].message_sent  # type: ignore[method-assign]
+        else:
+            self.__dict__.pop("message_sent", None)
 
     def state_changed(self, time: int, subsystem: str, source: str | None, destination: str, transition: str) -> None:
         for recorder in self.recorders:
