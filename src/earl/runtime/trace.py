@@ -23,6 +23,7 @@ while its trace is written on the other.  A stream (`io.BytesIO`) is written in-
 from __future__ import annotations
 
 import contextlib
+import gc
 import io
 import json
 import os
@@ -286,25 +287,48 @@ class BackgroundSink:
             stderr=subprocess.PIPE,
             env={**os.environ, "PYTHONPATH": search_path},
         )
-        self._batch: list[tuple[Any, ...]] = []
         self._due = _clock() + self.LATEST
         self._finished = False
+        self._start_batch()
+
+    def _start_batch(self) -> None:
+        # Four lists, not a tuple per message: appending what exists allocates nothing that Python's
+        # collector tracks, where thousands of new tuples a second would make it run hundreds of times.
+        self._numbers: list[int] = []
+        self._times: list[int] = []
+        self._sequences: list[int] = []
+        self._values: list[Any] = []
+        self._channels: list[tuple[Any, ...]] = []
 
     def channel(
         self, number: int, topic: str, schema_name: str, schema: dict[str, Any], metadata: dict[str, str]
     ) -> None:
-        self._batch.append(("channel", number, topic, schema_name, schema, metadata))
+        # with the number of messages before it in the batch: the writer keeps the order exactly
+        self._channels.append((len(self._values), number, topic, schema_name, schema, metadata))
 
     def message(self, channel: int, time: int, sequence: int, value: Any) -> None:
-        batch = self._batch
-        batch.append((channel, time, sequence, value))
-        if len(batch) >= self.BATCH or _clock() >= self._due:
+        if self._finished:  # failed already (and said so): what comes after is dropped
+            return
+        self._numbers.append(channel)
+        self._times.append(time)
+        self._sequences.append(sequence)
+        self._values.append(value)
+        if len(self._values) >= self.BATCH or _clock() >= self._due:
             self._send()
 
-    def _send(self) -> None:
+    def _send(self, finish: bool = False) -> None:
         buffer = io.BytesIO()
-        _PlainPickler(buffer, protocol=pickle.HIGHEST_PROTOCOL).dump(self._batch)
-        self._batch = []
+        batch = (self._channels, self._numbers, self._times, self._sequences, self._values, finish)
+        # The dicts the pickler makes of Records live until the batch is written, thousands of new
+        # objects that would set Python's collector off several times, to find no garbage.
+        collecting = gc.isenabled()
+        gc.disable()
+        try:
+            _PlainPickler(buffer, protocol=pickle.HIGHEST_PROTOCOL).dump(batch)
+        finally:
+            if collecting:
+                gc.enable()
+        self._start_batch()
         self._due = _clock() + self.LATEST
         data = buffer.getbuffer()
         stdin = self._process.stdin
@@ -313,6 +337,7 @@ class BackgroundSink:
             stdin.write(_LENGTH.pack(len(data)))
             stdin.write(data)
         except (BrokenPipeError, OSError):
+            del data
             self._fail()
 
     def finish(self) -> None:
@@ -320,8 +345,7 @@ class BackgroundSink:
         if self._finished:
             return
         self._finished = True
-        self._batch.append(("finish",))
-        self._send()
+        self._send(finish=True)
         stdin = self._process.stdin
         assert stdin is not None
         with contextlib.suppress(OSError):  # a writer that failed has closed its end: said below

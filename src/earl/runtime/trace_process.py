@@ -31,15 +31,24 @@ def write(path: str, source: BinaryIO) -> None:
             data = None if header is None else _read_exactly(source, _LENGTH.unpack(header)[0])
             if data is None:  # the run ended without saying so (killed): keep what came
                 break
-            for item in pickle.loads(data):
-                kind = item[0]
-                if type(kind) is int:
-                    sink.message(*item)
-                elif kind == "channel":
-                    sink.channel(*item[1:])
-                else:  # "finish"
-                    sink.finish()
-                    return
+            channels, numbers, times, sequences, values, finish = pickle.loads(data)
+            message = sink.message
+            done = 0
+            for position, *channel in channels:  # each after the messages that came before it
+                for item in zip(
+                    numbers[done:position],
+                    times[done:position],
+                    sequences[done:position],
+                    values[done:position],
+                    strict=True,
+                ):
+                    message(*item)
+                done = position
+                sink.channel(*channel)
+            for item in zip(numbers[done:], times[done:], sequences[done:], values[done:], strict=True):
+                message(*item)
+            if finish:
+                break
         sink.finish()
 
 
