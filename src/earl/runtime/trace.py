@@ -273,6 +273,8 @@ class BackgroundSink:
     #: a batch goes at the latest this long after the previous one (s): a run in real time sends
     #: few messages, and a run that is killed loses at most this much of its trace
     LATEST = 0.2
+    #: how long `finish` waits for the writer (s): it has a batch or two to write, unless the disk hangs
+    FINISH_TIMEOUT = 120.0
 
     def __init__(self, path: Path) -> None:
         self.path = path
@@ -350,7 +352,14 @@ class BackgroundSink:
         assert stdin is not None
         with contextlib.suppress(OSError):  # a writer that failed has closed its end: said below
             stdin.close()
-        if self._process.wait() != 0:
+        try:
+            code = self._process.wait(timeout=self.FINISH_TIMEOUT)
+        except subprocess.TimeoutExpired:
+            self._process.kill()
+            raise TraceWriteError(
+                f"cannot write the trace {self.path}: its writer did not finish within {self.FINISH_TIMEOUT:g} s"
+            ) from None
+        if code != 0:
             self._fail()
 
     def _fail(self) -> NoReturn:
