@@ -186,7 +186,9 @@ class FamilyOutputs:
             ) from None
 
     def __setitem__(self, index: int, value: Any) -> None:
-        target = self._target(index, write=True)
+        target = self._members.get(index)  # `_target` only to refuse: this runs for every member written
+        if target is None:
+            target = self._target(index, write=True)
         target.store[target.key] = target.coerce(value)
 
     def __getitem__(self, index: int) -> Value:
