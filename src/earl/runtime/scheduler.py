@@ -251,7 +251,8 @@ class Scheduler:
             if arrived > self.now:
                 self.now = arrived
             time = self.now
-            inbox.drain(time)  # what came before, first
+            if inbox.pending:
+                inbox.drain(time)  # what came before, first
             action(time, value)
             should_stop = self._should_stop
             queue = self._queue

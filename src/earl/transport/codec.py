@@ -170,7 +170,7 @@ def _fixed_reals(types: TypeSystem, data_type: DataType, fingerprint: bytes) -> 
 class LinkCodec:
     """Encodes and decodes the messages of one data type."""
 
-    __slots__ = ("_coerce", "_fixed", "_pack", "_prepare", "description", "encode", "fingerprint")
+    __slots__ = ("_coerce", "_fixed", "_pack", "_prepare", "description", "encode", "fingerprint", "fixed_decoder")
 
     def __init__(self, types: TypeSystem, data_type: DataType, where: str) -> None:
         self.description = describe(types, data_type)
@@ -181,6 +181,11 @@ class LinkCodec:
         self._fixed = _fixed_reals(types, data_type, self.fingerprint)
         #: `value` (already a checked run-time value: it left an output buffer) on the wire
         self.encode: Callable[[Any], bytes] = self._fixed.encode if self._fixed is not None else self._encode
+        #: for a fixed array of reals: the value of a well-formed message, None for anything else
+        #: (which `decode` then explains); None for other types
+        self.fixed_decoder: Callable[[bytes], Reals | None] | None = (
+            self._fixed.decode if self._fixed is not None else None
+        )
 
     def _encode(self, value: Any) -> bytes:
         prepare = self._prepare

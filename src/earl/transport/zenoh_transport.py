@@ -125,14 +125,23 @@ class _Input:
         self.channel = engine.channels[buffer]
         # bound once: every message goes through these on Zenoh's thread
         self._decode = codec.decode
+        #: a fixed array of reals' own decoder (None otherwise), called first: one call less per message
+        self._decode_fixed = codec.fixed_decoder
         self._hand_over = transport.inbox.put
         self._arrive = self.arrive
 
     # ---------------------------------------------------------------- on Zenoh's thread
     def on_sample(self, sample: zenoh.Sample) -> None:
         """Never raises: a bad message is counted (and the first one of each kind reported)."""
+        payload = sample.payload.to_bytes()
+        fixed = self._decode_fixed
+        value = fixed(payload) if fixed is not None else None
+        if value is not None:
+            self.statistics.messages += 1
+            self._hand_over(self._arrive, value)
+            return
         try:
-            value = self._decode(sample.payload.to_bytes())
+            value = self._decode(payload)
         except FingerprintMismatch as mismatch:
             self.statistics.refused += 1
             if self.statistics.refused == 1:
