@@ -263,7 +263,8 @@ class BackgroundSink:
     """A McapSink in a second process (`python -m earl.runtime.trace_process FILE`), fed in batches.
 
     The file is created here first, so that a path that cannot be written fails at once, in
-    the caller.  Records and Reals travel as the plain dicts and tuples they encode to.  If
+    the caller.  Records travel as the plain dicts they encode to (their classes are made at
+    run time, so the writer could not find them by name).  If
     this process ends without `finish` (killed), the writer sees its input end and finishes
     the file, which therefore stays readable.
     """
