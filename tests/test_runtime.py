@@ -294,16 +294,21 @@ r/r {
 """
 
 
-def test_a_lone_subsystem_that_waits_for_a_buffer_times_out_on_time(tmp_path: Path) -> None:
-    # One engine alone runs in the scheduler's tight loop (`_run_alone`); a wait must leave it
-    # for the timeout event exactly as the general loop does: start, wait 3 ms, start again.
-    (tmp_path / "system.earl").write_text(LONE_WAITER)
+def lone_waiter(tmp_path: Path, spec: str) -> tuple[Simulation, Events]:
+    """`spec` (LONE_WAITER or a variant) with its counting function, ready to run."""
+    (tmp_path / "system.earl").write_text(spec)
     (tmp_path / "waiting.py").write_text(
         "def count(inputs, outputs, context):\n    outputs.misses = inputs.misses + 1\n"
     )
     events = Events()
     # nothing sends `ping`: a rule of the manual the checker enforces, not the subject here
-    sim = earl.simulate(earl.load(tmp_path / "system.earl"), recorders=[events], check=False)
+    return earl.simulate(earl.load(tmp_path / "system.earl"), recorders=[events], check=False), events
+
+
+def test_a_lone_subsystem_that_waits_for_a_buffer_times_out_on_time(tmp_path: Path) -> None:
+    # One engine alone runs in the scheduler's tight loop (`_run_alone`); a wait must leave it
+    # for the timeout event exactly as the general loop does: start, wait 3 ms, start again.
+    sim, events = lone_waiter(tmp_path, LONE_WAITER)
     try:
         sim.advance_to(0.0100)
         waiter = sim.state_of("waiter/a.cs")
@@ -321,12 +326,7 @@ def test_stale_reads_the_set_of_buffers_whose_remote_sender_is_gone(tmp_path: Pa
     spec = LONE_WAITER.replace("missed/pp = timeout(ping/ib)", "missed/pp = stale(ping/ib)").replace(
         "state wait: wait/bb { obligatory ping/ib  timeout 3 ms }", "state wait: wait/bb"
     )
-    (tmp_path / "system.earl").write_text(spec)
-    (tmp_path / "waiting.py").write_text(
-        "def count(inputs, outputs, context):\n    outputs.misses = inputs.misses + 1\n"
-    )
-    events = Events()
-    sim = earl.simulate(earl.load(tmp_path / "system.earl"), recorders=[events], check=False)
+    sim, events = lone_waiter(tmp_path, spec)
     try:
         sim.advance_to(0.0025)
         assert [b for _, _, _, b in events.states] == ["wait"]  # never stale: no transition

@@ -501,13 +501,18 @@ class _Plant:
         pass
 
 
-def _served_run(tmp_path: Path, environment: object, values: list[float]) -> tuple[Any, list[tuple[float, str]]]:
+def _served_simulation(tmp_path: Path, environment: object) -> tuple[Simulation, _InboxOnly]:
     (tmp_path / "system.earl").write_text(SERVED_SPEC)
     (tmp_path / "served.py").write_text(SERVED_CODE)
     transport = _InboxOnly()
     simulation = Simulation(
         earl.load(tmp_path / "system.earl"), environment=environment, realtime=True, transport=transport
     )
+    return simulation, transport
+
+
+def _served_run(tmp_path: Path, environment: object, values: list[float]) -> tuple[Any, list[tuple[float, str]]]:
+    simulation, transport = _served_simulation(tmp_path, environment)
     import served  # type: ignore[import-not-found]  # bound by the Simulation from tmp_path
 
     served.calls.clear()
@@ -549,10 +554,7 @@ def test_with_an_environment_every_message_is_handed_over_to_the_scheduler(tmp_p
 
 
 def test_what_fails_while_serving_is_raised_in_the_scheduler_thread(tmp_path: Path) -> None:
-    (tmp_path / "system.earl").write_text(SERVED_SPEC)
-    (tmp_path / "served.py").write_text(SERVED_CODE)
-    transport = _InboxOnly()
-    simulation = Simulation(earl.load(tmp_path / "system.earl"), environment=None, realtime=True, transport=transport)
+    simulation, transport = _served_simulation(tmp_path, None)
     simulation.advance_to(0.01)
 
     def broken(time: int, value: Any) -> None:

@@ -32,21 +32,17 @@ def write(path: str, source: BinaryIO) -> None:
             if data is None:  # the run ended without saying so (killed): keep what came
                 break
             channels, numbers, times, sequences, values, finish = pickle.loads(data)
-            message = sink.message
-            done = 0
-            for position, *channel in channels:  # each after the messages that came before it
-                for item in zip(
-                    numbers[done:position],
-                    times[done:position],
-                    sequences[done:position],
-                    values[done:position],
-                    strict=True,
-                ):
-                    message(*item)
-                done = position
-                sink.channel(*channel)
-            for item in zip(numbers[done:], times[done:], sequences[done:], values[done:], strict=True):
-                message(*item)
+            # each channel is registered where it came among the messages (its position)
+            pending = iter(channels)
+            channel = next(pending, None)
+            for position, item in enumerate(zip(numbers, times, sequences, values, strict=True)):
+                while channel is not None and channel[0] == position:
+                    sink.channel(*channel[1:])
+                    channel = next(pending, None)
+                sink.message(*item)
+            while channel is not None:  # registered after the batch's last message
+                sink.channel(*channel[1:])
+                channel = next(pending, None)
             if finish:
                 break
         sink.finish()
