@@ -1,6 +1,7 @@
 """One subsystem at run time: Figure 5 of the manual, to the letter (docs/semantics.md).
 
-`bb.execute()` is one iteration, `iterate()` here:
+`bb.execute()` is one iteration, `iterate()` here, compiled per FSM state by
+earl/runtime/compiled_iteration.py from the methods below:
 
     1. tf.execute(): the stages in order, the functions of a stage on one snapshot
        (Eq. 4–8), compiled per behaviour by earl/runtime/iteration.py
@@ -27,8 +28,9 @@ from typing import Any, Protocol
 
 from earl.runtime.binding import UserFunction
 from earl.runtime.channels import Channel
+from earl.runtime.compiled_iteration import Iterate, compile_iteration
 from earl.runtime.events import Fault, Recorder
-from earl.runtime.iteration import Execute, compile_execute
+from earl.runtime.iteration import Execute
 from earl.runtime.predicates import CompiledPredicate
 from earl.runtime.values import ValueTypeError
 from earl.runtime.views import Context, Inputs, Outputs, UndeclaredAccess, explain
@@ -73,6 +75,8 @@ class StateRuntime:
     timeout: int | None  # nanoseconds
     #: leaving transitions, highest priority first, then in declaration order
     transitions: list[TransitionRuntime]
+    #: one whole iteration in this state, compiled at its first use
+    iterate: Iterate | None = None
 
 
 class Sink(Protocol):
@@ -135,58 +139,40 @@ class SubsystemEngine:
         self.on_delivery: Callable[[SubsystemEngine], None] | None = None
         self.waiting = False
         self.iteration_start = 0
+        #: one whole iteration in the current state (earl/runtime/compiled_iteration.py); set by `start`
+        self.iterate: Iterate = self._not_started
+
+    def _not_started(self, time: int) -> bool:
+        raise RuntimeError(f"{self.name} has not started: its FSM has no state yet")
 
     # ------------------------------------------------------------------ set-up
     def start(self, initial: str, time: int) -> None:
         """`fsm.run()` begins in the initial state `ifs`."""
         self.state = self.states[initial]
+        self.iterate = self._iteration_of(self.state)
         self.iteration = 0
         self.recorder.state_changed(time, self.name, None, initial, f"*,{initial}")
         self.recorder.behaviour_started(time, self.name, initial, self.state.behaviour.name)
 
-    # ------------------------------------------------------------------ Figure 5b, steps 1-3
-    def iterate(self, time: int) -> bool:
-        """One whole iteration (steps 1-5) when the state waits for no buffer that is still empty.
+    # ------------------------------------------------------------------ Figure 5b, steps 1-5
+    def _iteration_of(self, state: StateRuntime) -> Iterate:
+        """`iterate(time)` while in `state`: one whole iteration (steps 1-5), compiled at its first use.
 
-        False after step 3 when an obligatory input buffer is empty: the scheduler then waits
-        for it (or its timeout) and calls `receive` and `decide` itself. One method rather than
-        the scheduler calling each step, because this is the path of nearly every iteration.
+        It returns False after step 3 when an obligatory input buffer is empty: the scheduler then
+        waits for it (or its timeout) and calls `receive` and `decide` itself.
         """
-        state = self.state
-        assert state is not None
-        behaviour = state.behaviour
-        self.iteration_start = time
-        self._error_in_iteration = False
-        execute = behaviour.execute
-        if execute is None:
-            execute = behaviour.execute = compile_execute(
-                behaviour.stages, self.memory, self.context, self._function_fault
-            )
-        sent = execute(time)
-        if sent:
-            self._send(time, sent)
-        self.iteration += 1
-        self.total_iterations += 1
-        if state.obligatory and not self.obligatory_ready():
-            return False
-        if self.channels or self._timeouts_set or self.stale:
-            self.receive(time)
-        if self._error_in_iteration or not behaviour.never_ends:
-            self.decide(time)
-        return True
+        if state.iterate is not None:
+            return state.iterate
 
-    def _send(self, time: int, sent: dict[str, Any]) -> None:
-        # a recorder that looks at no message (no trace) is not called for each of them
-        record = self.recorder.message_sent if self.recorder.wants_messages else None
-        destinations = self.destinations
-        for key, value in sent.items():
-            for destination in destinations.get(key, ()):
-                destination.channel.deliver(value)
-                if record is not None:
-                    record(time, destination.link, value)
-                engine = destination.engine
-                if engine is not None and engine.waiting and engine.on_delivery is not None:
-                    engine.on_delivery(engine)
+        def first(time: int) -> bool:
+            # compiled when first run rather than when built: the scheduler and the transport have
+            # set up links, recorders and waits by then
+            state.iterate = compile_iteration(self, state)
+            if self.state is state:
+                self.iterate = state.iterate
+            return state.iterate(time)
+
+        return first
 
     def _function_fault(self, time: int, function: str, raised: Exception) -> None:
         error = explain(raised)
@@ -315,6 +301,7 @@ class SubsystemEngine:
         self.recorder.behaviour_stopped(time, self.name, state.name, state.behaviour.name, self.iteration, reason)
         self.recorder.state_changed(time, self.name, state.name, transition.destination, transition.name)
         self.state = self.states[transition.destination]
+        self.iterate = self._iteration_of(self.state)
         self.iteration = 0
         self._stuck = False
         self.recorder.behaviour_started(time, self.name, self.state.name, self.state.behaviour.name)

@@ -6,8 +6,12 @@ another.  Times are integer nanoseconds of run time (simulated or wall).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
+
+#: records one message of one link: `write(time, value)`
+MessageWriter = Callable[[int, Any], None]
 
 
 @dataclass
@@ -39,9 +43,6 @@ class SubsystemStatistics:
 class Recorder:
     """Receives the events of a run; this base class ignores them all."""
 
-    #: whether `message_sent` should be called at all (messages are the most frequent event)
-    wants_messages: bool = True
-
     def state_changed(self, time: int, subsystem: str, source: str | None, destination: str, transition: str) -> None:
         pass
 
@@ -55,6 +56,19 @@ class Recorder:
 
     def message_sent(self, time: int, link: str, value: Any) -> None:
         pass
+
+    def message_writer(self, link: str) -> MessageWriter | None:
+        """What records each message sent on `link`, or None if nothing would.
+
+        The engine asks once per link, when it compiles the iteration that sends on it, and then
+        calls the writer for every message: messages are the most frequent event of a run, and
+        a link that nobody records then costs nothing per message. This default calls
+        `message_sent`, if the recorder has one of its own.
+        """
+        if type(self).message_sent is Recorder.message_sent:
+            return None
+        sent = self.message_sent
+        return lambda time, value: sent(time, link, value)
 
     def memory_snapshot(self, time: int, subsystem: str, memory: dict[str, Any]) -> None:
         pass
@@ -71,26 +85,21 @@ class Recorders(Recorder):
 
     def __init__(self, recorders: list[Recorder]) -> None:
         self.recorders = recorders
-        # messages are the most frequent event: call only the recorders that look at them
-        self._message_recorders = [r for r in recorders if type(r).message_sent is not Recorder.message_sent]
-        #: read by the engine at every send: a plain attribute, kept up to date by `add`
-        self.wants_messages = bool(self._message_recorders)
-        self._route_messages()
 
     def add(self, recorder: Recorder) -> None:
+        """Another recorder; add it before the run starts (the engines ask for message writers then)."""
         self.recorders.append(recorder)
-        if type(recorder).message_sent is not Recorder.message_sent:
-            self._message_recorders.append(recorder)
-            self.wants_messages = True
-            self._route_messages()
 
-    def _route_messages(self) -> None:
-        # One recorder looks at messages (the trace, typically): the engine calls it directly, one
-        # call less for each of the thousands of messages a second a run sends.
-        if len(self._message_recorders) == 1:
-            self.message_sent = self._message_recorders[0].message_sent  # type: ignore[method-assign]
-        else:
-            self.__dict__.pop("message_sent", None)
+    def message_writer(self, link: str) -> MessageWriter | None:
+        writers = [w for w in (r.message_writer(link) for r in self.recorders) if w is not None]
+        if len(writers) <= 1:
+            return writers[0] if writers else None
+
+        def write(time: int, value: Any) -> None:
+            for writer in writers:
+                writer(time, value)
+
+        return write
 
     def state_changed(self, time: int, subsystem: str, source: str | None, destination: str, transition: str) -> None:
         for recorder in self.recorders:
@@ -107,7 +116,7 @@ class Recorders(Recorder):
             recorder.behaviour_stopped(time, subsystem, state, behaviour, iterations, reason)
 
     def message_sent(self, time: int, link: str, value: Any) -> None:
-        for recorder in self._message_recorders:
+        for recorder in self.recorders:
             recorder.message_sent(time, link, value)
 
     def memory_snapshot(self, time: int, subsystem: str, memory: dict[str, Any]) -> None:

@@ -346,10 +346,10 @@ class Scheduler:
                 self.now = next_start
                 next_start = self._start(engine, next_start)
             return next_start
-        iterate = engine.iterate
         while following <= last:
             self.now = following
-            if not iterate(following):
+            # looked up each time: the engine's `iterate` changes with its state
+            if not engine.iterate(following):
                 self._wait(engine, following)
                 return None
             following += period

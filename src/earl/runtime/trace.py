@@ -32,6 +32,7 @@ import struct
 import subprocess
 import sys
 import time
+from collections.abc import Callable
 from fnmatch import fnmatchcase
 from pathlib import Path
 from typing import IO, Any, NoReturn
@@ -40,7 +41,7 @@ from mcap.writer import CompressionType, Writer
 
 from earl import __version__
 from earl.model.types import DataType
-from earl.runtime.events import Fault, Recorder
+from earl.runtime.events import Fault, MessageWriter, Recorder
 from earl.runtime.values import Record, TypeSystem, json_schema, to_json
 
 _STATE_SCHEMA = {
@@ -93,7 +94,12 @@ def _encode(value: Any) -> bytes:
 
 
 class McapSink:
-    """Writes what a TraceWriter decides into an MCAP file: channels, then messages as JSON."""
+    """Writes what a TraceWriter decides into an MCAP file: channels, then messages as JSON.
+
+    A message's sequence number is its position among all the messages of the file (from 1).
+    A channel registered with `wrap` carries a link's values: those that are not structs are
+    written as `{"value": ...}`, since Foxglove's JSON messages are objects.
+    """
 
     def __init__(self, stream: IO[bytes]) -> None:
         self.writer = Writer(stream, compression=CompressionType.ZSTD)
@@ -101,9 +107,17 @@ class McapSink:
         self._schemas: dict[str, int] = {}
         #: the TraceWriter's channel numbers -> the MCAP writer's
         self._channels: dict[int, int] = {}
+        self._wrapped: set[int] = set()
+        self._sequence = 0
 
     def channel(
-        self, number: int, topic: str, schema_name: str, schema: dict[str, Any], metadata: dict[str, str]
+        self,
+        number: int,
+        topic: str,
+        schema_name: str,
+        schema: dict[str, Any],
+        metadata: dict[str, str],
+        wrap: bool = False,
     ) -> None:
         schema_id = self._schemas.get(schema_name)
         if schema_id is None:
@@ -113,11 +127,28 @@ class McapSink:
         self._channels[number] = self.writer.register_channel(
             topic=topic, message_encoding="json", schema_id=schema_id, metadata=metadata
         )
+        if wrap:
+            self._wrapped.add(number)
 
-    def message(self, channel: int, time: int, sequence: int, value: Any) -> None:
+    def message(self, channel: int, time: int, value: Any) -> None:
+        if channel in self._wrapped and not isinstance(value, dict):
+            value = {"value": value}
+        self._sequence += 1
         self.writer.add_message(
-            self._channels[channel], log_time=time, data=_encode(value), publish_time=time, sequence=sequence
+            self._channels[channel], log_time=time, data=_encode(value), publish_time=time, sequence=self._sequence
         )
+
+    def writer_of(self, register: Callable[[], int]) -> MessageWriter:
+        """`message` for one channel, which `register()` registers at the first message and numbers."""
+        channel = 0
+
+        def write(time: int, value: Any) -> None:
+            nonlocal channel
+            if not channel:
+                channel = register()
+            self.message(channel, time, value)
+
+        return write
 
     def finish(self) -> None:
         self.writer.finish()  # type: ignore[no-untyped-call]
@@ -149,20 +180,20 @@ class TraceWriter(Recorder):
         self._channels: dict[str, int | None] = {}
         #: link -> channel number or None, the same as `_channels` without making the topic's name
         self._links: dict[str, int | None] = {}
-        self._sequence = 0
         self.closed = False
 
     # ------------------------------------------------------------------ plumbing
-    def _channel(self, topic: str, schema_name: str, schema: dict[str, Any], metadata: dict[str, str]) -> int:
+    def _channel(
+        self, topic: str, schema_name: str, schema: dict[str, Any], metadata: dict[str, str], wrap: bool = False
+    ) -> int:
         found = self._channels.get(topic)
         if found is None:
             found = self._channels[topic] = len(self._channels) + 1
-            self._sink.channel(found, topic, schema_name, schema, metadata)
+            self._sink.channel(found, topic, schema_name, schema, metadata, wrap)
         return found
 
     def _write(self, channel: int, time: int, message: Any) -> None:
-        self._sequence += 1
-        self._sink.message(channel, time, self._sequence, message)
+        self._sink.message(channel, time, message)
 
     # ------------------------------------------------------------------ events
     def run_started(self, settings: dict[str, Any]) -> None:
@@ -191,16 +222,37 @@ class TraceWriter(Recorder):
         )
 
     def message_sent(self, time: int, link: str, value: Any) -> None:
+        channel = self._link(link)
+        if channel is not None:
+            self._write(channel, time, value)
+
+    def message_writer(self, link: str) -> MessageWriter | None:
+        """The sink's own writer for the link's channel, or None if the link is not recorded.
+
+        The channel is registered at the link's first message, as with `message_sent`, so that
+        the file is the same whichever way its messages came."""
+        if self._links.get(link, -1) is None or not self._recorded(link):
+            return None
+
+        def register() -> int:
+            channel = self._link(link)
+            assert channel is not None  # a recorded link has a channel
+            return channel
+
+        return self._sink.writer_of(register)
+
+    def _recorded(self, link: str) -> bool:
+        return self.link_patterns is None or any(fnmatchcase(link, p) for p in self.link_patterns)
+
+    def _link(self, link: str) -> int | None:
         channel = self._links.get(link, -1)
         if channel == -1:
             channel = self._links[link] = self._link_channel(link)
-        if channel is None:
-            return
-        self._write(channel, time, value if isinstance(value, Record) else {"value": value})
+        return channel
 
     def _link_channel(self, link: str) -> int | None:
         topic = f"link/{link}"
-        if self.link_patterns is not None and not any(fnmatchcase(link, p) for p in self.link_patterns):
+        if not self._recorded(link):
             self._channels[topic] = None
             return None
         data_type = self.link_types.get(link)
@@ -213,7 +265,8 @@ class TraceWriter(Recorder):
             else:
                 schema = {"type": "object", "properties": {"value": inner}}
                 name = f"earl.{type(data_type).__name__}.{json.dumps(inner, sort_keys=True)}"
-        return self._channel(topic, name, schema, {"link": link, "source": self.link_sources.get(link, "")})
+        metadata = {"link": link, "source": self.link_sources.get(link, "")}
+        return self._channel(topic, name, schema, metadata, wrap=True)
 
     def memory_snapshot(self, time: int, subsystem: str, memory: dict[str, Any]) -> None:
         topic = f"{subsystem}/memory"
@@ -295,33 +348,62 @@ class BackgroundSink:
         self._start_batch()
 
     def _start_batch(self) -> None:
-        # Four lists, not a tuple per message: appending what exists allocates nothing that Python's
+        # Three lists, not a tuple per message: appending what exists allocates nothing that Python's
         # collector tracks, where thousands of new tuples a second would make it run hundreds of times.
+        # They are emptied in place after each batch, so that the writers keep their `append`s.
         self._numbers: list[int] = []
         self._times: list[int] = []
-        self._sequences: list[int] = []
         self._values: list[Any] = []
         self._channels: list[tuple[Any, ...]] = []
 
     def channel(
-        self, number: int, topic: str, schema_name: str, schema: dict[str, Any], metadata: dict[str, str]
+        self,
+        number: int,
+        topic: str,
+        schema_name: str,
+        schema: dict[str, Any],
+        metadata: dict[str, str],
+        wrap: bool = False,
     ) -> None:
         # with the number of messages before it in the batch: the writer keeps the order exactly
-        self._channels.append((len(self._values), number, topic, schema_name, schema, metadata))
+        self._channels.append((len(self._values), number, topic, schema_name, schema, metadata, wrap))
 
-    def message(self, channel: int, time: int, sequence: int, value: Any) -> None:
+    def message(self, channel: int, time: int, value: Any) -> None:
         if self._finished:  # failed already (and said so): what comes after is dropped
             return
         self._numbers.append(channel)
         self._times.append(time)
-        self._sequences.append(sequence)
         self._values.append(value)
         if len(self._values) >= self.BATCH or _clock() >= self._due:
             self._send()
 
+    def writer_of(self, register: Callable[[], int]) -> MessageWriter:
+        """`message` for one channel, which `register()` registers at the first message and numbers: a
+        closure over the batch's lists, since it is the path of every message of a link."""
+        numbers, times, values = self._numbers.append, self._times.append, self._values.append
+        batch = self._values
+        limit = self.BATCH
+        send = self._send
+        channel = 0
+
+        def write(time: int, value: Any) -> None:
+            nonlocal channel
+            if not channel:
+                channel = register()
+            numbers(channel)
+            times(time)
+            values(value)
+            if len(batch) >= limit or _clock() >= self._due:
+                if self._finished:  # failed already (and said so): what comes after is dropped
+                    batch.clear()
+                    return
+                send()
+
+        return write
+
     def _send(self, finish: bool = False) -> None:
         buffer = io.BytesIO()
-        batch = (self._channels, self._numbers, self._times, self._sequences, self._values, finish)
+        batch = (self._channels, self._numbers, self._times, self._values, finish)
         # The dicts the pickler makes of Records live until the batch is written, thousands of new
         # objects that would set Python's collector off several times, to find no garbage.
         collecting = gc.isenabled()
@@ -331,7 +413,10 @@ class BackgroundSink:
         finally:
             if collecting:
                 gc.enable()
-        self._start_batch()
+        self._numbers.clear()
+        self._times.clear()
+        self._values.clear()
+        self._channels = []
         self._due = _clock() + self.LATEST
         data = buffer.getbuffer()
         stdin = self._process.stdin

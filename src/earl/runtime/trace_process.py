@@ -31,11 +31,11 @@ def write(path: str, source: BinaryIO) -> None:
             data = None if header is None else _read_exactly(source, _LENGTH.unpack(header)[0])
             if data is None:  # the run ended without saying so (killed): keep what came
                 break
-            channels, numbers, times, sequences, values, finish = pickle.loads(data)
+            channels, numbers, times, values, finish = pickle.loads(data)
             # each channel is registered where it came among the messages (its position)
             pending = iter(channels)
             channel = next(pending, None)
-            for position, item in enumerate(zip(numbers, times, sequences, values, strict=True)):
+            for position, item in enumerate(zip(numbers, times, values, strict=True)):
                 while channel is not None and channel[0] == position:
                     sink.channel(*channel[1:])
                     channel = next(pending, None)
