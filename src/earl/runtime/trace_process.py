@@ -10,6 +10,7 @@ standard error, which the run reports.
 
 from __future__ import annotations
 
+import logging
 import pickle
 import signal
 import sys
@@ -43,6 +44,7 @@ def write(path: str, source: BinaryIO) -> None:
             while channel is not None:  # registered after the batch's last message
                 sink.channel(*channel[1:])
                 channel = next(pending, None)
+            sink.output.raise_error()  # a write that failed (a full disk) ends the run's trace now
             if finish:
                 break
         sink.finish()
@@ -50,6 +52,9 @@ def write(path: str, source: BinaryIO) -> None:
 
 def main(argv: list[str]) -> int:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    # The SDK logs a line for every message it cannot write; the run reads this process's last
+    # line of standard error only at the end, so the first error is reported (above) instead.
+    logging.disable(logging.CRITICAL)
     try:
         write(argv[0], sys.stdin.buffer)
     except OSError as error:
