@@ -23,11 +23,8 @@ while its trace is written on the other.  A stream (`io.BytesIO`) is written in-
 from __future__ import annotations
 
 import contextlib
-import gc
-import io
 import json
 import os
-import pickle
 import struct
 import subprocess
 import sys
@@ -37,10 +34,12 @@ from fnmatch import fnmatchcase
 from pathlib import Path
 from typing import IO, Any, NoReturn
 
+import msgpack  # type: ignore[import-untyped]
+
 from earl import __version__
 from earl.model.types import DataType
 from earl.runtime.events import Fault, MessageWriter, Recorder
-from earl.runtime.values import Record, TypeSystem, json_schema, to_json
+from earl.runtime.values import TypeSystem, json_schema, to_json
 
 _STATE_SCHEMA = {
     "type": "object",
@@ -368,10 +367,11 @@ class BackgroundSink:
     """A McapSink in a second process (`python -m earl.runtime.trace_process FILE`), fed in batches.
 
     The file is created here first, so that a path that cannot be written fails at once, in
-    the caller.  Records travel as the plain dicts they encode to (their classes are made at
-    run time, so the writer could not find them by name).  If
-    this process ends without `finish` (killed), the writer sees its input end and finishes
-    the file, which therefore stays readable.
+    the caller. A batch travels as msgpack: it packs Records as maps and Reals as arrays in C,
+    as the plain values they are in JSON, where pickle would call back into Python for each
+    (their classes are made at run time, so the writer could not find them by name anyway).
+    If this process ends without `finish` (killed), the writer sees its input end and
+    finishes the file, which therefore stays readable.
     """
 
     #: messages per batch: large enough to make the hand-over cheap, small enough to stay in flight
@@ -397,6 +397,7 @@ class BackgroundSink:
         )
         self._due = _clock() + self.LATEST
         self._finished = False
+        self._packer = msgpack.Packer(use_bin_type=True, default=_plain)
         self._start_batch()
 
     def _start_batch(self) -> None:
@@ -454,23 +455,13 @@ class BackgroundSink:
         return write
 
     def _send(self, finish: bool = False) -> None:
-        buffer = io.BytesIO()
         batch = (self._channels, self._numbers, self._times, self._values, finish)
-        # The dicts the pickler makes of Records live until the batch is written, thousands of new
-        # objects that would set Python's collector off several times, to find no garbage.
-        collecting = gc.isenabled()
-        gc.disable()
-        try:
-            _PlainPickler(buffer, protocol=pickle.HIGHEST_PROTOCOL).dump(batch)
-        finally:
-            if collecting:
-                gc.enable()
+        data = self._packer.pack(batch)
         self._numbers.clear()
         self._times.clear()
         self._values.clear()
         self._channels = []
         self._due = _clock() + self.LATEST
-        data = buffer.getbuffer()
         stdin = self._process.stdin
         assert stdin is not None
         try:
@@ -514,17 +505,11 @@ class BackgroundSink:
         )
 
 
-#: the length of each pickled batch, before it
+#: the length of each batch, before it
 _LENGTH = struct.Struct("<Q")
 _clock = time.monotonic
 
 
-class _PlainPickler(pickle.Pickler):
-    """Pickles Records as the dicts they are as JSON: a Record's class is made at run time and cannot
-    be found by name in another process."""
-
-    def reducer_override(self, obj: Any) -> Any:
-        # called only for instances of subclasses (pickle's own types never reach it); Reals pickle as they are
-        if isinstance(obj, Record):
-            return (dict, (dict(obj),))
-        return NotImplemented
+def _plain(value: Any) -> Any:
+    """What msgpack cannot pack by itself, as JSON would have it (a NumPy array a function left in memory)."""
+    return to_json(value)

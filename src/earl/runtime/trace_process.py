@@ -1,6 +1,6 @@
 """The trace writer's own process: `python -m earl.runtime.trace_process FILE` (see trace.py).
 
-It reads length-prefixed pickled batches from its standard input, written by
+It reads length-prefixed msgpack batches from its standard input, written by
 `BackgroundSink` in the run's process (trusted: its parent), and applies them to a
 `McapSink`.  Ctrl-C reaches every process of the terminal: this one ignores it and
 finishes the file when the run says so, or when its input ends because the run
@@ -11,10 +11,11 @@ standard error, which the run reports.
 from __future__ import annotations
 
 import logging
-import pickle
 import signal
 import sys
 from typing import BinaryIO
+
+import msgpack  # type: ignore[import-untyped]
 
 from earl.runtime.trace import _LENGTH, McapSink
 
@@ -32,7 +33,7 @@ def write(path: str, source: BinaryIO) -> None:
             data = None if header is None else _read_exactly(source, _LENGTH.unpack(header)[0])
             if data is None:  # the run ended without saying so (killed): keep what came
                 break
-            channels, numbers, times, values, finish = pickle.loads(data)
+            channels, numbers, times, values, finish = msgpack.unpackb(data, use_list=False, strict_map_key=False)
             # each channel is registered where it came among the messages (its position)
             pending = iter(channels)
             channel = next(pending, None)
