@@ -25,6 +25,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import select
 import struct
 import subprocess
 import sys
@@ -481,25 +482,46 @@ class BackgroundSink:
         assert stdin is not None
         with contextlib.suppress(OSError):  # a writer that failed has closed its end: said below
             stdin.close()
-        try:
-            code = self._process.wait(timeout=self.FINISH_TIMEOUT)
-        except subprocess.TimeoutExpired:
-            self._process.kill()
-            raise TraceWriteError(
-                f"cannot write the trace {self.path}: its writer did not finish within {self.FINISH_TIMEOUT:g} s"
-            ) from None
-        if code != 0:
-            self._fail()
+        said = self._read_until_exit()
+        if self._process.wait() != 0:
+            self._fail(said)
 
-    def _fail(self) -> NoReturn:
+    def _read_until_exit(self) -> bytes:
+        """What the writer says on standard error until it exits (its end of the pipe closes then).
+
+        Waiting on the pipe wakes up the moment the writer ends; `Popen.wait` with a timeout
+        polls with sleeps of up to 50 ms instead, which every run would wait out at its end.
+        """
+        stderr = self._process.stderr
+        assert stderr is not None
+        descriptor = stderr.fileno()
+        deadline = _clock() + self.FINISH_TIMEOUT
+        said: list[bytes] = []
+        while True:
+            remaining = deadline - _clock()
+            if remaining <= 0 or not select.select([descriptor], [], [], remaining)[0]:
+                self._process.kill()
+                self._process.wait()
+                raise TraceWriteError(
+                    f"cannot write the trace {self.path}: its writer did not finish within {self.FINISH_TIMEOUT:g} s"
+                )
+            chunk = os.read(descriptor, 65536)
+            if not chunk:
+                return b"".join(said)
+            said.append(chunk)
+
+    def _fail(self, said: bytes | None = None) -> NoReturn:
+        """Raise what went wrong in the writer: `said` is its standard error, if already read."""
         self._finished = True
         process = self._process
         if process.stdin is not None:
             with contextlib.suppress(OSError):
                 process.stdin.close()
+        if said is None:
+            said = self._read_until_exit()
         process.wait()
-        said = process.stderr.read().decode("utf-8", "replace").strip() if process.stderr is not None else ""
-        why = said.splitlines()[-1] if said else ""  # the last line: the error itself, never a traceback
+        text = said.decode("utf-8", "replace").strip()
+        why = text.splitlines()[-1] if text else ""  # the last line: the error itself, never a traceback
         raise TraceWriteError(
             f"cannot write the trace {self.path}: {why or f'its writer stopped (exit code {process.returncode})'}"
         )
