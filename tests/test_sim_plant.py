@@ -186,3 +186,23 @@ def test_pictures_are_png_or_the_reason_why_not(tmp_path: object) -> None:
     written = video.save(out / "clip")
     assert written.exists() and written.suffix in {".mp4", ".gif"}
     plant.close()
+
+
+def test_importing_earl_sim_without_a_display_loads_no_opengl_until_a_picture_is_taken() -> None:
+    import os
+    import subprocess
+    import sys
+
+    environment = {k: v for k, v in os.environ.items() if k not in ("MUJOCO_GL", "DISPLAY", "PYOPENGL_PLATFORM")}
+    probe = (
+        "import os, sys, earl.sim\n"
+        "print('OpenGL' in sys.modules, os.environ.get('MUJOCO_GL'))\n"
+        "earl.sim.use_offscreen_backend()\n"
+        "from mujoco.rendering.classic import gl_context\n"
+        "print(os.environ.get('MUJOCO_GL'), gl_context.GLContext.__module__)\n"
+    )
+    result = subprocess.run(
+        [sys.executable, "-c", probe], capture_output=True, text=True, env=environment, timeout=60, check=True
+    )
+    # a run without pictures never loads PyOpenGL, and leaves MUJOCO_GL unset for the processes it starts
+    assert result.stdout.splitlines() == ["False None", "egl mujoco.egl"]

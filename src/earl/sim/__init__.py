@@ -10,17 +10,54 @@ takes pictures offscreen.  See docs/simulation.md.
 
 from __future__ import annotations
 
+import importlib
+import importlib.util
 import os
 import sys
+from pathlib import Path
 
 #: MuJoCo was imported before earl.sim could choose its OpenGL backend (render.py says so when it matters)
 MUJOCO_IMPORTED_FIRST = "mujoco" in sys.modules
 
-# MuJoCo picks its OpenGL backend when it is first imported; without a display the
-# only backends that work are EGL and OSMesa, and EGL is the faster one.
+#: the module of MuJoCo that picks its OpenGL backend, when it is first imported, from `MUJOCO_GL`
+_GL_CONTEXT = "mujoco.rendering.classic.gl_context"
+#: the backend earl.sim chose and has not turned on yet (see `use_offscreen_backend`)
+_deferred_backend: str | None = None
+
+
+def _knows_gl_context() -> bool:
+    """Whether this MuJoCo picks its backend in `_GL_CONTEXT`, found without importing MuJoCo."""
+    spec = importlib.util.find_spec("mujoco")
+    origin = spec.origin if spec is not None else None
+    return origin is not None and (Path(origin).parent / "rendering" / "classic" / "gl_context.py").is_file()
+
+
+# Without a display the only backends that work are EGL and OSMesa, and EGL is the faster one.
+# Importing it (PyOpenGL) costs a tenth of a second that a run without pictures never needs:
+# MuJoCo is imported with rendering off, and `use_offscreen_backend` turns EGL on before the
+# first picture. The environment is left as it was, so that other processes choose for themselves.
 if "MUJOCO_GL" not in os.environ and not os.environ.get("DISPLAY") and not MUJOCO_IMPORTED_FIRST:
-    os.environ["MUJOCO_GL"] = "egl"
+    if _knows_gl_context():
+        os.environ["MUJOCO_GL"] = "disable"
+        try:
+            import mujoco  # noqa: F401
+        finally:
+            del os.environ["MUJOCO_GL"]
+        _deferred_backend = "egl"
+    else:
+        os.environ["MUJOCO_GL"] = "egl"
+
+
+def use_offscreen_backend() -> None:
+    """Turn on the OpenGL backend earl.sim chose, before MuJoCo first renders (render.py calls it)."""
+    global _deferred_backend
+    if _deferred_backend is None:
+        return
+    os.environ["MUJOCO_GL"], _deferred_backend = _deferred_backend, None
+    # MuJoCo's renderer reads the context class from this module when it makes a context
+    importlib.reload(importlib.import_module(_GL_CONTEXT))
+
 
 from earl.sim.plant import Encoder, MujocoPlant, PlantError, Pose  # noqa: E402  (after choosing the GL backend)
 
-__all__ = ["Encoder", "MujocoPlant", "PlantError", "Pose"]
+__all__ = ["Encoder", "MujocoPlant", "PlantError", "Pose", "use_offscreen_backend"]

@@ -1,8 +1,9 @@
 """Pictures of a plant through MuJoCo's offscreen renderer: PNG images and short videos.
 
 MuJoCo renders without a display through EGL or OSMesa, chosen by the `MUJOCO_GL`
-environment variable before MuJoCo is first imported; `earl.sim` sets it to `egl`
-when it is unset and there is no display.  Where no OpenGL context can be made,
+environment variable; `earl.sim` chooses `egl` when it is unset and there is no display,
+and turns it on before the first picture (`use_offscreen_backend`), so that a run without
+pictures never loads OpenGL.  Where no OpenGL context can be made,
 `RenderUnavailable` says so in one sentence with what to install; callers report it
 and carry on, because a picture is never what a run is for.
 
@@ -22,6 +23,7 @@ import numpy as np
 from numpy.typing import NDArray
 from PIL import Image
 
+from earl.sim import use_offscreen_backend
 from earl.sim.plant import MujocoPlant
 
 Frame = NDArray[np.uint8]
@@ -52,6 +54,7 @@ class PlantCamera:
     def __init__(
         self, plant: MujocoPlant, width: int = 640, height: int = 480, camera: str | None = None, shadows: bool = True
     ) -> None:
+        use_offscreen_backend()
         model = plant.model
         # MuJoCo's offscreen buffer must hold the image; grow it rather than fail.
         model.vis.global_.offwidth = max(int(model.vis.global_.offwidth), width)
