@@ -38,6 +38,8 @@ if TYPE_CHECKING:
 
 #: `iterate(time)`: one iteration; False when it stopped to wait for an obligatory input buffer
 Iterate = Callable[[int], bool]
+#: `complete(time)`: receive and decide, after a wait that ended with every obligatory buffer filled
+Completion = Callable[[int], None]
 
 
 def compile_iteration(engine: SubsystemEngine, state: StateRuntime) -> Iterate:
@@ -71,7 +73,34 @@ def compile_iteration(engine: SubsystemEngine, state: StateRuntime) -> Iterate:
     lines += _receives(engine, namespace)
     lines += _decision(behaviour.never_ends, behaviour.error_condition is not None)
     lines.append("    return True")
-    return generated_function("iterate", lines, namespace)
+    return generated_function("iterate", lines, namespace)  # type: ignore[return-value]
+
+
+def compile_completion(engine: SubsystemEngine, state: StateRuntime) -> Completion:
+    """Steps 4 and 5 of `engine` in `state`, once the obligatory input buffers it waited for are all filled.
+
+    The scheduler calls it when the last of them arrives (not when the wait timed out: then the
+    engine's own `receive` sets the timeout flags). A control subsystem that waits for its drives'
+    readings every period (`manip/a.cs`) ends every iteration here.
+    """
+    behaviour = state.behaviour
+    namespace: dict[str, Any] = {
+        "engine": engine,
+        "inputs": engine.inputs,
+        "new_data": engine.new_data,
+        "timed_out": engine.timed_out,
+        "memory": engine.memory,
+        "predicates": engine.predicates,
+        "stale": engine.stale,
+        "receive": engine.receive,
+        "decide": engine.decide,
+        "terminal_condition": behaviour.terminal_condition,
+        "Exception": Exception,
+    }
+    lines = ["def complete(time):"]
+    lines += _receives(engine, namespace)
+    lines += _decision(behaviour.never_ends, behaviour.error_condition is not None)
+    return generated_function("complete", lines, namespace)  # type: ignore[return-value]
 
 
 def _sends(engine: SubsystemEngine, namespace: dict[str, Any]) -> list[str]:

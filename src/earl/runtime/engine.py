@@ -28,7 +28,7 @@ from typing import Any, Protocol
 
 from earl.runtime.binding import UserFunction
 from earl.runtime.channels import Channel
-from earl.runtime.compiled_iteration import Iterate, compile_iteration
+from earl.runtime.compiled_iteration import Completion, Iterate, compile_completion, compile_iteration
 from earl.runtime.events import Fault, Recorder
 from earl.runtime.iteration import Execute
 from earl.runtime.predicates import CompiledPredicate
@@ -77,6 +77,8 @@ class StateRuntime:
     transitions: list[TransitionRuntime]
     #: one whole iteration in this state, compiled at its first use
     iterate: Iterate | None = None
+    #: receive and decide after a wait for the obligatory buffers, compiled at its first use
+    complete: Completion | None = None
 
 
 class Sink(Protocol):
@@ -202,6 +204,15 @@ class SubsystemEngine:
                 trace,
             )
         )
+
+    def complete(self, time: int) -> None:
+        """Steps 4 and 5 after a wait that ended with every obligatory input buffer filled."""
+        state = self.state
+        assert state is not None
+        complete = state.complete
+        if complete is None:
+            complete = state.complete = compile_completion(self, state)
+        complete(time)
 
     # ------------------------------------------------------------------ Figure 5b, step 4
     def obligatory_ready(self) -> bool:

@@ -368,8 +368,11 @@ class Scheduler:
             engine.waiting = False
             self._resume_pending.discard(engine.name)
             self._tokens[engine.name] += 1
-        engine.receive(time, timed_out)
-        engine.decide(time)
+        if timed_out:
+            engine.receive(time, timed_out=True)
+            engine.decide(time)
+        else:
+            engine.complete(time)
         if self.record_memory and engine.name in self.record_memory:
             self.recorder.memory_snapshot(time, engine.name, engine.memory)
         period = engine.period
