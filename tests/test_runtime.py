@@ -218,6 +218,29 @@ def test_the_same_spec_and_seed_give_a_byte_identical_trace(tmp_path: Path) -> N
     assert traces[0] != traces[2]  # the display's noise comes from the seeded stream
 
 
+def test_each_link_gets_a_message_writer_only_from_the_recorders_that_record_it(tmp_path: Path) -> None:
+    """The engine asks for a writer per link once: a recorder without `message_sent` gives none, the trace
+    none for a link it does not record, and a link nobody records is then never reported."""
+    from earl.runtime.trace import TraceWriter
+
+    sim, events = simulate(SPECS / "counter", trace=tmp_path / "links.mcap", record_links=["nothing-matches"])
+    links = sorted(sim.network.link_types)
+    assert links
+    assert all(Recorder().message_writer(link) is None for link in links)
+    trace = sim.trace
+    assert isinstance(trace, TraceWriter)
+    assert all(trace.message_writer(link) is None for link in links)
+    sim.advance_to(0.05)
+    sim.close()
+    # the test's recorder has message_sent: it saw every message, the trace none
+    assert events.messages and {link for _, link, _ in events.messages} <= set(links)
+    from mcap.reader import make_reader
+
+    with (tmp_path / "links.mcap").open("rb") as stream:
+        topics = {channel.topic for _, channel, _ in make_reader(stream).iter_messages()}
+    assert not any(topic.startswith("link/") for topic in topics)
+
+
 def test_a_trace_written_by_its_own_process_is_the_trace_written_in_process(tmp_path: Path) -> None:
     """A file trace is written by a second process (trace_process.py); a stream, in this one: same bytes."""
     import io
