@@ -47,20 +47,7 @@ def compile_iteration(engine: SubsystemEngine, state: StateRuntime) -> Iterate:
     behaviour = state.behaviour
     if behaviour.execute is None:
         behaviour.execute = compile_execute(behaviour.stages, engine.memory, engine.context, engine._function_fault)
-    namespace: dict[str, Any] = {
-        "engine": engine,
-        "execute": behaviour.execute,
-        "inputs": engine.inputs,
-        "new_data": engine.new_data,
-        "timed_out": engine.timed_out,
-        "memory": engine.memory,
-        "predicates": engine.predicates,
-        "stale": engine.stale,
-        "receive": engine.receive,
-        "decide": engine.decide,
-        "terminal_condition": behaviour.terminal_condition,
-        "Exception": Exception,
-    }
+    namespace = {**_steps_4_and_5(engine, state), "execute": behaviour.execute}
     lines = [
         "def iterate(time):",
         "    engine.iteration_start = time",
@@ -84,7 +71,16 @@ def compile_completion(engine: SubsystemEngine, state: StateRuntime) -> Completi
     readings every period (`manip/a.cs`) ends every iteration here.
     """
     behaviour = state.behaviour
-    namespace: dict[str, Any] = {
+    namespace = _steps_4_and_5(engine, state)
+    lines = ["def complete(time):"]
+    lines += _receives(engine, namespace)
+    lines += _decision(behaviour.never_ends, behaviour.error_condition is not None)
+    return generated_function("complete", lines, namespace)  # type: ignore[return-value]
+
+
+def _steps_4_and_5(engine: SubsystemEngine, state: StateRuntime) -> dict[str, Any]:
+    """What receiving and deciding read: the engine's dictionaries, its own methods for the rare paths."""
+    return {
         "engine": engine,
         "inputs": engine.inputs,
         "new_data": engine.new_data,
@@ -94,13 +90,9 @@ def compile_completion(engine: SubsystemEngine, state: StateRuntime) -> Completi
         "stale": engine.stale,
         "receive": engine.receive,
         "decide": engine.decide,
-        "terminal_condition": behaviour.terminal_condition,
+        "terminal_condition": state.behaviour.terminal_condition,
         "Exception": Exception,
     }
-    lines = ["def complete(time):"]
-    lines += _receives(engine, namespace)
-    lines += _decision(behaviour.never_ends, behaviour.error_condition is not None)
-    return generated_function("complete", lines, namespace)  # type: ignore[return-value]
 
 
 def _sends(engine: SubsystemEngine, namespace: dict[str, Any]) -> list[str]:
