@@ -58,9 +58,14 @@ def user_code_path(directories: list[Path]) -> Iterator[None]:
 
 
 def _forget_shadowed(directory: Path) -> None:
+    # what the directory can be imported as, listed once: a run starts with hundreds of modules loaded
+    try:
+        entries = list(directory.iterdir())
+    except OSError:
+        return
+    importable = {e.name for e in entries if e.is_dir()} | {e.stem for e in entries if e.suffix == ".py"}
     for name, module in list(sys.modules.items()):
-        top = name.partition(".")[0]
-        if not ((directory / top).is_dir() or (directory / f"{top}.py").is_file()):
+        if name.partition(".")[0] not in importable:
             continue
         location = getattr(module, "__file__", None)
         if location is None or not Path(location).resolve().is_relative_to(directory):

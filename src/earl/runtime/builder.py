@@ -171,8 +171,14 @@ def _engine(
     parameters.update({p.name: _value(p.value) for p in subsystem.parameters})
     period = None if subsystem.period is None else to_nanoseconds(subsystem.period.seconds)
     # one stream per subsystem, so that adding a subsystem does not change another's numbers
-    random = numpy.random.default_rng([seed, zlib.crc32(name.encode())])
-    context = Context(name, parameters, None if period is None else period / NANOSECONDS, environment, random)
+    entropy = [seed, zlib.crc32(name.encode())]
+    context = Context(
+        name,
+        parameters,
+        None if period is None else period / NANOSECONDS,
+        environment,
+        lambda: numpy.random.default_rng(entropy),
+    )
     engine = SubsystemEngine(name, order, period, context, recorder)
     for buffer in subsystem.input_buffers:
         key = indexed(buffer.name, buffer.index)

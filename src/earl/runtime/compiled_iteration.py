@@ -31,7 +31,8 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from earl.runtime.channels import Channel
-from earl.runtime.iteration import compile_execute, generated_function
+from earl.runtime.codegen import generated_function
+from earl.runtime.iteration import compile_execute
 
 if TYPE_CHECKING:
     from earl.runtime.engine import StateRuntime, SubsystemEngine

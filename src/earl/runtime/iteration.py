@@ -21,12 +21,11 @@ every function, view and dictionary is passed in as a numbered variable.
 
 from __future__ import annotations
 
-import functools
 from collections.abc import Callable, Sequence
-from types import CodeType
 from typing import Any, Protocol
 
 from earl.runtime.binding import UserFunction
+from earl.runtime.codegen import generated_function
 from earl.runtime.values import QUICK_TEST_NAMES, QuickTest
 from earl.runtime.views import Context, Inputs, Outputs
 
@@ -82,27 +81,6 @@ def compile_execute(
             lines += [f"    if {target}:", f"        memory.update({target})", f"        {target}.clear()"]
     lines.append("    return sent")
     return generated_function("execute", lines, namespace)  # type: ignore[return-value]
-
-
-def generated_function(name: str, lines: list[str], namespace: dict[str, Any]) -> Callable[..., Any]:
-    """The function `name` that `lines` define, with every name of `namespace` a closure variable.
-
-    It is made inside a factory whose parameters are everything it uses, so that each is a
-    closure variable (as fast to read as a local) rather than a global (a dictionary). The
-    members of a family (`motorController[1..6]`) generate the same text: it is compiled once.
-    """
-    names = sorted(namespace)
-    source = "\n".join([f"def make({', '.join(names)}):", *(f"    {line}" for line in lines), f"    return {name}"])
-    scope: dict[str, Any] = {}
-    exec(_compiled(source), scope)
-    function = scope["make"](**namespace)
-    function.source = source  # for whoever debugs the engine: print(behaviour.execute.source)
-    return function  # type: ignore[no-any-return]
-
-
-@functools.lru_cache(maxsize=1024)
-def _compiled(source: str) -> CodeType:
-    return compile(source, "<string>", "exec")
 
 
 class _Missing:

@@ -23,6 +23,7 @@ from typing import Any, NoReturn
 from earl.model.elements import System
 from earl.model.expressions import ListLiteral, Literal, Negate
 from earl.model.types import ArrayType, DataType, PrimitiveType, StructType, TypeAlias, TypeReference, type_text
+from earl.runtime.codegen import compiled
 
 Value = Any  # bool | int | float | str | bytes | tuple[Value, ...] | Record | None
 
@@ -108,7 +109,7 @@ class QuickTest:
             ["def check(value):", *(f"    {line}" for line in self.lines("value", "slow")), "    return value"]
         )
         namespace: dict[str, Any] = {**QUICK_TEST_NAMES, "slow": slow}
-        exec(source, namespace)  # generated from the test's own kind and bounds, no text of a spec
+        exec(compiled(source), namespace)  # generated from the test's own kind and bounds, no text of a spec
         function: Callable[[Any], Value] = namespace["check"]
         return function
 
@@ -320,7 +321,7 @@ class TypeSystem:
             lines.append("        return slow(value)")
             items.append(f"{field.name!r}: {variable}")
         lines.append("    return cls({" + ", ".join(items) + "})")
-        exec("\n".join(lines), names)  # the source is generated from the spec's own type definitions
+        exec(compiled("\n".join(lines)), names)  # the source is generated from the spec's own type definitions
         function: Callable[[Any], Value] = names["coerce_struct"]
         return function
 

@@ -18,6 +18,7 @@ from typing import Any, NoReturn
 from earl.model.expressions import ElementReference
 from earl.model.kinds import Kind
 from earl.model.types import DataType
+from earl.runtime.codegen import compiled
 from earl.runtime.names import reference_index, reference_key
 from earl.runtime.values import QuickTest, TypeSystem, Value
 
@@ -135,7 +136,7 @@ def _compile_refresh(values: dict[str, Any], singles: list[tuple[str, dict[str, 
     if len(lines) == 1:
         lines.append("    pass")
     namespace: dict[str, Any] = {"values": values} | {f"store_{i}": store for i, store in enumerate(stores)}
-    exec("\n".join(lines), namespace)
+    exec(compiled("\n".join(lines)), namespace)
     return namespace["refresh"]  # type: ignore[no-any-return]
 
 
@@ -294,7 +295,7 @@ class Context:
     asked for, so that keeping them current costs nothing per iteration.
     """
 
-    __slots__ = ("_engine", "environment", "parameters", "period", "random", "subsystem")
+    __slots__ = ("_engine", "_make_random", "_random", "environment", "parameters", "period", "subsystem")
 
     def __init__(
         self,
@@ -302,14 +303,23 @@ class Context:
         parameters: Mapping[str, Any],
         period: float | None,
         environment: object,
-        random: Any,
+        random: Callable[[], Any],
     ) -> None:
         self.subsystem = subsystem
         self.parameters = MappingProxyType(dict(parameters))
         self.period = period
         self.environment = environment
-        self.random = random
+        self._make_random = random
+        self._random: Any = None
         self._engine: Any = None
+
+    @property
+    def random(self) -> Any:
+        """This subsystem's own seeded stream (a `numpy.random.Generator`), made when first asked for:
+        seeding one costs a millisecond, and most subsystems never draw a number."""
+        if self._random is None:
+            self._random = self._make_random()
+        return self._random
 
     @property
     def time(self) -> float:
