@@ -193,14 +193,25 @@ class _Shared:
                 seen.add(id(node))
                 if isinstance(node, (list, tuple)):
                     stack.extend(node)
-                elif is_dataclass(node):
-                    stack.extend(getattr(node, f.name) for f in fields(node))
+                else:
+                    stack.extend(getattr(node, name) for name in _field_names(type(node)))
         result = tuple(sorted(names))
         self.names[id(root)] = (root, result)
         return result
 
     def key(self, root: object, environment: Mapping[str, Value]) -> tuple[int, tuple[tuple[str, Value | None], ...]]:
         return id(root), tuple((name, environment.get(name)) for name in self.free_names(root))
+
+
+#: the field names of each model class, for walking a declaration (dataclasses.fields is slow to ask)
+_FIELD_NAMES: dict[type, tuple[str, ...]] = {}
+
+
+def _field_names(cls: type) -> tuple[str, ...]:
+    names = _FIELD_NAMES.get(cls)
+    if names is None:
+        names = _FIELD_NAMES[cls] = tuple(f.name for f in fields(cls)) if is_dataclass(cls) else ()
+    return names
 
 
 def _agent(agent: Agent, environment: Environment, index: int | None, cache: _Shared) -> Agent:
