@@ -149,13 +149,19 @@ def read_signals(path: Path, names: list[str]) -> Signals:
             raise TraceError(
                 f"`{name}` does not start with a subsystem of this trace ({', '.join(sorted(subsystems)) or 'none'})"
             )
-        owners.append((name, subsystem, name[len(subsystem) + 1 :]))
+        inner = name[len(subsystem) + 1 :]
+        owners.append((name, subsystem, inner))
         if f"{subsystem}/memory" in available:
             wanted[f"{subsystem}/memory"] = (subsystem, "")
+        # only the links of the output buffer the name starts with: a control subsystem's other links
+        # can carry tens of thousands of messages that this plot would decode for nothing
+        element = _element(inner)
         for topic, metadata in available.items():
             source = metadata.get("source", "")
             if topic.startswith("link/") and source.startswith(subsystem + "."):
-                wanted.setdefault(topic, (subsystem, source[len(subsystem) + 1 :]))
+                buffer = source[len(subsystem) + 1 :]
+                if _element(buffer) == element:
+                    wanted.setdefault(topic, (subsystem, buffer))
         wanted[f"{subsystem}/fsm"] = (subsystem, "")
     leaves: dict[tuple[str, str], tuple[list[float], list[float]]] = {}
     stays: dict[str, list[tuple[float, str]]] = {}
@@ -201,6 +207,11 @@ def read_signals(path: Path, names: list[str]) -> Signals:
         for subsystem, changes in stays.items()
     }
     return Signals(series, bands, end)
+
+
+def _element(name: str) -> str:
+    """The element a signal or buffer name starts with: `motorControllerCommand` of `motorControllerCommand[2].x`."""
+    return re.split(r"[.\[]", name, maxsplit=1)[0]
 
 
 def _natural(name: str) -> list[object]:
