@@ -23,6 +23,7 @@ while its trace is written on the other.  A stream (`io.BytesIO`) is written in-
 from __future__ import annotations
 
 import contextlib
+import fcntl
 import json
 import os
 import select
@@ -417,6 +418,7 @@ class BackgroundSink:
             stderr=subprocess.PIPE,
             env={**os.environ, "PYTHONPATH": search_path},
         )
+        _widen(self._process.stdin)
         self._due = _clock() + self.LATEST
         self._finished = False
         self._packer = msgpack.Packer(use_bin_type=True, default=_plain)
@@ -548,6 +550,21 @@ class BackgroundSink:
         )
 
 
+def _widen(pipe: IO[bytes] | None) -> None:
+    """Let the pipe to the writer hold several batches (Linux; up to the system's limit, 1 MiB by default).
+
+    A batch is about 200 kB and a pipe holds 64 kB: the run would wait at every batch until the
+    writer had taken the one before, which the writer does only once it has written that one out.
+    """
+    set_size = getattr(fcntl, "F_SETPIPE_SZ", None)
+    if pipe is None or set_size is None:
+        return
+    with contextlib.suppress(OSError):  # above the limit for this user: the pipe keeps its size
+        fcntl.fcntl(pipe.fileno(), set_size, PIPE_SIZE)
+
+
+#: bytes the pipe to the trace's writer holds
+PIPE_SIZE = 1 << 20
 #: the length of each batch, before it
 _LENGTH = struct.Struct("<Q")
 _clock = time.monotonic
