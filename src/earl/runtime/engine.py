@@ -79,6 +79,8 @@ class StateRuntime:
     iterate: Iterate | None = None
     #: receive and decide after a wait for the obligatory buffers, compiled at its first use
     complete: Completion | None = None
+    #: the queues of the obligatory input buffers' channels, found at the first wait
+    obligatory_queues: tuple[Any, ...] | None = None
 
 
 class Sink(Protocol):
@@ -216,13 +218,13 @@ class SubsystemEngine:
 
     # ------------------------------------------------------------------ Figure 5b, step 4
     def obligatory_ready(self) -> bool:
+        """Every obligatory input buffer of the state has a message (asked at each delivery while waiting)."""
         state = self.state
         assert state is not None
-        channels = self.channels
-        for key in state.obligatory:  # noqa: SIM110 — a plain loop: this runs every iteration
-            if not channels[key].queue:
-                return False
-        return True
+        queues = state.obligatory_queues
+        if queues is None:
+            queues = state.obligatory_queues = tuple(self.channels[key].queue for key in state.obligatory)
+        return all(queues)
 
     def receive(self, time: int, timed_out: bool = False) -> None:
         """`tf.pf.ib.receive()`: every input buffer takes what arrived; obligatory ones not filled time out."""
