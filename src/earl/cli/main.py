@@ -116,6 +116,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     return result
 
 
+#: True in the `earl` program, a process that ends with its command (not when a test calls `main`)
+AS_PROGRAM = False
+
+
 def script() -> int:
     """The `earl` program: `main`, then an exit that does not scan the heap again.
 
@@ -125,6 +129,8 @@ def script() -> int:
     that the exit's own collections skip it; it is freed as the modules are torn down.
     Only the program does this: a caller of `main` (a test) keeps its collector as it was.
     """
+    global AS_PROGRAM
+    AS_PROGRAM = True
     code = main()
     gc.collect()
     gc.freeze()

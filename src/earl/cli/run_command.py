@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import gc
 import signal
 import statistics
 import sys
@@ -237,6 +238,12 @@ def _execute(simulation: Any, duration: float, arguments: argparse.Namespace, re
         raise KeyboardInterrupt
 
     signal.signal(signal.SIGTERM, stop)
+    from earl.cli import main as program
+
+    if program.AS_PROGRAM:
+        # What is built by now (the model, NumPy, MuJoCo, Lark's tables) lives until the process ends:
+        # frozen, it is skipped by the collector's full passes during the run and at the exit.
+        gc.freeze()
     started = time.perf_counter()
     steps = 200
     progress: Progress | None = None
