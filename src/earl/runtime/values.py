@@ -89,14 +89,13 @@ class QuickTest:
         else:  # real_array: Reals were checked before; a tuple is, in C (a NaN makes the sum NaN)
             size = "" if self.size is None else f" and len({value}) == {self.size!r}"
             wrong_size = "" if self.size is None else f" or len({value}) != {self.size!r}"
+            # a list or tuple becomes Reals in one copy; a 1-D NumPy array is made a list first
+            sequence = f"(type({value}) is list or type({value}) is tuple)"
             return [
                 f"if type({value}) is not Reals{wrong_size}:",
-                f"    if type({value}) is list:",
-                f"        {value} = tuple({value})",
-                f"    elif getattr({value}, 'ndim', None) == 1:",
-                f"        {value} = tuple({value}.tolist())",
-                f"    if type({value}) is tuple{size} and only_floats(map(type, {value})) "
-                f"and (total := sum({value})) == total:",
+                f"    if not {sequence} and getattr({value}, 'ndim', None) == 1:",
+                f"        {value} = {value}.tolist()",
+                f"    if {sequence}{size} and only_floats(map(type, {value})) and (total := sum({value})) == total:",
                 f"        {value} = Reals({value})",
                 "    else:",
                 f"        {value} = {slow}({value})",
