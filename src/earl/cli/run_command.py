@@ -242,7 +242,8 @@ def _execute(simulation: Any, duration: float, arguments: argparse.Namespace, re
 
     if program.AS_PROGRAM:
         # What is built by now (the model, NumPy, MuJoCo, Lark's tables) lives until the process ends:
-        # frozen, it is skipped by the collector's full passes during the run and at the exit.
+        # frozen, it is skipped by the collector's full passes during the run and at the exit. (Any
+        # garbage of the set-up is frozen with it, and goes with the process.)
         gc.freeze()
     started = time.perf_counter()
     steps = 200

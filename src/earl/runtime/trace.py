@@ -446,13 +446,21 @@ class BackgroundSink:
         self._channels.append((len(self._values), number, topic, schema_name, schema, metadata, wrap))
 
     def message(self, channel: int, time: int, value: Any) -> None:
-        if self._finished:  # failed already (and said so): what comes after is dropped
-            return
         self._numbers.append(channel)
         self._times.append(time)
         self._values.append(value)
         if len(self._values) >= self.BATCH or _clock() >= self._due:
-            self._send()
+            self._batch_done()
+
+    def _batch_done(self) -> None:
+        """The batch is full or due: it goes to the writer, or is dropped once the writer has failed
+        (which was said then)."""
+        if self._finished:
+            self._numbers.clear()
+            self._times.clear()
+            self._values.clear()
+            return
+        self._send()
 
     def writer_of(self, register: Callable[[], int]) -> MessageWriter:
         """`message` for one channel, which `register()` registers at the first message and numbers: a
@@ -460,7 +468,6 @@ class BackgroundSink:
         numbers, times, values = self._numbers.append, self._times.append, self._values.append
         batch = self._values
         limit = self.BATCH
-        send = self._send
         channel = 0
 
         def write(time: int, value: Any) -> None:
@@ -471,10 +478,7 @@ class BackgroundSink:
             times(time)
             values(value)
             if len(batch) >= limit or _clock() >= self._due:
-                if self._finished:  # failed already (and said so): what comes after is dropped
-                    batch.clear()
-                    return
-                send()
+                self._batch_done()
 
         return write
 
