@@ -279,3 +279,22 @@ def test_a_checked_array_of_reals_passes_again_at_once_but_only_at_its_size() ->
     assert check(Reals((1.0, 2.0))) == "refused"  # a checked double[2] is no double[3]
     assert check((1.0, float("nan"), 3.0)) == "refused" and check((1, 2.0, 3.0)) == "refused"
     assert len(refused) == 3
+
+
+@pytest.mark.parametrize("size", [0, 1, 6, 16, 17, 40])
+def test_every_element_of_an_array_of_reals_is_tested_at_every_size(size: int) -> None:
+    """Short arrays have their element tests written out one by one, longer ones test them in one
+    call (`UNROLLED_ELEMENTS`); both refuse a non-float or a NaN wherever it sits, the last element too."""
+    from earl.runtime.values import UNROLLED_ELEMENTS, QuickTest
+
+    assert 6 <= UNROLLED_ELEMENTS < 17  # the sizes above cover both forms
+    check = QuickTest("real_array", size=size).compile(lambda value: "refused")
+    good = [0.5 * index for index in range(size)]
+    assert type(check(good)) is Reals and check(good) == tuple(good)
+    assert type(check(tuple(good))) is Reals
+    for position in range(size):
+        for bad in (1, True, "1.0", None, float("nan")):
+            value = list(good)
+            value[position] = bad
+            assert check(value) == "refused", (position, bad)
+    assert check([*good, 1.0]) == "refused"  # one element too many
