@@ -8,7 +8,6 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from functools import lru_cache
 from importlib import resources
-from operator import attrgetter
 from typing import Any
 
 from lark import Lark, Token
@@ -257,12 +256,17 @@ def attach_comments(declarations: list[Any], comments: list[Token], path: str) -
     closing: list[str] = []
     if not comments:
         return closing
-    elements = sorted(_statements(declarations), key=attrgetter("location.line", "location.column"))
+    # the first element of each line (the leftmost), and the lines that have one, in order: a
+    # comment goes to the first of them at or below it; only lines are sorted, not elements
     by_line: dict[int, Any] = {}
-    for element in elements:
-        by_line.setdefault(element.location.line, element)
-    starts = [e.location.line for e in elements]
+    for element in _statements(declarations):
+        location = element.location
+        first = by_line.get(location.line)
+        if first is None or location.column < first.location.column:
+            by_line[location.line] = element
+    starts = sorted(by_line)
     last_line: dict[int, int] = {}  # id(element) -> line of its last leading comment
+    commented: list[Any] = []
     last_closing = 0
     for comment in comments:
         text = str(comment)
@@ -272,11 +276,13 @@ def attach_comments(declarations: list[Any], comments: list[Token], path: str) -
             owner.comments.trailing = text
             continue
         position = bisect_left(starts, line)
-        if position < len(elements):
-            element = elements[position]
+        if position < len(starts):
+            element = by_line[starts[position]]
             leading = element.comments.leading
             if leading and line > last_line[id(element)] + 1:
                 leading.append("")
+            elif not leading:
+                commented.append(element)
             leading.append(text)
             last_line[id(element)] = line
         else:
@@ -284,7 +290,7 @@ def attach_comments(declarations: list[Any], comments: list[Token], path: str) -
                 closing.append("")
             closing.append(text)
             last_closing = line
-    for element in elements:
-        if id(element) in last_line and element.location.line > last_line[id(element)] + 1:
+    for element in commented:
+        if element.location.line > last_line[id(element)] + 1:
             element.comments.leading.append("")
     return closing
