@@ -1,9 +1,9 @@
 """The fast reader changes nothing: same tokens, same elements, same spans as Lark's own way.
 
-The reader (earl/lang/parser.py) runs Lark's LALR parser with callbacks that build elements
-as it reduces (reductions.py) and a tighter loop around Lark's contextual scanners
-(lexing.py).  These tests hold it to Lark's behaviour: the spans it measures equal the
-positions Lark's tree parser propagates, and Lark's own lexer loop gives the same model.
+The reader (earl/lang/parser.py) runs Lark's LALR tables and contextual scanners in one loop
+(driver.py) with callbacks that build elements as it reduces (reductions.py).  These tests
+hold it to Lark's behaviour: the spans it measures equal the positions Lark's tree parser
+propagates, and Lark's own parser and lexer loops give the same model.
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ from lark.lexer import ContextualLexer
 import earl
 from earl.diagnostics import SourceMap
 from earl.lang import parser as reader
-from earl.lang.lexing import FastContextualLexer
+from earl.lang.driver import NotWellFormed
 from earl.lang.transformer import ParsedFile
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -97,21 +97,75 @@ def test_element_spans_equal_the_positions_of_lark_trees(name: str, text: str) -
         assert sorted(found.get(element, [])) == sorted(spans), element
 
 
+def _not_well_formed(text: str) -> Any:
+    """The loop giving up at once: the reader then parses with Lark's own loop."""
+    raise NotWellFormed(0)
+
+
+def _comments(parsed: ParsedFile) -> list[tuple[int, int, list[str], str | None]]:
+    return sorted(
+        (e.location.line, e.location.column, list(e.comments.leading), e.comments.trailing)
+        for e in reader._statements(parsed.declarations)
+    )
+
+
 @pytest.mark.parametrize(("name", "text"), TEXTS, ids=[name for name, _ in TEXTS])
-def test_lark_own_lexer_loop_reads_the_same_model(name: str, text: str) -> None:
-    lexer = reader._element_parser().lark.parser.lexer
+def test_lark_own_loops_read_the_same_model(name: str, text: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The reader's one loop (driver.py) against Lark's own parser loop and Lark's own lexer loop."""
+    element_parser = reader._element_parser()
     fast = _parse(text)
-    lexer.__class__ = ContextualLexer
-    try:
-        slow = _parse(text)
-    finally:
-        lexer.__class__ = FastContextualLexer
+    monkeypatch.setattr(element_parser.driver, "read", _not_well_formed)  # the fallback: Lark's own loops
+    assert type(element_parser.lark.parser.lexer) is ContextualLexer
+    slow = _parse(text)
     assert fast.declarations == slow.declarations
     spans_fast: dict[str, list[tuple[int, int, int, int]]] = {}
     spans_slow: dict[str, list[tuple[int, int, int, int]]] = {}
     _elements(fast.declarations, spans_fast)
     _elements(slow.declarations, spans_slow)
     assert spans_fast == spans_slow
+    assert _comments(fast) == _comments(slow)
+    assert (fast.header_comments, fast.closing_comments) == (slow.header_comments, slow.closing_comments)
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        "system s\r\n\r\na/a {\r\n    cs { period 2 ms }\r\n}\r\n",  # Windows line ends
+        "system s\n\na/a {\n    cs { period 2 ms }\n}\n   \n\t\n",  # blank lines and tabs at the end
+        "system s\na/a { cs { period 2 ms } } // the last line, a comment, no newline",
+        "\n\n   system s\n\n\n\na/a {\n\n\n    cs { period 2 ms }\n}",  # whitespace first, no final newline
+    ],
+)
+def test_the_loop_reads_whitespace_and_comments_anywhere_as_lark_does(
+    text: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    fast = _parse(text)
+    monkeypatch.setattr(reader._element_parser().driver, "read", _not_well_formed)
+    slow = _parse(text)
+    assert fast.declarations == slow.declarations
+    spans_fast: dict[str, list[tuple[int, int, int, int]]] = {}
+    spans_slow: dict[str, list[tuple[int, int, int, int]]] = {}
+    _elements(fast.declarations, spans_fast)
+    _elements(slow.declarations, spans_slow)
+    assert spans_fast == spans_slow and spans_fast
+    assert _comments(fast) == _comments(slow) and fast.closing_comments == slow.closing_comments
+
+
+def test_a_text_the_loop_cannot_read_gets_lark_s_error_from_the_same_spot() -> None:
+    """Each malformed spec fails in the loop first; the error the user sees comes from Lark's own parse."""
+    element_parser = reader._element_parser()
+    for text, code, line, column in [
+        ("system s\n\na/a {\n    cs {\n        period 2\n    }\n}\n", "EARL-S008", 5, 16),  # no action for `}`
+        ("system s\n\na/a {\n    cs { period 2 ms } §\n}\n", "EARL-S001", 4, 24),  # no terminal matches `§`
+    ]:
+        with pytest.raises(NotWellFormed):
+            element_parser.driver.read(text)
+        with pytest.raises(earl.EarlError) as caught:
+            _parse(text)
+        diagnostic = caught.value.diagnostics[0]
+        assert diagnostic.location is not None
+        assert (diagnostic.code, diagnostic.location.line, diagnostic.location.column) == (code, line, column)
+    assert _parse("system t\n\na/a {\n    cs {\n        period 2 ms\n    }\n}\n").system_name == "t"
 
 
 def test_a_syntax_error_is_explained_by_lark_and_the_reader_recovers() -> None:

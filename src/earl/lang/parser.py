@@ -15,7 +15,7 @@ from lark.exceptions import UnexpectedInput
 
 from earl.diagnostics import Diagnostic, EarlError, Severity, SourceMap
 from earl.lang import reductions
-from earl.lang.lexing import FastContextualLexer
+from earl.lang.driver import Driver, NotWellFormed
 from earl.lang.syntax_errors import translate
 from earl.lang.transformer import ElementBuilder, ParsedFile, SpecificationSyntaxError
 from earl.model.location import SourceLocation
@@ -91,13 +91,20 @@ class _ElementParser:
         self.builder = ElementBuilder("<text>")
         self.spans = reductions.SpanTable()
         reductions.install(self.lark.parser.parser.parser, self.builder, self.spans)
-        FastContextualLexer.adopt(self.lark.parser.lexer)
+        self.driver = Driver(self.lark)
 
     def parse(self, text: str, path: str) -> ParsedFile:
         self.builder.reset(path)
         self.spans.clear()
         try:
-            parsed: ParsedFile = self.lark.parse(text)  # type: ignore[assignment]  # the callbacks build it
+            try:
+                parsed: ParsedFile = self.driver.read(text)  # the callbacks build it
+            except NotWellFormed:
+                # Lark's own loops, from the start, meet the same spot and raise Lark's own error
+                self.builder.reset(path)
+                self.spans.clear()
+                _collector.comments.clear()
+                parsed = self.lark.parse(text)  # type: ignore[assignment]
         finally:
             self.spans.clear()
             self.builder.reset("<text>")
