@@ -555,8 +555,8 @@ class Resolver:
         role: str,
         star: bool = False,
     ) -> _Declared | None:
-        text = reference_text(reference)
         if reference.kind not in allowed:
+            text = reference_text(reference)  # made for messages only: a large spec has 100,000 references
             permitted = ", ".join(f"`/{k.value}`" for k in allowed)
             hint = None
             if reference.kind is Kind.OUTPUT_BUFFER and Kind.INPUT_BUFFER in allowed:
@@ -589,7 +589,6 @@ class Resolver:
         return declared
 
     def _indices(self, reference: ElementReference, family: IndexRange | None, scope: Scope, star: bool) -> None:
-        text = reference_text(reference)
         if family is None:
             if reference.indices:
                 self.error(
@@ -610,14 +609,16 @@ class Resolver:
             return
         if len(reference.indices) > 1:
             self.error(
-                f"`{text}` has {len(reference.indices)} indices; a family has one", reference.location, "EARL-R025"
+                f"`{reference_text(reference)}` has {len(reference.indices)} indices; a family has one",
+                reference.location,
+                "EARL-R025",
             )
             return
         index = reference.indices[0]
         if isinstance(index, Star):
             if not star:
                 self.error(
-                    f"`{text}`: `[*]` stands for every member and cannot be a value in an expression",
+                    f"`{reference_text(reference)}`: `[*]` stands for every member and cannot be a value in an expression",
                     reference.location,
                     "EARL-R026",
                     f"use `any(K in {family.first}..{family.last}: {reference.name}[K]/{reference.kind.value})` or `all(…)`",
@@ -629,7 +630,7 @@ class Resolver:
         outside = sorted({v for v in values if v < family.first or v > family.last})
         if outside:
             self.error(
-                f"`{text}` reaches index {outside[0]}, outside the family's {family.first}..{family.last}",
+                f"`{reference_text(reference)}` reaches index {outside[0]}, outside the family's {family.first}..{family.last}",
                 index.location or reference.location,
                 "EARL-R027",
             )

@@ -77,6 +77,15 @@ from earl.model.types import (
     TypeReference,
 )
 
+#: a suffix's Kind by its text: `Kind(text)` looks it up through Enum's Python-level machinery,
+#: and a large spec has a hundred thousand references
+_KIND_OF_SUFFIX: dict[str, Kind] = {kind.value: kind for kind in Kind}
+
+
+def _kind(suffix: str) -> Kind:
+    return _KIND_OF_SUFFIX.get(suffix) or Kind(suffix)  # Kind(...) explains an unknown suffix
+
+
 #: Deeper expressions are refused: no person writes them, and they would exhaust the stack.
 MAX_EXPRESSION_DEPTH = 100
 
@@ -294,7 +303,7 @@ class ElementBuilder:
         return ElementReference("cs", Kind.CONTROL_SUBSYSTEM, (), self._loc(meta))
 
     def subsystem_ref(self, meta: Meta, children: list[Any]) -> ElementReference:
-        return ElementReference(str(children[0]), Kind(str(children[-1])), tuple(children[1:-1]), self._loc(meta))
+        return ElementReference(str(children[0]), _kind(str(children[-1])), tuple(children[1:-1]), self._loc(meta))
 
     # ------------------------------------------------------------------ subsystems
     def subsystem(self, meta: Meta, children: list[Any]) -> Subsystem:
@@ -302,7 +311,7 @@ class ElementBuilder:
         if isinstance(head, Token) and head.type == "CS":
             return self._fill(ControlSubsystem(location=self._loc(meta)), children[1:])
         declared: _DeclaredName = head
-        cls = SUBSYSTEM_CLASSES[Kind(str(children[1]))]
+        cls = SUBSYSTEM_CLASSES[_kind(str(children[1]))]
         subsystem = cls(declared.name, declared.family, location=self._loc(meta))
         return self._fill(subsystem, children[2:])
 
@@ -541,7 +550,7 @@ class ElementBuilder:
     def element_ref(self, meta: Meta, children: list[Any]) -> ElementReference:
         name, *indices, kind = children
         converted = tuple(Star(self._loc(i)) if isinstance(i, Token) and i.type == "STAR" else i for i in indices)
-        return ElementReference(str(name), Kind(str(kind)), converted, self._loc(meta))
+        return ElementReference(str(name), _kind(str(kind)), converted, self._loc(meta))
 
     def _expression(self, node: Expression, children: list[Any]) -> Expression:
         depth = 1 + max((self._depth.get(id(c), 0) for c in children), default=0)
