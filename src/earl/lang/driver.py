@@ -30,6 +30,8 @@ from lark import Lark, Token
 from lark.lexer import PatternStr, UnlessCallback
 from lark.parsers.lalr_analysis import Shift
 
+from earl.lang.reductions import PASS_THROUGH
+
 _new_string = str.__new__
 
 #: What the loop needs of one of Lark's per-state lexers: its match function, the terminals
@@ -92,7 +94,10 @@ class Driver:
         for actions in self._states.values():
             for action, argument in actions.values():
                 if action is not Shift and argument not in self._rules:
-                    self._rules[argument] = (len(argument.expansion), argument.origin.name, callbacks[argument])
+                    size, callback = len(argument.expansion), callbacks[argument]
+                    if callback is PASS_THROUGH and size != 1:  # the loop's shortcut is for one child only
+                        raise ValueError(f"the rule {argument} passes its first child through, but has {size}")
+                    self._rules[argument] = (size, argument.origin.name, callback)
         self._whitespace: str = lark.get_terminal("WS").pattern.to_regexp()
         self._scanners: dict[int, Scanner] = {}
         self._by_lexer: dict[int, Scanner] = {}  # states that accept the same terminals share a lexer
@@ -116,6 +121,7 @@ class Driver:
         new = _new_string
         token_class = Token
         shift = Shift
+        pass_through = PASS_THROUGH
         state = self._start_state
         state_stack: list[int] = [state]
         value_stack: list[Any] = []
@@ -183,18 +189,21 @@ class Driver:
                     value_stack.append(token if type_ not in shift_callbacks else shift_callbacks[type_](token))
                     break
                 size, origin, callback = rules[argument]
-                if size:
-                    children = value_stack[-size:]
-                    del state_stack[-size:]
-                    del value_stack[-size:]
+                if callback is pass_through:  # `?sum: product`: the value stays, only the state changes
+                    state = states[state_stack[-2]][origin][1]
+                    state_stack[-1] = state
                 else:
-                    children = []
-                reduced = callback(children)
-                state = states[state_stack[-1]][origin][1]
-                state_stack.append(state)
-                value_stack.append(reduced)
+                    if size:
+                        children = value_stack[-size:]
+                        del state_stack[-size:]
+                        del value_stack[-size:]
+                    else:
+                        children = []
+                    value_stack.append(callback(children))
+                    state = states[state_stack[-1]][origin][1]
+                    state_stack.append(state)
                 if at_end and state == end_state:
-                    return reduced
+                    return value_stack[-1]
 
 
 __all__ = ["Driver", "NotWellFormed"]

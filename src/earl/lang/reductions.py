@@ -26,6 +26,11 @@ from lark.grammar import Rule
 Span = tuple[int, int, int, int]
 
 
+#: the callback of a rule whose one child is its value (`?sum: product`); a parser loop that
+#: knows it may leave the value where it is on the stack
+PASS_THROUGH: Callable[[list[Any]], Any] = itemgetter(0)
+
+
 class Inline(list[Any]):
     """The children of an `_inlined` rule, spliced into its parent's children."""
 
@@ -126,7 +131,7 @@ def _callback(rule: Any, builder: Any, table: SpanTable) -> Callable[[list[Any]]
 
     if expand_single and len(rule.expansion) == 1 and kept and not kept[0][1]:
         # `?sum: product`: the one child is the result, span and all.
-        return itemgetter(0)
+        return PASS_THROUGH
 
     method: Callable[[Span | None, list[Any]], Any] | None = None
     always_single = expand_single and len(kept) == 1 and not kept[0][1]
@@ -205,4 +210,4 @@ def _callback(rule: Any, builder: Any, table: SpanTable) -> Callable[[list[Any]]
     return reduce
 
 
-__all__ = ["Inline", "Span", "SpanTable", "install"]
+__all__ = ["PASS_THROUGH", "Inline", "Span", "SpanTable", "install"]
