@@ -37,9 +37,10 @@ sys.path.insert(0, str(HERE))
 
 from lark import Lark  # noqa: E402
 
+from earl.collector import paused as collection_paused  # noqa: E402
 from earl.diagnostics import SourceMap  # noqa: E402
 from earl.lang.loader import merge  # noqa: E402
-from earl.lang.parser import _element_parser, _grammar, collection_paused, decode, parse_text  # noqa: E402
+from earl.lang.parser import _element_parser, _grammar, decode, parse_text  # noqa: E402
 from earl.lang.resolver import resolve  # noqa: E402
 from earl.model.elements import System  # noqa: E402
 from generate import generate  # noqa: E402

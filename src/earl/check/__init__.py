@@ -11,9 +11,9 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 from earl.check import fsm_analysis, rules_behaviour, rules_communication, rules_structure
-from earl.check.collector import collector_paused
 from earl.check.context import CheckContext
 from earl.check.registry import RULES, Finding, Rule
+from earl.collector import paused as collector_paused
 from earl.diagnostics import Diagnostic, Severity
 from earl.model.elements import System
 from earl.model.expand import expand

@@ -14,7 +14,7 @@ import importlib
 import sys
 from collections.abc import Sequence
 
-from earl import __version__
+from earl import __version__, collector
 
 #: every command, in the order `earl --help` lists them, and the module that implements it
 COMMANDS = {
@@ -123,6 +123,9 @@ AS_PROGRAM = False
 def script() -> int:
     """The `earl` program: `main`, then an exit that does not scan the heap again.
 
+    What a command builds while the collector is paused (the model read, expanded and
+    checked) is frozen when the pause ends (`earl.collector`), so that no collection visits
+    it again: about 8% of `earl check` on the 5 MB benchmark spec.
     Python's own exit collects garbage over every object still alive (the parsed model, NumPy,
     MuJoCo, Lark's tables: a tenth of a second after `earl run`). The garbage is collected
     here once, so that every finalizer runs as before, and what is still alive is frozen, so
@@ -131,6 +134,7 @@ def script() -> int:
     """
     global AS_PROGRAM
     AS_PROGRAM = True
+    collector.FREEZE_ON_RESUME = True  # what a command builds lives until the process ends
     code = main()
     gc.collect()
     gc.freeze()

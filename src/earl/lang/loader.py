@@ -5,8 +5,9 @@ from __future__ import annotations
 from collections.abc import Mapping
 from pathlib import Path
 
+from earl.collector import paused as collection_paused
 from earl.diagnostics import Diagnostic, EarlError, Severity, SourceMap
-from earl.lang.parser import collection_paused, decode, parse_text
+from earl.lang.parser import decode, parse_text
 from earl.lang.transformer import ParsedFile
 from earl.model.elements import Agent, Import, Link, Parameter, Robot, System
 from earl.model.location import SourceLocation

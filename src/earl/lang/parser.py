@@ -2,10 +2,7 @@
 
 from __future__ import annotations
 
-import gc
 from bisect import bisect_left
-from collections.abc import Iterator
-from contextlib import contextmanager
 from functools import lru_cache
 from importlib import resources
 from typing import Any
@@ -13,6 +10,7 @@ from typing import Any
 from lark import Lark, Token
 from lark.exceptions import UnexpectedInput
 
+from earl.collector import paused as collection_paused
 from earl.diagnostics import Diagnostic, EarlError, Severity, SourceMap
 from earl.lang import reductions
 from earl.lang.driver import Driver, NotWellFormed
@@ -39,23 +37,6 @@ class _CommentCollector:
 
 
 _collector = _CommentCollector()
-
-
-@contextmanager
-def collection_paused() -> Iterator[None]:
-    """Python's cyclic garbage collector paused while a spec is read.
-
-    Reading allocates hundreds of thousands of small objects and frees almost none, so
-    the collector would keep scanning a growing heap for cycles that are not there
-    (a fifth of the time of a large file).  It runs again, as before, afterwards.
-    """
-    enabled = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        if enabled:
-            gc.enable()
 
 
 def _grammar() -> str:
