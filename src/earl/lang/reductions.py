@@ -171,6 +171,7 @@ def _callback(rule: Any, builder: Any, table: SpanTable) -> Callable[[list[Any]]
         start: Any = first if type(first) is Token else spans.pop(id(first), None)
         finish: Any = start if last is first else last if type(last) is Token else spans.pop(id(last), None)
         span: Any  # Span | None; Lark types a token's positions as optional
+        inner: Any = raw  # the values whose spans may still be in the table
         if start is None or finish is None:
             # Put back what was taken (one of them has no span); `measure` looks further in.
             if type(first) is not Token:
@@ -178,15 +179,17 @@ def _callback(rule: Any, builder: Any, table: SpanTable) -> Callable[[list[Any]]
             if type(last) is not Token:
                 spans[id(last)] = finish
             span = measure(raw)
-        elif type(start) is Token:
-            if type(finish) is Token:
-                span = (start.line, start.column, finish.end_line, finish.end_column)
-            else:
-                span = (start.line, start.column, finish[2], finish[3])
-        elif type(finish) is Token:
-            span = (start[0], start[1], finish.end_line, finish.end_column)
         else:
-            span = (start[0], start[1], finish[2], finish[3])
+            inner = raw[1:-1] if len(raw) > 2 else ()  # the first and the last were taken out above
+            if type(start) is Token:
+                if type(finish) is Token:
+                    span = (start.line, start.column, finish.end_line, finish.end_column)
+                else:
+                    span = (start.line, start.column, finish[2], finish[3])
+            elif type(finish) is Token:
+                span = (start[0], start[1], finish.end_line, finish.end_column)
+            else:
+                span = (start[0], start[1], finish[2], finish[3])
         children = children_of(raw)
         if expand_single and len(children) == 1:
             # `?atom: "(" expression ")"` passes its child through; like Lark's "container", the
@@ -195,7 +198,7 @@ def _callback(rule: Any, builder: Any, table: SpanTable) -> Callable[[list[Any]]
             if type(only) is not Token:
                 spans[id(only)] = span
             return only
-        for value in raw:
+        for value in inner:
             if type(value) is not Token:
                 spans.pop(id(value), None)
         result: Any = (
