@@ -12,6 +12,8 @@ model costs on top of the parser it is built on.
 
 Every figure is the median of several runs, as wall-clock time and as the process's CPU time
 (the machine may be shared with other work; CPU time is what an idle machine shows as wall time).
+earl's reads and Lark's parses alternate, and the ratio of their CPU times is taken per pair:
+this machine's speed drifts by up to 1.5x within minutes.
 
     .venv/bin/python benchmarks/bench_parse.py            # 100 and 1,000 agents, 3 runs each
     .venv/bin/python benchmarks/bench_parse.py --quick    # 20 agents, one run: a smoke test
@@ -111,23 +113,28 @@ def bench(sizes: list[int], runs: int, peer_runs: int) -> list[dict[str, Any]]:
     rows = []
     for agents in sizes:
         data = generate(agents).encode("utf-8")
-        timings: list[ReadRun] = []
-        for _ in range(runs):
-            run, system = read_once(data)
-            subsystems = sum(len(agent.subsystems) for agent in system.agents)
-            links = len(system.links) + sum(len(agent.links) for agent in system.agents)
-            del system
-            gc.collect()  # the previous run's model, before the next is built
-            timings.append(run)
-            print(f"  {agents} agents: {run.total.wall:.2f} s wall, {run.total.cpu:.2f} s CPU", flush=True)
         text = data.decode("utf-8")
+        timings: list[ReadRun] = []
         peer_timings: list[Timing] = []
-        for _ in range(peer_runs):
-            with collection_paused():
-                tree, timing = timed(lambda text=text: peer.parse(text))  # type: ignore[misc]
-            del tree
-            gc.collect()
-            peer_timings.append(timing)
+        # earl and Lark alternate, so that both meet the same moods of this machine, whose speed
+        # drifts by up to 1.5x within minutes; the ratio of each pair is kept too
+        for index in range(max(runs, peer_runs)):
+            if index < runs:
+                run, system = read_once(data)
+                subsystems = sum(len(agent.subsystems) for agent in system.agents)
+                links = len(system.links) + sum(len(agent.links) for agent in system.agents)
+                del system
+                gc.collect()  # the previous run's model, before the next is built
+                timings.append(run)
+                print(f"  {agents} agents: {run.total.wall:.2f} s wall, {run.total.cpu:.2f} s CPU", flush=True)
+            if index < peer_runs:
+                with collection_paused():
+                    tree, timing = timed(lambda text=text: peer.parse(text))  # type: ignore[misc]
+                del tree
+                gc.collect()
+                peer_timings.append(timing)
+                print(f"  {agents} agents, Lark's tree parse: {timing.cpu:.2f} s CPU", flush=True)
+        ratios = [run.total.cpu / timing.cpu for run, timing in zip(timings, peer_timings, strict=False)]
         tokens = sum(1 for token in peer.lex(text) if token.type not in ("WS", "COMMENT"))
         rows.append(
             {
@@ -142,6 +149,8 @@ def bench(sizes: list[int], runs: int, peer_runs: int) -> list[dict[str, Any]]:
                 "resolve": asdict(median([t.resolve for t in timings])),
                 "total": asdict(median([t.total for t in timings])),
                 "peer_lark_tree_parse": asdict(median(peer_timings)) if peer_timings else None,
+                "earl_over_lark_cpu_per_pair": ratios,
+                "earl_over_lark_cpu_median": statistics.median(ratios) if ratios else None,
             }
         )
     return rows
@@ -150,18 +159,20 @@ def bench(sizes: list[int], runs: int, peer_runs: int) -> list[dict[str, Any]]:
 def table(rows: list[dict[str, Any]]) -> str:
     header = (
         f"{'agents':>7} {'MB':>6} {'tokens':>9} {'decode':>7} {'parse':>7} {'resolve':>8} "
-        f"{'total':>7} {'total CPU':>9} {'peer: Lark tree':>16} {'peer CPU':>9} {'µs/token':>9}"
+        f"{'total':>7} {'total CPU':>9} {'peer: Lark tree':>16} {'peer CPU':>9} {'earl/Lark':>9} {'µs/token':>9}"
     )
     lines = [header, "-" * len(header)]
     for row in rows:
         peer = row["peer_lark_tree_parse"]
         peer_text = f"{peer['wall']:.2f}s" if peer else "-"
         peer_cpu = f"{peer['cpu']:.2f}s" if peer else "-"
+        ratio = row["earl_over_lark_cpu_median"]
+        ratio_text = f"{ratio:.2f}" if ratio is not None else "-"
         lines.append(
             f"{row['agents']:>7} {row['text_bytes'] / 1e6:>6.2f} {row['tokens']:>9} "
             f"{row['decode']['wall']:>6.2f}s {row['parse']['wall']:>6.2f}s {row['resolve']['wall']:>7.2f}s "
             f"{row['total']['wall']:>6.2f}s {row['total']['cpu']:>8.2f}s "
-            f"{peer_text:>16} {peer_cpu:>9} "
+            f"{peer_text:>16} {peer_cpu:>9} {ratio_text:>9} "
             f"{row['total']['cpu'] / row['tokens'] * 1e6:>9.2f}"  # CPU time per token read
         )
     return "\n".join(lines)
