@@ -19,7 +19,7 @@ from earl.lang.transformer import ElementBuilder, ParsedFile, SpecificationSynta
 from earl.model.location import SourceLocation
 
 #: Larger files are refused before parsing.  The benchmark's thousand agents, written out in
-#: full, take 5 MB and some 7 s of CPU to read (benchmarks/results/parse.json); a file much
+#: full, take 5 MB and some 4–5 s of CPU to read (benchmarks/results/parse.json); a file much
 #: larger than that would look like a hang rather than a spec, while a 10 MB file gets its
 #: error at once.
 MAX_FILE_BYTES = 8 * 1024 * 1024
