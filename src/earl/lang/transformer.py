@@ -157,6 +157,8 @@ class ElementBuilder:
         self._depth.clear()
 
     def _loc(self, meta: Meta) -> SourceLocation:
+        if type(meta) is tuple:  # a rule's span: most of the 300,000 locations of a large spec
+            return SourceLocation(self.path, *meta)
         return _location(self.path, meta)
 
     # ------------------------------------------------------------------ file
