@@ -21,7 +21,7 @@ from lark.lexer import ContextualLexer
 import earl
 from earl.diagnostics import SourceMap
 from earl.lang import parser as reader
-from earl.lang.driver import NotWellFormed
+from earl.lang.driver import Driver, NotWellFormed
 from earl.lang.transformer import ParsedFile
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -95,6 +95,13 @@ def test_element_spans_equal_the_positions_of_lark_trees(name: str, text: str) -
     assert expected, name
     for element, spans in expected.items():
         assert sorted(found.get(element, [])) == sorted(spans), element
+
+
+@pytest.mark.parametrize(("name", "text"), TEXTS, ids=[name for name, _ in TEXTS])
+def test_the_loop_with_lark_s_own_tree_callbacks_builds_lark_s_tree(name: str, text: str) -> None:
+    """The loop is Lark's parse, whatever its callbacks build: with the tree parser's, Lark's tree."""
+    tree_parser = reader._parser()
+    assert Driver(tree_parser).read(text) == tree_parser.parse(text)
 
 
 def _not_well_formed(text: str) -> Any:
