@@ -116,9 +116,8 @@ def _comments(parsed: ParsedFile) -> list[tuple[int, int, list[str], str | None]
     )
 
 
-@pytest.mark.parametrize(("name", "text"), TEXTS, ids=[name for name, _ in TEXTS])
-def test_lark_own_loops_read_the_same_model(name: str, text: str, monkeypatch: pytest.MonkeyPatch) -> None:
-    """The reader's one loop (driver.py) against Lark's own parser loop and Lark's own lexer loop."""
+def _assert_lark_s_loops_read_the_same(text: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The reader's one loop (driver.py) against Lark's own parser and lexer loops: model, spans, comments."""
     element_parser = reader._element_parser()
     fast = _parse(text)
     monkeypatch.setattr(element_parser.driver, "read", _not_well_formed)  # the fallback: Lark's own loops
@@ -129,9 +128,14 @@ def test_lark_own_loops_read_the_same_model(name: str, text: str, monkeypatch: p
     spans_slow: dict[str, list[tuple[int, int, int, int]]] = {}
     _elements(fast.declarations, spans_fast)
     _elements(slow.declarations, spans_slow)
-    assert spans_fast == spans_slow
+    assert spans_fast == spans_slow and spans_fast
     assert _comments(fast) == _comments(slow)
     assert (fast.header_comments, fast.closing_comments) == (slow.header_comments, slow.closing_comments)
+
+
+@pytest.mark.parametrize(("name", "text"), TEXTS, ids=[name for name, _ in TEXTS])
+def test_lark_own_loops_read_the_same_model(name: str, text: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    _assert_lark_s_loops_read_the_same(text, monkeypatch)
 
 
 @pytest.mark.parametrize(
@@ -146,16 +150,7 @@ def test_lark_own_loops_read_the_same_model(name: str, text: str, monkeypatch: p
 def test_the_loop_reads_whitespace_and_comments_anywhere_as_lark_does(
     text: str, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    fast = _parse(text)
-    monkeypatch.setattr(reader._element_parser().driver, "read", _not_well_formed)
-    slow = _parse(text)
-    assert fast.declarations == slow.declarations
-    spans_fast: dict[str, list[tuple[int, int, int, int]]] = {}
-    spans_slow: dict[str, list[tuple[int, int, int, int]]] = {}
-    _elements(fast.declarations, spans_fast)
-    _elements(slow.declarations, spans_slow)
-    assert spans_fast == spans_slow and spans_fast
-    assert _comments(fast) == _comments(slow) and fast.closing_comments == slow.closing_comments
+    _assert_lark_s_loops_read_the_same(text, monkeypatch)
 
 
 def test_a_text_the_loop_cannot_read_gets_lark_s_error_from_the_same_spot() -> None:
