@@ -104,6 +104,21 @@ def test_the_loop_with_lark_s_own_tree_callbacks_builds_lark_s_tree(name: str, t
     assert Driver(tree_parser).read(text) == tree_parser.parse(text)
 
 
+def test_the_benchmark_s_loop_alone_walks_every_text_and_builds_nothing() -> None:
+    """bench_parse's "loop alone" (the model's share is what a read costs beyond it) must walk the
+    whole text the reader walks: a text the loop cannot read raises, so a short walk cannot pass."""
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    try:
+        from bench_parse import loop_alone
+    finally:
+        sys.path.remove(str(ROOT / "benchmarks"))
+    loop = loop_alone()
+    for name, text in TEXTS:
+        assert loop.read(text) is None, name
+    with pytest.raises(NotWellFormed):
+        loop.read(TEXTS[0][1] + "\n}")
+
+
 def _not_well_formed(text: str) -> Any:
     """The loop giving up at once: the reader then parses with Lark's own loop."""
     raise NotWellFormed(0)
