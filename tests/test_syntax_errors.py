@@ -383,6 +383,43 @@ SYNTAX = [
         "EARL-S017",
         "this array type has more than 32 dimensions",
     ),
+    # a string's escapes are JSON's: what JSON refuses is pointed at, never a traceback
+    Malformed(
+        "string_with_unknown_escape",
+        'system s\nparam P: string = "a\\qb"\n',
+        2,
+        21,
+        "EARL-S018",
+        "`\\q` is not an escape a string can hold",
+        "the escapes of JSON",
+    ),
+    Malformed(
+        "string_with_short_unicode_escape",
+        _in_cs('        f/pf(->) = python "m:\\u12"\n'),
+        9,
+        30,
+        "EARL-S018",
+        "`\\u12` is not an escape a string can hold",
+        "four hexadecimal digits",
+    ),
+    Malformed(
+        "string_with_a_tab",
+        'system s\nimport "lib\tx.earl"\n',
+        2,
+        12,
+        "EARL-S018",
+        "a string cannot hold the control character U+0009 as it is",
+        "`\\t` for a tab",
+    ),
+    Malformed(
+        "string_with_half_a_surrogate_pair",
+        _in_cs('        label/m: string = "\\ud800"\n'),
+        9,
+        27,
+        "EARL-S018",
+        "half of a surrogate pair (`\\ud800`)",
+        "both halves of its pair",
+    ),
     Malformed(
         "unexpected_character_dollar",
         _in_cs("        x/pp = $true\n"),
@@ -670,6 +707,8 @@ def test_a_syntax_error_is_one_located_sentence(case: Malformed) -> None:
     assert case.fragment in diagnostic.message
     assert "\n" not in diagnostic.message
     assert "Token(" not in diagnostic.message and "Tree(" not in diagnostic.message  # no parser internals
+    if case.hint is not None:  # a fragment of it
+        assert case.hint in (diagnostic.hint or "")
 
 
 @pytest.mark.parametrize("case", NAMES, ids=lambda case: case.name)

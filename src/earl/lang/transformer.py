@@ -9,6 +9,7 @@ refused above a bound so that nothing later in the pipeline can.
 
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -156,6 +157,9 @@ class ElementBuilder:
         self.path = path
         self._depth.clear()
 
+    def _string(self, token: Token) -> str:
+        return _string_value(token, self.path)
+
     def _loc(self, meta: Meta) -> SourceLocation:
         if type(meta) is tuple:  # a rule's span: most of the 300,000 locations of a large spec
             return SourceLocation(self.path, *meta)
@@ -174,7 +178,7 @@ class ElementBuilder:
         return ("system", str(children[0]), self._loc(children[0]))
 
     def import_decl(self, meta: Meta, children: list[Token]) -> Import:
-        return Import(_string_value(children[0]), self._loc(meta))
+        return Import(self._string(children[0]), self._loc(meta))
 
     def parameter(self, meta: Meta, children: list[Any]) -> Parameter:
         name, data_type, value = children
@@ -449,7 +453,7 @@ class ElementBuilder:
         return list(children)
 
     def implementation(self, meta: Meta, children: list[Token]) -> PythonImplementation:
-        return PythonImplementation(_string_value(children[0]))
+        return PythonImplementation(self._string(children[0]))
 
     def stage_set(self, meta: Meta, children: list[Any]) -> StageSet:
         return StageSet(str(children[0]), children[1], self._loc(meta))
@@ -614,7 +618,7 @@ class ElementBuilder:
         return Literal(_number(children[0]), self._loc(meta))
 
     def string(self, meta: Meta, children: list[Token]) -> Expression:
-        return Literal(_string_value(children[0]), self._loc(meta))
+        return Literal(self._string(children[0]), self._loc(meta))
 
     def true(self, meta: Meta, children: list[Token]) -> Expression:
         return Literal(True, self._loc(meta))
@@ -651,10 +655,44 @@ def _number(token: Token) -> int | float:
     return int(text)
 
 
-def _string_value(token: Token) -> str:
-    import json
+#: what a string may hold after a backslash, for the message when it holds something else
+_STRING_ESCAPES = '`\\"`, `\\\\`, `\\/`, `\\b`, `\\f`, `\\n`, `\\r`, `\\t` and `\\uXXXX`'
 
-    return str(json.loads(str(token)))
+
+def _string_value(token: Token, path: str) -> str:
+    """The text a string literal stands for: its escapes are JSON's (docs/language.md)."""
+    text = str(token)
+    try:
+        value = json.loads(text)
+        value.encode("utf-8")  # a lone surrogate (`\ud800`) would fail every file written later
+    except json.JSONDecodeError as error:
+        # json points at a bad escape's backslash, but at the `u` of a short `\\u` escape
+        start = error.pos - 1 if error.msg.startswith("Invalid \\uXXXX") else error.pos
+        column = (token.column or 1) + start
+        if error.msg.startswith("Invalid control character"):
+            message = f"a string cannot hold the control character U+{ord(text[start]):04X} as it is"
+            hint = "write it as an escape: `\\t` for a tab, `\\u00XX` for any other"
+            width = 1
+        else:
+            escape = text[start : start + (6 if text[start + 1 : start + 2] == "u" else 2)].rstrip('"')
+            message = f"`{escape}` is not an escape a string can hold"
+            hint = f"a string takes the escapes of JSON: {_STRING_ESCAPES} (four hexadecimal digits)"
+            width = len(escape)
+        location = SourceLocation(path, token.line or 1, column, token.line or 1, column + width)
+        raise SpecificationSyntaxError(
+            Diagnostic(Severity.ERROR, message, location, code="EARL-S018", hint=hint)
+        ) from None
+    except UnicodeEncodeError as error:
+        raise SpecificationSyntaxError(
+            Diagnostic(
+                Severity.ERROR,
+                f"this string holds half of a surrogate pair (`\\u{ord(value[error.start]):04x}`), which is no character",
+                _location(path, token),
+                code="EARL-S018",
+                hint="write the character itself, or both halves of its pair (`\\ud83d\\ude00`)",
+            )
+        ) from None
+    return str(value)
 
 
 def _index_source(index: Expression) -> str:
