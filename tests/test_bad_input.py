@@ -7,9 +7,12 @@ or huge range (issue 2, "Bad input").
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 import earl
 from earl.cli.main import main
@@ -226,3 +229,92 @@ def test_a_huge_family_of_buffers_is_refused_too(tmp_path: Path) -> None:
     [error] = _errors(path)
     assert error.code == "EARL-R017"
     assert error.location is not None and error.location.line == 9
+
+
+# ---------------------------------------------------------------------- mutated specs
+#: the specs mutated below, with the files beside them (imports, code): each a real system
+_MUTATED = sorted((Path(__file__).parent.parent / "examples").glob("*/system.earl"))
+#: what a mutation may insert: punctuation, the language's own words and suffixes, odd numbers and characters
+_INSERTS = [
+    *"{}()[],:;/.-><=!*?\"'\\@#$%^&|~`+",
+    "->",
+    "..",
+    " in ",
+    " and ",
+    " not ",
+    "newData(",
+    "/ib",
+    "/ob",
+    "/m",
+    "/pp",
+    "/pf",
+    "/bb",
+    "/a",
+    "/r",
+    "N",
+    "-1",
+    "1e309",
+    "99999999999999999999",
+    "\n",
+    "\t",
+    "é",
+    "\ufeff",
+    "state",
+    "fsm",
+    "link",
+    'import "x.earl"',
+    "param",
+    "period",
+    "obligatory",
+    "timeout",
+    "tf =",
+    "then",
+    'python "a:b"',
+    '"\\q"',
+]
+
+
+@st.composite
+def _mutated_text(draw: st.DrawFn) -> tuple[Path, str]:
+    """An example with one to three random cuts, insertions and copies of its own text."""
+    path = draw(st.sampled_from(_MUTATED))
+    text = path.read_text(encoding="utf-8")
+    for _ in range(draw(st.integers(1, 3))):
+        start = draw(st.integers(0, len(text)))
+        end = min(len(text), start + draw(st.integers(0, 20)))
+        action = draw(st.sampled_from(["cut", "insert", "copy", "in a string"]))
+        strings = [found.span() for found in re.finditer(r'"[^"\n]*"', text)]
+        if action == "in a string" and strings:  # what only a string's reader sees: escapes, control characters
+            opening, closing = draw(st.sampled_from(strings))
+            at = draw(st.integers(opening + 1, closing - 1))
+            text = text[:at] + draw(st.sampled_from(["\\q", "\t", "\\u12", "\\ud800", "\\n", "\x01"])) + text[at:]
+        elif action == "cut":
+            text = text[:start] + text[end:]
+        elif action == "insert":
+            text = text[:start] + draw(st.sampled_from(_INSERTS)) + text[start:]
+        else:
+            source = draw(st.integers(0, len(text)))
+            text = text[:start] + text[source : source + draw(st.integers(1, 40))] + text[start:]
+    return path, text
+
+
+@settings(max_examples=120, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(_mutated_text())
+def test_a_mutated_example_gets_a_verdict_never_a_traceback(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], case: tuple[Path, str]
+) -> None:
+    """`earl check` and `earl fmt` of a damaged spec end with 0 or 1; an error names its file, line and column."""
+    example, text = case
+    for sibling in example.parent.iterdir():  # the files it imports, the code it names
+        if sibling.is_file() and sibling.name != example.name:
+            (tmp_path / sibling.name).write_bytes(sibling.read_bytes())
+    spec = tmp_path / example.name
+    spec.write_text(text, encoding="utf-8")
+    for command in (["check", str(spec)], ["fmt", str(spec)]):
+        code = main(command)
+        output = capsys.readouterr()
+        printed = output.out + output.err
+        assert code in (0, 1), (command[0], text)
+        assert "Traceback" not in printed
+        if code == 1 and command[0] == "check":
+            assert f"{example.name}:" in printed and "error" in printed
