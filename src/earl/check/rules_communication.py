@@ -93,36 +93,41 @@ def _chain(context: CheckContext, middle: Kind, real: Kind, towards_real: bool) 
         if not link.between_agents:
             inside.setdefault(id(link.source_agent), []).append(link)
     chain = f"cs → {middle.value} → {real.value}" if towards_real else f"{real.value} → {middle.value} → cs"
+    # per agent, once: an agent with a family of N effectors has N of them and some 2N links
+    on_a_chain: dict[int, set[int]] = {}
     for agent, subsystem in context.subsystems():
         if subsystem.kind is not real:
             continue
-        links = inside.get(id(agent), [])
-        if towards_real:
-            commanded = {
-                id(link.destination_subsystem) for link in links if link.source_subsystem.kind is Kind.CONTROL_SUBSYSTEM
-            }
-            complete = any(
-                link.destination_subsystem is subsystem
-                and link.source_subsystem.kind is middle
-                and id(link.source_subsystem) in commanded
-                for link in links
-            )
-        else:
-            reporting = {
-                id(link.source_subsystem) for link in links if link.destination_subsystem.kind is Kind.CONTROL_SUBSYSTEM
-            }
-            complete = any(
-                link.source_subsystem is subsystem
-                and link.destination_subsystem.kind is middle
-                and id(link.destination_subsystem) in reporting
-                for link in links
-            )
-        if not complete:
+        complete = on_a_chain.get(id(agent))
+        if complete is None:
+            complete = on_a_chain[id(agent)] = _ends_of_chains(inside.get(id(agent), []), middle, towards_real)
+        if id(subsystem) not in complete:
             yield Finding(
                 f"`{subsystem_name(agent, subsystem)}` is not on a chain {chain}",
                 subsystem.location,
                 f"§2.3: every {KIND_TITLES[real]} needs the chain {chain}; link the missing step",
             )
+
+
+def _ends_of_chains(links: list[ResolvedLink], middle: Kind, towards_real: bool) -> set[int]:
+    """The subsystems (by id) that a cs → middle → x chain reaches, or that start an x → middle → cs chain."""
+    if towards_real:
+        commanded = {
+            id(link.destination_subsystem) for link in links if link.source_subsystem.kind is Kind.CONTROL_SUBSYSTEM
+        }
+        return {
+            id(link.destination_subsystem)
+            for link in links
+            if link.source_subsystem.kind is middle and id(link.source_subsystem) in commanded
+        }
+    reporting = {
+        id(link.source_subsystem) for link in links if link.destination_subsystem.kind is Kind.CONTROL_SUBSYSTEM
+    }
+    return {
+        id(link.source_subsystem)
+        for link in links
+        if link.destination_subsystem.kind is middle and id(link.destination_subsystem) in reporting
+    }
 
 
 @rule("EARL-E014", Severity.ERROR, "every Real Effector is commanded through cs → ve → re", "§2.3, Figure 7")
