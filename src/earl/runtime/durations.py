@@ -5,7 +5,10 @@ from __future__ import annotations
 import re
 
 _UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "min": 60.0, "": 1.0}
-_PATTERN = re.compile(r"^\s*([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)\s*(s|ms|us|min|)\s*$")
+#: the longest duration taken: about 31 years, far beyond any run, and far inside what a float and
+#: the runtime's integer nanoseconds hold exactly enough (`1e400s` would be infinite)
+MAX_SECONDS = 1e9
+_PATTERN = re.compile(r"^\s*([-+]?[0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)\s*(s|ms|us|min|)\s*$")
 
 
 def parse_duration(text: str) -> float:
@@ -16,4 +19,6 @@ def parse_duration(text: str) -> float:
     value = float(match.group(1)) * _UNITS[match.group(2)]
     if value <= 0:
         raise ValueError(f"`{text}`: a duration must be positive")
+    if not value <= MAX_SECONDS:  # also catches the infinity of `1e400`
+        raise ValueError(f"`{text}` is too long: a duration is at most {MAX_SECONDS:,.0f} s (about 31 years)")
     return value
