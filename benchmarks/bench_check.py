@@ -4,6 +4,10 @@
 (b) Doubling the spec costs less than 2.2x the time.
 (c) The FSM analysis of one subsystem with 20 primitive predicates and 50 transitions takes
     under 1 s.
+(d) The same doubling bound (< 2.2x) where the growth is inside one agent: the flagship example
+    with N joints, N = 2,500, 5,000 and 10,000, so one agent holds N virtual and N real
+    effectors and 2N links between them (a rule that compared every effector with every link
+    of its agent once made N = 10,000 take 78 s).
 
 The spec of (a) and (b) comes from benchmarks/generate_families.py: agent and subsystem
 families, so the text is short and the cost is reading it, expanding it into 100,000 concrete
@@ -128,6 +132,62 @@ def measure_once(workers: int) -> dict[str, Any]:
         "rules": asdict(run.rules),
         "total": asdict(run.total),
     }
+
+
+FLAGSHIP = HERE.parent / "examples" / "pick_and_place"
+JOINTS = [2500, 5000, 10000]
+
+
+def measure_joints_once(joints: int) -> dict[str, Any]:
+    """`earl check examples/pick_and_place --param N=joints`, its phases timed."""
+    earl.load(FLAGSHIP)  # warm up: the first read builds the parser's tables
+    with collector_paused():
+        system, read = timed(lambda: earl.load(FLAGSHIP))
+        context, expand = timed(lambda: context_for(system, {"N": joints}))
+        diagnostics, rules = timed(lambda: check_context(context))
+    run = SpecRun(read, expand, rules)
+    return {
+        "joints": joints,
+        "subsystems": sum(len(agent.subsystems) for agent in context.system.agents),
+        "errors": sum(1 for d in diagnostics if d.severity is Severity.ERROR),
+        "total": asdict(run.total),
+    }
+
+
+def bench_joints(joints: list[int], runs: int) -> dict[str, Any]:
+    rows = []
+    for count in joints:
+        measured = []
+        for _ in range(runs):
+            output = subprocess.run(
+                [sys.executable, str(Path(__file__).resolve()), "--measure-joints-once", str(count)],
+                check=True,
+                capture_output=True,
+                text=True,
+            ).stdout
+            one = json.loads(output)
+            if one["errors"]:
+                raise SystemExit(f"the example with N={count} has {one['errors']} errors")
+            measured.append(one)
+            print(f"  pick_and_place, N={count}: {one['total']['wall']:.2f} s wall", flush=True)
+        rows.append(
+            {
+                "joints": count,
+                "subsystems": measured[0]["subsystems"],
+                "runs": runs,
+                "total": asdict(median([Timing(**one["total"]) for one in measured])),
+            }
+        )
+    doubling = [
+        {
+            "from_joints": smaller["joints"],
+            "to_joints": larger["joints"],
+            "cpu_ratio": larger["total"]["cpu"] / smaller["total"]["cpu"],
+        }
+        for smaller, larger in itertools.pairwise(rows)
+        if larger["joints"] == 2 * smaller["joints"]
+    ]
+    return {"sizes": rows, "doubling": doubling, "met": all(d["cpu_ratio"] < TARGET_DOUBLING for d in doubling)}
 
 
 def bench_sizes(sizes: list[int], runs: int) -> list[dict[str, Any]]:
@@ -391,9 +451,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--quick", action="store_true", help="small sizes and one run: a smoke test")
     parser.add_argument("--output", type=Path, default=RESULTS, help="where to write the JSON results")
     parser.add_argument("--measure-once", type=int, metavar="AGENTS", help=argparse.SUPPRESS)
+    parser.add_argument("--measure-joints-once", type=int, metavar="N", help=argparse.SUPPRESS)
     arguments = parser.parse_args(argv)
     if arguments.measure_once is not None:
         print(json.dumps(measure_once(arguments.measure_once)))
+        return 0
+    if arguments.measure_joints_once is not None:
+        print(json.dumps(measure_joints_once(arguments.measure_joints_once)))
         return 0
     if arguments.quick:
         arguments.sizes, arguments.runs = [250, 500], 1
@@ -402,7 +466,12 @@ def main(argv: list[str] | None = None) -> int:
     sizes = bench_sizes(arguments.sizes, arguments.runs)
     fsm_runs = max(3, arguments.runs)
     fsms = [bench_fsm(20, 50, fsm_runs, peer=True), bench_fsm(40, 100, fsm_runs, peer=False)]
+    joints = bench_joints([250, 500] if arguments.quick else JOINTS, arguments.runs)
     summary = report(sizes, fsms)
+    print()
+    for d in joints["doubling"]:
+        print(f"one agent, doubling N {d['from_joints']} -> {d['to_joints']} joints: {d['cpu_ratio']:.2f}x CPU")
+    print(f"d_one_agent_doubling_under_2_2x: {joints['met']}")
     results = {
         "benchmark": "check",
         "issue": 3,
@@ -418,6 +487,7 @@ def main(argv: list[str] | None = None) -> int:
         },
         "sizes": sizes,
         "fsm": fsms,
+        "one_agent_family": joints,
         **summary,
     }
     arguments.output.parent.mkdir(parents=True, exist_ok=True)
