@@ -88,6 +88,27 @@ def test_a_10_mb_file_is_refused_before_it_is_read(tmp_path: Path, capsys: pytes
     assert "MiB" in error.message and "refused" in error.message
     assert error.hint is not None and "import" in error.hint
     _check_exits_1(path, capsys)
+    assert "9.5 MiB" in error.message  # the file's own size, though only 8 MiB and a byte are read
+
+
+@pytest.mark.skipif(not Path("/dev/zero").exists(), reason="needs /dev/zero")
+def test_an_endless_file_is_read_no_further_than_the_size_limit(capsys: pytest.CaptureFixture[str]) -> None:
+    """`/dev/zero` (or a pipe that never ends) must not be read for ever, nor into memory whole."""
+    [error] = _errors(Path("/dev/zero"))
+    assert error.code == "EARL-S020"
+    assert "more than 8 MiB" in error.message
+    _check_exits_1(Path("/dev/zero"), capsys)
+
+
+def test_an_import_of_a_loop_of_symbolic_links_points_at_the_import(tmp_path: Path) -> None:
+    (tmp_path / "one.earl").symlink_to(tmp_path / "two.earl")
+    (tmp_path / "two.earl").symlink_to(tmp_path / "one.earl")
+    spec = tmp_path / "system.earl"
+    spec.write_text('system s\nimport "one.earl"\n', encoding="utf-8")
+    [error] = _errors(spec)
+    assert error.code == "EARL-S030"
+    assert error.location is not None and (error.location.line, error.location.column) == (2, 1)
+    assert "cannot read" in error.message and "one.earl" in error.message
 
 
 DEEP = 10_000

@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
+import os
 from collections.abc import Mapping
 from pathlib import Path
 
 from earl.collector import paused as collection_paused
 from earl.diagnostics import Diagnostic, EarlError, Severity, SourceMap
-from earl.lang.parser import decode, parse_text
+from earl.lang.parser import MAX_FILE_BYTES, decode, parse_text, too_large
 from earl.lang.transformer import ParsedFile
 from earl.model.elements import Agent, Import, Link, Parameter, Robot, System
 from earl.model.location import SourceLocation
@@ -19,15 +20,29 @@ ParameterValue = bool | int | float | str
 def _display_path(path: Path) -> str:
     """Paths in messages are relative to the working directory when they can be."""
     try:
-        return str(path.resolve().relative_to(Path.cwd().resolve()))
+        return str(_resolved(path).relative_to(Path.cwd().resolve()))
     except ValueError:
         return str(path)
+
+
+def _resolved(path: Path) -> Path:
+    """The absolute path with symbolic links followed; as far as they go when they loop, for the
+    error that reading it then reports."""
+    try:
+        return path.resolve()
+    except (RuntimeError, OSError):  # Python 3.11 raises RuntimeError for a loop of links, 3.13 OSError
+        return path.absolute()
 
 
 def read_file(path: Path, sources: SourceMap, location: SourceLocation | None = None) -> ParsedFile:
     shown = _display_path(path)
     try:
-        data = path.read_bytes()
+        with path.open("rb") as file:
+            # at most one byte more than a spec may have: `/dev/zero` or a pipe must not be read for ever
+            data = file.read(MAX_FILE_BYTES + 1)
+            if len(data) > MAX_FILE_BYTES:
+                size = os.fstat(file.fileno()).st_size
+                raise EarlError([too_large(shown, size if size > MAX_FILE_BYTES else None)], sources)
     except FileNotFoundError:
         raise EarlError(
             [Diagnostic(Severity.ERROR, f"no such file: {shown}", location, code="EARL-S030")], sources
@@ -69,13 +84,13 @@ def load_files(path: Path, sources: SourceMap) -> tuple[ParsedFile, list[ParsedF
     """The root file and every file it imports (depth first, each once), cycles refused."""
     root = read_file(path, sources)
     imported: list[ParsedFile] = []
-    seen: dict[Path, ParsedFile] = {path.resolve(): root}
+    seen: dict[Path, ParsedFile] = {_resolved(path): root}
 
     def visit(parsed: ParsedFile, file_path: Path, chain: list[Path]) -> None:
         for declaration in parsed.declarations:
             if not isinstance(declaration, Import):
                 continue
-            target = (file_path.parent / declaration.path).resolve()
+            target = _resolved(file_path.parent / declaration.path)
             if target in chain:
                 cycle = " -> ".join(_display_path(p) for p in [*chain[chain.index(target) :], target])
                 raise EarlError(
@@ -111,7 +126,7 @@ def load_files(path: Path, sources: SourceMap) -> tuple[ParsedFile, list[ParsedF
             visit(child, target, [*chain, target])
             imported.append(child)
 
-    visit(root, path, [path.resolve()])
+    visit(root, path, [_resolved(path)])
     return root, imported
 
 

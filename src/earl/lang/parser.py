@@ -108,22 +108,23 @@ def keyword_terminals() -> dict[str, str]:
     return result
 
 
+def too_large(path: str, size: int | None) -> Diagnostic:
+    """The error for a file over MAX_FILE_BYTES; `size` None when unknown (a device or a pipe)."""
+    measured = f"{size / 2**20:.1f} MiB" if size is not None else f"more than {MAX_FILE_BYTES // 2**20} MiB"
+    return Diagnostic(
+        Severity.ERROR,
+        f"the file is {measured}; specifications larger than {MAX_FILE_BYTES // 2**20} MiB are refused",
+        SourceLocation(path, 1, 1, 1, 1),
+        code="EARL-S020",
+        hint="split the system into files joined with `import`",
+    )
+
+
 def decode(data: bytes, path: str) -> str:
     """The text of a spec file, or an error saying why these bytes are not one."""
     location = SourceLocation(path, 1, 1, 1, 1)
     if len(data) > MAX_FILE_BYTES:
-        raise EarlError(
-            [
-                Diagnostic(
-                    Severity.ERROR,
-                    f"the file is {len(data) / 2**20:.1f} MiB; specifications larger than "
-                    f"{MAX_FILE_BYTES // 2**20} MiB are refused",
-                    location,
-                    code="EARL-S020",
-                    hint="split the system into files joined with `import`",
-                )
-            ]
-        )
+        raise EarlError([too_large(path, len(data))])
     if b"\x00" in data[:8192]:
         raise EarlError(
             [
