@@ -8,6 +8,7 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from random import Random
 
 import pytest
 
@@ -73,6 +74,41 @@ def test_a_trace_summary_of_something_else_is_a_clear_error(tmp_path: Path) -> N
     assert result.returncode == 1
     assert "not a readable MCAP trace" in result.stderr
     assert earl_cli("trace", "summary", str(tmp_path / "missing.mcap")).returncode == 2
+
+
+def test_a_damaged_trace_is_a_clear_error_for_summary_and_plot(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Cut short or with bytes changed anywhere (a disk error, a copy that stopped): exit 1 and one line,
+    whatever the MCAP reader or its decompressor raises on the way."""
+    from earl.cli.main import main
+
+    trace = tmp_path / "run.mcap"
+    assert earl_cli("run", str(SPECS / "counter"), "--duration", "200ms", "--trace", str(trace)).returncode == 0
+    data = trace.read_bytes()
+    damaged = tmp_path / "damaged.mcap"
+    random = Random(7)
+    cases = [data[:length] for length in (8, len(data) // 3, len(data) // 2, len(data) - 20)]
+    for _ in range(60):
+        changed = bytearray(data)
+        for _ in range(random.randint(1, 6)):
+            changed[random.randrange(len(changed))] = random.randrange(256)
+        cases.append(bytes(changed))
+    failures = 0
+    for case in cases:
+        damaged.write_bytes(case)
+        for command in (
+            ["trace", "summary", str(damaged)],
+            ["plot", str(damaged), "--signal", "counter/a.relay/ve.back", "-o", str(tmp_path / "p.png")],
+        ):
+            code = main(command)
+            output = capsys.readouterr()
+            assert code in (0, 1), command
+            if code == 1:
+                failures += 1
+                assert output.err.startswith(f"earl {command[0]}: "), output.err
+                assert output.err.count("\n") == 1
+    assert failures >= len(cases)  # most damage is found: some changed bytes (in a padding, say) harm nothing
 
 
 @pytest.mark.parametrize(

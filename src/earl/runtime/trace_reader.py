@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from mcap.exceptions import McapError
+from mcap.exceptions import EndOfFile, McapError
 from mcap.reader import make_reader
 
 from earl.runtime.values import iter_leaves
@@ -52,54 +52,88 @@ def _messages(path: Path, topics: list[str] | None = None) -> Iterator[tuple[str
                 yield channel.topic, channel.metadata, message.log_time, json.loads(message.data)
     except FileNotFoundError:
         raise TraceError(f"no such file: {path}") from None
-    except (McapError, json.JSONDecodeError, ValueError, EOFError) as error:
-        raise TraceError(f"{path} is not a readable MCAP trace ({error})") from None
+    except Exception as error:  # a damaged file provokes whatever the reader and its decompressors raise
+        raise _unreadable(path, error) from None
+
+
+def _unreadable(path: Path, error: BaseException) -> TraceError:
+    """A damaged or foreign file: McapError, a decompressor's error, a record too long to allocate …"""
+    if not str(error):
+        detail = "it ends early" if isinstance(error, EOFError | EndOfFile) else type(error).__name__
+    elif isinstance(error, McapError | json.JSONDecodeError):
+        detail = str(error)
+    else:
+        detail = f"{type(error).__name__}: {error}"
+    return TraceError(f"{path} is not a readable MCAP trace ({detail})")
+
+
+def _not_earl_s(path: Path, topic: str) -> TraceError:
+    return TraceError(
+        f"{path}: a message on `{topic}` is not one earl writes (the file is damaged or not an earl trace)"
+    )
 
 
 def summarise(path: Path) -> TraceSummary:
-    subsystems: dict[str, SubsystemSummary] = {}
-    entered: dict[str, tuple[str, int]] = {}
-    faults: list[dict[str, Any]] = []
-    end_time = 0
-    messages = 0
-    settings: dict[str, Any] = {}
-    seen_run = False
+    summariser = _Summariser()
+    for topic, metadata, time, data in _messages(path):
+        try:
+            summariser.add(topic, metadata, time, data)
+        except (KeyError, TypeError, ValueError, AttributeError):
+            raise _not_earl_s(path, topic) from None
+    if not summariser.seen_run:
+        raise TraceError(f"{path} is an MCAP file but not an earl trace (it has no /earl/run topic)")
+    return summariser.summary()
 
-    def of(name: str) -> SubsystemSummary:
-        found = subsystems.get(name)
+
+class _Summariser:
+    """The summary, message by message; a message not as earl writes it raises KeyError, TypeError …"""
+
+    def __init__(self) -> None:
+        self.subsystems: dict[str, SubsystemSummary] = {}
+        self.entered: dict[str, tuple[str, int]] = {}
+        self.faults: list[dict[str, Any]] = []
+        self.end_time = 0
+        self.messages = 0
+        self.settings: dict[str, Any] = {}
+        self.seen_run = False
+
+    def of(self, name: str) -> SubsystemSummary:
+        found = self.subsystems.get(name)
         if found is None:
-            found = subsystems[name] = SubsystemSummary(name)
+            found = self.subsystems[name] = SubsystemSummary(str(name))
         return found
 
-    for topic, metadata, time, data in _messages(path):
-        end_time = max(end_time, time)
+    def add(self, topic: str, metadata: dict[str, str], time: int, data: Any) -> None:
+        self.end_time = max(self.end_time, time)
         if topic == "/earl/run":
-            seen_run = True
+            self.seen_run = True
             if data.get("event") == "start":
-                settings = {k: v for k, v in data.items() if k != "event"}
+                self.settings = {k: v for k, v in data.items() if k != "event"}
             elif data.get("event") == "end":
                 for name, count in data.get("iterations", {}).items():
-                    of(name).iterations = int(count)
+                    self.of(name).iterations = int(count)
         elif topic == "/earl/faults":
-            faults.append({"time": time, **data})
-            of(data.get("subsystem", "?")).faults += 1
+            self.faults.append({"time": time, **data})
+            self.of(data.get("subsystem", "?")).faults += 1
         elif topic.startswith("link/"):
-            messages += 1
+            self.messages += 1
         elif topic.endswith("/fsm"):
             name = metadata.get("subsystem", topic[: -len("/fsm")])
-            summary = of(name)
-            if name in entered:
-                state, since = entered[name]
+            summary = self.of(name)
+            state_to = str(data["to"])
+            if name in self.entered:
+                state, since = self.entered[name]
                 summary.state_time[state] = summary.state_time.get(state, 0) + time - since
-                summary.transitions[data["transition"]] = summary.transitions.get(data["transition"], 0) + 1
-            entered[name] = (data["to"], time)
-            summary.final_state = data["to"]
-    if not seen_run:
-        raise TraceError(f"{path} is an MCAP file but not an earl trace (it has no /earl/run topic)")
-    for name, (state, since) in entered.items():
-        summary = subsystems[name]
-        summary.state_time[state] = summary.state_time.get(state, 0) + end_time - since
-    return TraceSummary(end_time, subsystems, faults, messages, settings)
+                transition = str(data["transition"])
+                summary.transitions[transition] = summary.transitions.get(transition, 0) + 1
+            self.entered[name] = (state_to, time)
+            summary.final_state = state_to
+
+    def summary(self) -> TraceSummary:
+        for name, (state, since) in self.entered.items():
+            summary = self.subsystems[name]
+            summary.state_time[state] = summary.state_time.get(state, 0) + self.end_time - since
+        return TraceSummary(self.end_time, self.subsystems, self.faults, self.messages, self.settings)
 
 
 def topics(path: Path) -> dict[str, dict[str, str]]:
@@ -108,8 +142,8 @@ def topics(path: Path) -> dict[str, dict[str, str]]:
             summary = make_reader(stream).get_summary()
     except FileNotFoundError:
         raise TraceError(f"no such file: {path}") from None
-    except (McapError, ValueError, EOFError) as error:
-        raise TraceError(f"{path} is not a readable MCAP trace ({error})") from None
+    except Exception as error:  # as in `_messages`
+        raise _unreadable(path, error) from None
     if summary is None:
         return {}
     return {channel.topic: dict(channel.metadata) for channel in summary.channels.values()}
@@ -171,18 +205,21 @@ def read_signals(path: Path, names: list[str]) -> Signals:
         end = max(end, seconds)
         if topic == "/earl/run":
             continue
-        subsystem, buffer = wanted[topic]
-        if topic.endswith("/fsm"):
-            stays.setdefault(subsystem, []).append((seconds, data["to"]))
-            continue
-        for leaf, value in iter_leaves(data):
-            if buffer:
-                leaf = buffer if leaf == "value" else f"{buffer}.{leaf}"
-            found = leaves.get((subsystem, leaf))
-            if found is None:
-                found = leaves[(subsystem, leaf)] = ([], [])
-            found[0].append(seconds)
-            found[1].append(float(value))
+        try:
+            subsystem, buffer = wanted[topic]
+            if topic.endswith("/fsm"):
+                stays.setdefault(subsystem, []).append((seconds, str(data["to"])))
+                continue
+            for leaf, value in iter_leaves(data):
+                if buffer:
+                    leaf = buffer if leaf == "value" else f"{buffer}.{leaf}"
+                found = leaves.get((subsystem, leaf))
+                if found is None:
+                    found = leaves[(subsystem, leaf)] = ([], [])
+                found[0].append(seconds)
+                found[1].append(float(value))
+        except (KeyError, TypeError, ValueError, AttributeError):
+            raise _not_earl_s(path, topic) from None
     series: list[Series] = []
     for name, subsystem, inner in owners:
         pattern = re.compile(re.escape(inner).replace(r"\[\*\]", r"\[\d+\]") + "$")
