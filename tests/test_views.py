@@ -81,6 +81,8 @@ def write(inputs, outputs, context):
         outputs.joints = numpy.array([0.5, 0.25, 0.125])
     elif mode == 6:
         outputs.level = math.nan
+    elif mode == 7:
+        inputs.sent = 100  # inputs are read-only: the call fails, and writes nothing
 """
 
 
@@ -126,6 +128,7 @@ def test_writes_are_taken_when_the_call_returns_and_read_back_by_item(tmp_path: 
         (3, "type", "joints/mo must have 3 elements"),
         (4, "undeclared-write", "`current` is a family: write one member"),
         (6, "type", "level/mo is NaN"),
+        (7, "undeclared-write", "`write/pf` assigned `inputs.sent`; inputs are read-only"),
     ],
 )
 def test_a_value_the_quick_test_rejects_gets_the_precise_message(

@@ -107,6 +107,21 @@ class Inputs:
             write=False,
         )
 
+    def __setattr__(self, name: str, value: Any) -> None:
+        # Reads stay CPython's fast attribute reads: only assignments come here.  Without this, an
+        # assignment would land in the snapshot and vanish at the next call, without a word.
+        if name.startswith("_earl_"):
+            object.__setattr__(self, name, value)
+            return
+        raise UndeclaredAccess(
+            f"`{self._earl_function}` assigned `inputs.{name}`; inputs are read-only: "
+            "a function writes only its declared outputs (`outputs.…`, the names after `->`)",
+            write=True,
+        )
+
+    def __delattr__(self, name: str) -> None:
+        self.__setattr__(name, None)
+
     def __getitem__(self, name: str) -> Any:
         entry = self._earl_full.get(name)
         if entry is not None:
