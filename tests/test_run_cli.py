@@ -111,6 +111,26 @@ def test_a_damaged_trace_is_a_clear_error_for_summary_and_plot(
     assert failures >= len(cases)  # most damage is found: some changed bytes (in a padding, say) harm nothing
 
 
+@pytest.mark.parametrize(("status", "code"), [("", 0), ("0", 0), ("3", 1), ("'gave up'", 1)])
+def test_a_function_that_calls_sys_exit_ends_the_run_in_order(tmp_path: Path, status: str, code: int) -> None:
+    spec = counter_copy(tmp_path)
+    functions = spec.parent / "counting" / "cs.py"
+    text = functions.read_text()
+    functions.write_text(
+        text.replace(
+            "    outputs.count = inputs.count + 1\n",
+            f"    outputs.count = inputs.count + 1\n    if inputs.count == 2:\n        import sys\n        sys.exit({status})\n",
+        )
+    )
+    trace = tmp_path / "run.mcap"
+    result = earl_cli("run", str(spec), "--duration", "200ms", "--trace", str(trace))
+    assert result.returncode == code, result.stderr
+    assert "called sys.exit(" in result.stderr and "at 0.020 s" in result.stderr
+    assert "Traceback" not in result.stderr
+    assert "counter/a.cs" in result.stdout  # the summary of what ran
+    assert earl_cli("trace", "summary", str(trace)).returncode == 0  # closed and readable
+
+
 @pytest.mark.parametrize(
     ("old", "new", "code", "fragment"),
     [

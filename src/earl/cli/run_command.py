@@ -39,9 +39,10 @@ distributed (docs/distributed.md):
 The spec is checked first; its errors stop the run. Only `earl run` imports the Python
 code a spec names (docs/runtime.md).
 
-exit codes: 0 the run completed, 1 invalid spec, the run could not start, or its trace
-            could not be written (a full disk), 2 usage error, 130 interrupted (the trace
-            is closed and readable)
+exit codes: 0 the run completed (or the spec's code called sys.exit(0)), 1 invalid spec,
+            the run could not start, its trace could not be written (a full disk), or the
+            spec's code called sys.exit with a failure, 2 usage error, 130 interrupted (the
+            trace is closed and readable)
 """
 
 
@@ -232,6 +233,7 @@ def _execute(simulation: Any, duration: float, arguments: argparse.Namespace, re
     console = Console(stderr=True, highlight=False)
     interrupted = False
     failed: TraceWriteError | None = None
+    exited: SystemExit | None = None
     previous = signal.getsignal(signal.SIGTERM)
 
     def stop(*_: object) -> None:
@@ -269,6 +271,8 @@ def _execute(simulation: Any, duration: float, arguments: argparse.Namespace, re
         interrupted = True
     except TraceWriteError as error:  # a full disk, say: the run stops, what was written stays readable
         failed = error
+    except SystemExit as request:  # the spec's own code called sys.exit(): the run ends there, in order
+        exited = request
     finally:
         if progress is not None:
             progress.stop()
@@ -293,6 +297,13 @@ def _execute(simulation: Any, duration: float, arguments: argparse.Namespace, re
     if interrupted:
         console.print(f"earl run: interrupted at {simulation.time:.3f} s; the trace is closed")
         return EXIT_INTERRUPTED
+    if exited is not None:
+        status = exited.code
+        console.print(
+            f"earl run: the spec's code called sys.exit({'' if status is None else repr(status)}) at "
+            f"{simulation.time:.3f} s; the run stopped there and the trace is closed"
+        )
+        return EXIT_OK if status in (None, 0) else EXIT_FAILED
     return EXIT_OK
 
 
