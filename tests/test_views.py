@@ -301,3 +301,27 @@ def test_every_element_of_an_array_of_reals_is_tested_at_every_size(size: int) -
             value[position] = bad
             assert check(value) == "refused", (position, bad)
     assert check([*good, 1.0]) == "refused"  # one element too many
+
+
+@pytest.mark.parametrize(
+    ("value", "type_name", "message"),
+    [
+        (300, "uint8", "x/mo = 300 does not fit uint8 (0..255)"),
+        (10**400, "int", "x/mo = (a whole number of 401 digits) does not fit int"),
+        (10**5000, "int64", "(a whole number of 5001 digits)"),  # beyond what Python will print
+        (-(10**300), "uint8", "x/mo = -(a whole number of 301 digits) does not fit uint8"),
+        (10**400, "double", "x/mo = (a whole number of 401 digits) is too large for a double"),
+        ("y" * 10_000, "int", "not the string 'yyyy"),
+    ],
+    ids=["uint8", "int", "int64 beyond printing", "negative uint8", "double", "long string"],
+)
+def test_a_value_of_any_size_is_refused_in_a_short_message(value: Any, type_name: str, message: str) -> None:
+    from earl.model.elements import System
+    from earl.model.types import PrimitiveType
+    from earl.runtime.values import TypeSystem, ValueTypeError
+
+    coerce = TypeSystem(System("s")).coercer(PrimitiveType(type_name), "x/mo")
+    with pytest.raises(ValueTypeError) as refused:
+        coerce(value)
+    assert message in str(refused.value)
+    assert len(str(refused.value)) < 200

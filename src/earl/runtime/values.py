@@ -381,10 +381,19 @@ def _describe(value: Any) -> str:
     if isinstance(value, bool):
         return f"the Boolean {value}"
     if isinstance(value, (int, float)):
-        return f"the number {value!r}"
+        return f"the number {_shown(value)}"
     if isinstance(value, str):
-        return f"the string {value!r}"
+        return f"the string {_shown(value)}"
     return f"a {type(value).__name__}"
+
+
+def _shown(value: int | float | str) -> str:
+    """A value as a message quotes it: short, whatever its size (Python refuses to print an int of over
+    4,300 digits, and a megabyte string would drown the message)."""
+    if isinstance(value, int) and value.bit_length() > 200:
+        return f"{'-' if value < 0 else ''}(a whole number of {int(value.bit_length() * math.log10(2)) + 1} digits)"
+    text = repr(value)
+    return text if len(text) <= 80 else f"{text[:60]}… ({len(text)} characters)"
 
 
 def _coerce_primitive(value: Any, name: str, where: str) -> Value:
@@ -397,7 +406,10 @@ def _coerce_primitive(value: Any, name: str, where: str) -> Value:
     if name in _REAL_TYPES:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise ValueTypeError(f"{where} must be a number ({name}), not {_describe(value)}")
-        result = float(value)
+        try:
+            result = float(value)
+        except OverflowError:  # an int beyond any double
+            raise ValueTypeError(f"{where} = {_shown(value)} is too large for a {name}") from None
         if math.isnan(result):
             raise ValueTypeError(f"{where} is NaN (not a number): a computation went wrong upstream")
         return result
@@ -409,7 +421,7 @@ def _coerce_primitive(value: Any, name: str, where: str) -> Value:
                 raise ValueTypeError(f"{where} must be a whole number ({name}), not {_describe(value)}")
         low, high = _INTEGER_RANGES[name]
         if not low <= value <= high:
-            raise ValueTypeError(f"{where} = {value} does not fit {name} ({low}..{high})")
+            raise ValueTypeError(f"{where} = {_shown(value)} does not fit {name} ({low}..{high})")
         return value
     if name == "string":
         if isinstance(value, str):
