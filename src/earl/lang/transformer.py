@@ -10,6 +10,7 @@ refused above a bound so that nothing later in the pipeline can.
 from __future__ import annotations
 
 import json
+import math
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -359,7 +360,7 @@ class ElementBuilder:
         return _BodyItem("period", children[0])
 
     def duration(self, meta: Meta, children: list[Token]) -> Duration:
-        number = _number(children[0])
+        number = _number(children[0], self.path)
         if number <= 0:
             raise SpecificationSyntaxError(
                 Diagnostic(
@@ -369,7 +370,22 @@ class ElementBuilder:
                     code="EARL-S012",
                 )
             )
-        return Duration(number, str(children[1]))
+        duration = Duration(number, str(children[1]))
+        try:
+            too_long = not duration.seconds <= Duration.MAX_SECONDS
+        except OverflowError:  # an int of hundreds of digits, times a float
+            too_long = True
+        if too_long:
+            raise SpecificationSyntaxError(
+                Diagnostic(
+                    Severity.ERROR,
+                    f"a duration is at most {Duration.MAX_SECONDS:,.0f} s (about 31 years), not {_number_text(children[0])} "
+                    f"{children[1]}",
+                    self._loc(children[0]),
+                    code="EARL-S012",
+                )
+            )
+        return duration
 
     def input_buffer(self, meta: Meta, children: list[Any]) -> InputBuffer:
         declared: _DeclaredName = children[0]
@@ -615,7 +631,7 @@ class ElementBuilder:
         return IndexAccess(children[0], self._loc(meta))
 
     def number(self, meta: Meta, children: list[Token]) -> Expression:
-        return Literal(_number(children[0]), self._loc(meta))
+        return Literal(_number(children[0], self.path), self._loc(meta))
 
     def string(self, meta: Meta, children: list[Token]) -> Expression:
         return Literal(self._string(children[0]), self._loc(meta))
@@ -648,11 +664,36 @@ def _span(first: SourceLocation | None, last: SourceLocation | None) -> SourceLo
     return SourceLocation(first.file, first.line, first.column, last.end_line, last.end_column)
 
 
-def _number(token: Token) -> int | float:
+#: digits of a number literal read at most: Python refuses to convert longer ones, and no type holds them
+MAX_NUMBER_DIGITS = 4000
+
+
+def _number(token: Token, path: str) -> int | float:
     text = str(token)
-    if any(c in text for c in ".eE"):
-        return float(text)
-    return int(text)
+    value: int | float
+    if len(text) > MAX_NUMBER_DIGITS:
+        value = math.inf
+    elif any(c in text for c in ".eE"):
+        value = float(text)
+    else:
+        value = int(text)
+    if isinstance(value, float) and math.isinf(value):
+        raise SpecificationSyntaxError(
+            Diagnostic(
+                Severity.ERROR,
+                f"the number {_number_text(token)} is beyond the range of every EARL number type",
+                _location(path, token),
+                code="EARL-S019",
+                hint="a double reaches about 1.8e308, an int64 about 9.2e18",
+            )
+        )
+    return value
+
+
+def _number_text(token: Token) -> str:
+    """A literal as a message quotes it: a thousand digits are shortened."""
+    text = str(token)
+    return f"`{text}`" if len(text) <= 40 else f"`{text[:20]}…` ({len(text)} characters)"
 
 
 #: what a string may hold after a backslash, for the message when it holds something else

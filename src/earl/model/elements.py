@@ -38,6 +38,9 @@ class Duration:
     unit: str  # "s" | "ms" | "us"
 
     UNITS: ClassVar[dict[str, float]] = {"s": 1.0, "ms": 1e-3, "us": 1e-6}
+    #: the longest period, timeout or run: about 31 years, beyond any run and well inside what the
+    #: runtime's integer nanoseconds and a float's exact range hold
+    MAX_SECONDS: ClassVar[float] = 1e9
 
     @property
     def seconds(self) -> float:

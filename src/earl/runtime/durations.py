@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import re
 
+from earl.model.elements import Duration
+
 _UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "min": 60.0, "": 1.0}
-#: the longest duration taken: about 31 years, far beyond any run, and far inside what a float and
-#: the runtime's integer nanoseconds hold exactly enough (`1e400s` would be infinite)
-MAX_SECONDS = 1e9
+#: the longest duration taken, the language's own (`1e400s` would be infinite)
+MAX_SECONDS = Duration.MAX_SECONDS
 _PATTERN = re.compile(r"^\s*([-+]?[0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)\s*(s|ms|us|min|)\s*$")
 
 
