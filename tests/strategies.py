@@ -287,7 +287,8 @@ durations: SearchStrategy[Duration] = st.builds(
     Duration,
     st.one_of(
         st.integers(min_value=1, max_value=10**6),
-        st.floats(min_value=0.0, exclude_min=True),  # the reader refuses 0 and negative durations
+        # the reader refuses 0, negative durations and those over Duration.MAX_SECONDS (1e9 s)
+        st.floats(min_value=0.0, max_value=1e9, exclude_min=True),
     ),
     st.sampled_from(("s", "ms", "us")),
 )

@@ -27,7 +27,7 @@ READING_CODES: dict[str, str] = {
     "EARL-S016": "an element that cannot be an indexed family declared as one",
     "EARL-S017": "an array type with too many dimensions",
     "EARL-S018": "a string with an escape or a character a string cannot hold",
-    "EARL-S019": "a number beyond the range of every number type",
+    "EARL-S019": "a whole number of thousands of digits",
     "EARL-S020": "a file too large to be a specification",
     "EARL-S021": "a binary file",
     "EARL-S022": "a file that is not UTF-8 text",

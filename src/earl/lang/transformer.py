@@ -664,30 +664,25 @@ def _span(first: SourceLocation | None, last: SourceLocation | None) -> SourceLo
     return SourceLocation(first.file, first.line, first.column, last.end_line, last.end_column)
 
 
-#: digits of a number literal read at most: Python refuses to convert longer ones, and no type holds them
+#: digits of a whole number read at most: Python refuses to convert longer ones, and no type holds them
 MAX_NUMBER_DIGITS = 4000
 
 
 def _number(token: Token, path: str) -> int | float:
     text = str(token)
-    value: int | float
-    if len(text) > MAX_NUMBER_DIGITS:
-        value = math.inf
-    elif any(c in text for c in ".eE"):
-        value = float(text)
-    else:
-        value = int(text)
-    if isinstance(value, float) and math.isinf(value):
+    if any(c in text for c in ".eE"):
+        return float(text)  # beyond a double's range: infinity, as `1e999` is written (model/text.py)
+    if len(text) > MAX_NUMBER_DIGITS:  # Python would refuse to read it, and no EARL type holds it
         raise SpecificationSyntaxError(
             Diagnostic(
                 Severity.ERROR,
-                f"the number {_number_text(token)} is beyond the range of every EARL number type",
+                f"the whole number {_number_text(token)} has more digits than any EARL number type holds",
                 _location(path, token),
                 code="EARL-S019",
-                hint="a double reaches about 1.8e308, an int64 about 9.2e18",
+                hint="an int64 holds 19 digits, a uint64 20; `1e999` is infinity",
             )
         )
-    return value
+    return int(text)
 
 
 def _number_text(token: Token) -> str:
