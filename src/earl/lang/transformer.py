@@ -10,7 +10,6 @@ refused above a bound so that nothing later in the pipeline can.
 from __future__ import annotations
 
 import json
-import math
 from dataclasses import dataclass, field, replace
 from typing import Any
 
