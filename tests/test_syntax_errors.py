@@ -791,3 +791,24 @@ def test_usage_errors_exit_2(
         code = int(exit.code or 0)
     assert code == 2
     assert "Traceback" not in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("column", [1, 20, 500, 981, 1000])
+def test_a_long_source_line_is_cut_around_the_spot(column: int) -> None:
+    """At most SHOWN_COLUMNS of a 1,000-column line, `…` where it was cut, the caret under the same text."""
+    from earl.diagnostics import SHOWN_COLUMNS, Diagnostic, Severity, SourceMap, render
+    from earl.model.location import SourceLocation
+
+    line = "".join(chr(ord("a") + i % 26) for i in range(1000))
+    sources = SourceMap()
+    sources.add("long.earl", "system s\n" + line + "\n")
+    location = SourceLocation("long.earl", 2, column, 2, column + 3)
+    text = render(Diagnostic(Severity.ERROR, "here", location, code="EARL-S006"), sources)
+    _, _, _, shown, carets = text.splitlines()
+    quoted = shown[len("2 | ") :]
+    assert len(quoted) <= SHOWN_COLUMNS + 2  # and the two `…`
+    assert quoted.startswith("…") == (column > 31) and quoted.endswith("…") == (column < 900)
+    start = carets.index("^") - len("  | ")
+    width = carets.count("^")
+    assert quoted[start : start + width] == line[column - 1 : column - 1 + width]
+    assert width == min(3, 1001 - column)

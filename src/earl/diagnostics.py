@@ -52,15 +52,20 @@ class SourceMap:
     """The text of every file read, so a diagnostic can quote the line it points at."""
 
     texts: dict[str, str] = field(default_factory=dict)
+    #: each file's lines, split once: a large spec with many findings would be split for each
+    _lines: dict[str, list[str]] = field(default_factory=dict, repr=False, compare=False)
 
     def add(self, name: str, text: str) -> None:
         self.texts[name] = text
+        self._lines.pop(name, None)
 
     def line(self, name: str, number: int) -> str | None:
-        text = self.texts.get(name)
-        if text is None:
-            return None
-        lines = text.splitlines()
+        lines = self._lines.get(name)
+        if lines is None:
+            text = self.texts.get(name)
+            if text is None:
+                return None
+            lines = self._lines[name] = text.splitlines()
         if 1 <= number <= len(lines):
             return lines[number - 1]
         return "" if number == len(lines) + 1 else None
@@ -70,6 +75,24 @@ def did_you_mean(name: str, candidates: Iterable[str]) -> str | None:
     """A hint naming the closest candidate, for misspelt names."""
     matches = difflib.get_close_matches(name, sorted(set(candidates)), n=1, cutoff=0.6)
     return f"did you mean `{matches[0]}`?" if matches else None
+
+
+#: columns of a source line shown at most; a longer line is cut around the spot, as rustc does
+SHOWN_COLUMNS = 100
+#: columns shown before the spot in a cut line
+CONTEXT_COLUMNS = 30
+
+
+def _window(source: str, start: int, width: int) -> tuple[str, int, int]:
+    """The part of a long line around `start` (0-based), with `…` where it was cut; where the caret
+    starts in it, and how wide it is."""
+    if len(source) <= SHOWN_COLUMNS:
+        return source, start, width
+    first = max(0, min(start - CONTEXT_COLUMNS, len(source) - SHOWN_COLUMNS))
+    last = first + SHOWN_COLUMNS
+    shown = ("…" if first else "") + source[first:last] + ("…" if last < len(source) else "")
+    offset = start - first + (1 if first else 0)
+    return shown, offset, max(1, min(width, last - start))
 
 
 def render(diagnostic: Diagnostic, sources: SourceMap) -> str:
@@ -89,9 +112,10 @@ def render(diagnostic: Diagnostic, sources: SourceMap) -> str:
             else:
                 width = 1
             width = max(1, min(width, max(1, len(source) - location.column + 1)))
+            source, offset, width = _window(source, location.column - 1, width)
             lines.append(f"{gutter} |")
             lines.append(f"{number} | {source}")
-            lines.append(f"{gutter} | {' ' * (location.column - 1)}{'^' * width}")
+            lines.append(f"{gutter} | {' ' * offset}{'^' * width}")
     if diagnostic.hint:
         gutter = " " * (len(str(location.line)) if location else 0)
         lines.append(f"{gutter} = hint: {diagnostic.hint}")
