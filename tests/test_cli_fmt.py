@@ -41,6 +41,41 @@ def test_fmt_write_rewrites_in_place_and_keeps_comments(tmp_path: Path) -> None:
     assert main(["fmt", "--check", str(spec)]) == 0
 
 
+def test_fmt_write_follows_a_link_and_keeps_the_file_s_permissions(tmp_path: Path) -> None:
+    spec = tmp_path / "real.earl"
+    spec.write_text(MESSY)
+    spec.chmod(0o640)
+    link = tmp_path / "link.earl"
+    link.symlink_to(spec)
+    assert main(["fmt", "--write", str(link)]) == 0
+    assert link.is_symlink() and spec.read_text() == CANONICAL
+    assert spec.stat().st_mode & 0o777 == 0o640
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["link.earl", "real.earl"]  # no temporary left
+
+
+def test_save_replaces_only_a_regular_file_and_leaves_it_whole_when_writing_fails(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import os
+
+    system = earl.loads(CANONICAL)
+    pipe = tmp_path / "pipe.earl"
+    os.mkfifo(pipe)
+    with pytest.raises(OSError, match="not a regular file"):
+        earl.save(system, pipe)  # renaming a file over it would put a file where the pipe (or /dev/null) was
+    assert pipe.is_fifo()
+    spec = tmp_path / "s.earl"
+    spec.write_text(MESSY)
+
+    def disk_full(self: Path, target: Path) -> None:
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(Path, "replace", disk_full)
+    assert main(["fmt", "--write", str(spec)]) == 1
+    assert spec.read_text() == MESSY
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["pipe.earl", "s.earl"]
+
+
 def test_fmt_diff_shows_the_change(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     spec = tmp_path / "s.earl"
     spec.write_text(MESSY)

@@ -19,7 +19,8 @@ def register(commands: Any) -> None:
         help="print a specification in canonical form",
         description="Print each FILE in canonical form: four-space indentation, one declaration per line, "
         "the parts of every subsystem in the manual's order. Comments are kept.",
-        epilog="exit codes: 0 done (or canonical with --check), 1 invalid or not canonical, 2 usage error",
+        epilog="exit codes: 0 done (or canonical with --check), 1 invalid, not canonical, or a file that could not "
+        "be rewritten (it is left as it was), 2 usage error",
     )
     parser.add_argument("files", metavar="FILE", nargs="+", help=".earl files")
     mode = parser.add_mutually_exclusive_group()
@@ -50,7 +51,12 @@ def run(arguments: argparse.Namespace) -> int:
                 status = 1
         elif arguments.write:
             if original != canonical:
-                save(system, path)
+                try:
+                    save(system, path)
+                except OSError as error:  # a read-only directory, a full disk, a device: the file is as it was
+                    sys.stderr.write(f"earl fmt: cannot rewrite {path}: {error.strerror or error}\n")
+                    status = 1
+                    continue
                 sys.stderr.write(f"{path}: reformatted\n")
         elif arguments.diff:
             diff = difflib.unified_diff(

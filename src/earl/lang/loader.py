@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import errno
 import os
+import shutil
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -202,11 +204,29 @@ def parse_file(path: str | Path) -> System:
 
 
 def save(system: System, path: str | Path) -> None:
-    """Write the system as canonical `.earl` text, replacing the file atomically."""
+    """Write the system as canonical `.earl` text, replacing the file atomically.
+
+    The text goes to a temporary file beside the target, which is then renamed over it: a full
+    disk or a crash leaves the old file whole.  A symbolic link is followed (the link stays a
+    link), the file keeps its permissions, and only a regular file is ever replaced — renaming
+    over `/dev/null` would put a file in the device's place.  An OSError says what went wrong.
+    """
     target = Path(path)
+    if target.exists() or target.is_symlink():
+        target = target.resolve()
+        if not target.is_file():
+            raise OSError(
+                errno.EINVAL, "not a regular file (a device, a pipe or a directory); only files are rewritten"
+            )
     temporary = target.with_name(f".{target.name}.tmp")
-    temporary.write_text(system.to_earl(), encoding="utf-8")
-    temporary.replace(target)
+    try:
+        temporary.write_text(system.to_earl(), encoding="utf-8")
+        if target.exists():
+            shutil.copymode(target, temporary)
+        temporary.replace(target)
+    except BaseException:
+        temporary.unlink(missing_ok=True)
+        raise
 
 
 def loads(text: str, path: str = "<text>", parameters: Mapping[str, ParameterValue] | None = None) -> System:
