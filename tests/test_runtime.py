@@ -360,3 +360,25 @@ def test_stale_reads_the_set_of_buffers_whose_remote_sender_is_gone(tmp_path: Pa
         assert sim.state_of("waiter/a.cs").timed_out == {"ping": True}  # a stale buffer also times out
     finally:
         sim.close()
+
+
+def test_the_python_api_refuses_a_parameter_the_system_does_not_declare() -> None:
+    """As `earl run --param` does (EARL-R001): a misspelt name must not leave the default in place."""
+    system = earl.load(SPECS / "counter")
+    with pytest.raises(earl.EarlError) as refused:
+        earl.simulate(system, parameters={"LIMTI": 3})
+    [diagnostic] = refused.value.diagnostics
+    assert diagnostic.code == "EARL-R001" and "`LIMTI`" in diagnostic.message
+    assert diagnostic.hint == "did you mean `LIMIT`?"
+
+
+@pytest.mark.parametrize(
+    ("time", "error"), [(float("nan"), ValueError), (float("inf"), ValueError), (2e9, ValueError), ("1s", TypeError)]
+)
+def test_advance_to_takes_a_finite_number_of_seconds(time: Any, error: type[Exception]) -> None:
+    sim = earl.simulate(earl.load(SPECS / "counter"), seed=1)
+    with pytest.raises(error, match="advance_to takes"):
+        sim.advance_to(time)
+    sim.advance_to(0.01)  # the run is intact
+    assert sim.time == pytest.approx(0.01)
+    sim.close()

@@ -14,7 +14,7 @@ from earl.check import fsm_analysis, rules_behaviour, rules_communication, rules
 from earl.check.context import CheckContext
 from earl.check.registry import RULES, Finding, Rule
 from earl.collector import paused as collector_paused
-from earl.diagnostics import Diagnostic, Severity
+from earl.diagnostics import Diagnostic, Severity, did_you_mean
 from earl.model.elements import System
 from earl.model.expand import expand
 
@@ -29,9 +29,30 @@ def context_for(system: System, parameters: Mapping[str, bool | int | float | st
 
 
 def check(system: System, parameters: Mapping[str, bool | int | float | str] | None = None) -> list[Diagnostic]:
-    """Every finding of every rule, ordered by file (the spec's own first), line and column."""
+    """Every finding of every rule, ordered by file (the spec's own first), line and column.
+
+    A parameter the system does not declare is EARL-R001, as `load(path, parameters)` reports it:
+    a misspelt `N` must not leave the default in place without a word."""
+    unknown = unknown_parameters(system, parameters or {})
+    if unknown:
+        return unknown
     with collector_paused():
         return check_context(context_for(system, parameters))
+
+
+def unknown_parameters(system: System, parameters: Mapping[str, object]) -> list[Diagnostic]:
+    known = [p.name for p in system.parameters]
+    return [
+        Diagnostic(
+            Severity.ERROR,
+            f"there is no system parameter `{name}` to set",
+            None,
+            "EARL-R001",
+            did_you_mean(name, known) or f"system parameters: {', '.join(known) or 'none'}",
+        )
+        for name in parameters
+        if name not in known
+    ]
 
 
 def check_context(context: CheckContext) -> list[Diagnostic]:

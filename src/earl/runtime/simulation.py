@@ -12,6 +12,8 @@ state lives in the subsystem engines this object owns.
 
 from __future__ import annotations
 
+import math
+import numbers
 import tomllib
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
@@ -19,7 +21,7 @@ from pathlib import Path
 from typing import Any, Protocol
 
 from earl.diagnostics import Diagnostic, EarlError, Severity
-from earl.model.elements import System
+from earl.model.elements import Duration, System
 from earl.model.expand import expand
 from earl.runtime.binding import BindingProblem, resolve_callable, user_code_path
 from earl.runtime.builder import NANOSECONDS, Network, RemoteLinks, build_network, to_nanoseconds
@@ -158,6 +160,12 @@ class Simulation:
         """Run every subsystem iteration due until `seconds` of run time."""
         if self.closed:
             raise RuntimeError("this simulation is closed")
+        if isinstance(seconds, bool) or not isinstance(seconds, numbers.Real):
+            raise TypeError(f"advance_to takes a run time in seconds (a number), not {seconds!r}")
+        if not math.isfinite(seconds) or seconds > Duration.MAX_SECONDS:
+            raise ValueError(
+                f"advance_to takes a finite run time of at most {Duration.MAX_SECONDS:g} s, not {seconds!r}"
+            )
         self.scheduler.advance_to(to_nanoseconds(seconds), should_stop)
 
     def advance_by(self, seconds: float) -> None:
