@@ -268,3 +268,35 @@ def test_run_help_teaches_with_examples() -> None:
 def _wide_terminal(monkeypatch: pytest.MonkeyPatch) -> None:
     # Rich wraps tables to the terminal; a wide one keeps each row on one line for the assertions
     monkeypatch.setenv("COLUMNS", "200")
+
+
+@pytest.mark.parametrize(
+    ("setting", "fragment"),
+    [
+        ("seed = -5", "`seed` is a whole number >= 0, not -5"),
+        ("seed = true", "`seed` is a whole number >= 0"),
+        ("duration = -3", "`duration` is a duration such as"),
+        ('duration = "soon"', "`soon` is not a duration"),
+        ("environment = 5", '`environment` is a "module:function" string'),
+        ('record_memory = "counter/a.cs"', "`record_memory` is a list of strings"),
+        ("colour = 1", "unknown setting `colour`"),
+    ],
+)
+def test_a_run_toml_setting_of_the_wrong_kind_is_a_usage_error(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], setting: str, fragment: str
+) -> None:
+    from earl.cli.main import main
+
+    spec = counter_copy(tmp_path)
+    (spec.parent / "run.toml").write_text(setting + "\n")
+    assert main(["run", str(spec), "--duration", "10ms", "--no-progress"]) == 2
+    error = capsys.readouterr().err
+    assert "run.toml" in error and fragment in error
+    assert "Traceback" not in error
+
+
+@pytest.mark.parametrize("seed", ["-1", "x", "1.5"])
+def test_a_seed_that_is_not_a_whole_number_from_zero_is_a_usage_error(seed: str) -> None:
+    result = earl_cli("run", str(SPECS / "counter"), f"--seed={seed}", "--duration", "10ms")
+    assert result.returncode == 2
+    assert "argument --seed" in result.stderr and "Traceback" not in result.stderr

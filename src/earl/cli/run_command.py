@@ -60,7 +60,12 @@ def register(commands: Any) -> None:
     parser.add_argument("--duration", metavar="TIME", help="run time, e.g. 10s, 500ms (default 10s or run.toml)")
     parser.add_argument("--realtime", action="store_true", help="pace the run by the wall clock, report jitter")
     parser.add_argument("--trace", metavar="FILE.mcap", help="record an MCAP trace (opens in Foxglove)")
-    parser.add_argument("--seed", type=int, help="seed of the subsystems' random streams (default 0)")
+    parser.add_argument(
+        "--seed",
+        type=_seed,
+        metavar="N",
+        help="seed of the subsystems' random streams, a whole number >= 0 (default 0)",
+    )
     parser.add_argument(
         "--param", action="append", default=[], metavar="NAME=VALUE", help="set a system parameter (repeatable)"
     )
@@ -225,6 +230,17 @@ def run(arguments: argparse.Namespace) -> int:
 def _close(transport: Any) -> None:
     if transport is not None:
         transport.close()
+
+
+def _seed(text: str) -> int:
+    """`--seed`: what NumPy's seed sequences take, refused at the command line rather than in a function."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"`{text}` is not a whole number") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"`{text}`: a seed is a whole number >= 0")
+    return value
 
 
 def _execute(simulation: Any, duration: float, arguments: argparse.Namespace, report: str | None, path: Path) -> int:

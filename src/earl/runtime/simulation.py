@@ -89,6 +89,10 @@ class Simulation:
         transport: Transport | None = None,
     ) -> None:
         parameters = dict(parameters or {})
+        if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+            # NumPy's seed sequences take whole numbers >= 0; anything else would fail inside the first
+            # function that draws a random number, and look like that function's fault
+            raise ValueError(f"the seed is a whole number >= 0, not {seed!r}")
         if transport is not None and not realtime:
             raise ValueError("a run over a transport between processes runs in real time only (realtime=True)")
         if check:
@@ -296,15 +300,35 @@ def read_run_settings(spec: Path) -> RunSettings:
     unknown = sorted(set(data) - known)
     if unknown:
         raise ValueError(f"{path}: unknown setting `{unknown[0]}` (known: {', '.join(sorted(known))})")
+
+    def refuse(key: str, wanted: str) -> ValueError:
+        return ValueError(f"{path}: `{key}` is {wanted}, not {data[key]!r}")
+
     duration = data.get("duration")
     if isinstance(duration, str):
         from earl.runtime.durations import parse_duration
 
-        duration = parse_duration(duration)
+        try:
+            duration = parse_duration(duration)
+        except ValueError as error:
+            raise ValueError(f"{path}: `duration`: {error}") from None
+    elif duration is not None and (
+        isinstance(duration, bool) or not isinstance(duration, int | float) or not 0 < duration <= Duration.MAX_SECONDS
+    ):
+        raise refuse("duration", 'a duration such as "13s" or a positive number of seconds')
+    seed = data.get("seed")
+    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int) or seed < 0):
+        raise refuse("seed", "a whole number >= 0")
+    for key in ("environment", "report"):
+        if key in data and not isinstance(data[key], str):
+            raise refuse(key, 'a "module:function" string')
+    for key in ("record_memory", "plot", "record_links"):
+        if key in data and not (isinstance(data[key], list) and all(isinstance(item, str) for item in data[key])):
+            raise refuse(key, 'a list of strings, e.g. ["manip/a.cs"]')
     return RunSettings(
         environment=data.get("environment"),
         duration=duration,
-        seed=data.get("seed"),
+        seed=seed,
         record_memory=data.get("record_memory"),
         report=data.get("report"),
         plot=data.get("plot"),
