@@ -194,6 +194,8 @@ def test_the_checker_runs_first_and_its_errors_stop_the_run(tmp_path: Path) -> N
         (["--duration", "ten seconds"], "is not a duration"),
         (["--duration", "1e400s"], "is too long: a duration is at most"),  # infinite as a float
         (["--duration=-1s"], "must be positive"),
+        (["--agents", ","], "--agents names no agent"),
+        (["--plot", "/nonexistent/dir/x.png", "--signal", "counter/a.cs.count"], "cannot write the trace"),
         (["--record-memory", "counter/a.nothing"], "names no subsystem"),
         (["--param", "LIMIT"], "NAME=VALUE"),
     ],

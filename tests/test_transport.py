@@ -566,3 +566,15 @@ def test_what_fails_while_serving_is_raised_in_the_scheduler_thread(tmp_path: Pa
     with pytest.raises(OSError, match="the disk is full"):
         simulation.advance_to(simulation.time + 0.05)
     simulation.close()
+
+
+def test_a_zenoh_configuration_zenoh_refuses_is_explained_without_rust_source_lines(tmp_path: Path) -> None:
+    from earl.transport.zenoh_transport import TransportError, config_from_file
+
+    wrong = tmp_path / "zenoh.txt"
+    wrong.write_text("not a configuration")
+    with pytest.raises(TransportError) as refused:
+        config_from_file(wrong)
+    message = str(refused.value)
+    assert message.startswith(f"cannot use the Zenoh configuration {wrong}: ")
+    assert ".rs:" not in message

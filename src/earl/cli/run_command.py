@@ -155,7 +155,9 @@ def run(arguments: argparse.Namespace) -> int:
     no_environment = environment == "none"
     if no_environment:
         environment = None
-    agents = [a.strip() for a in arguments.agents.split(",") if a.strip()] if arguments.agents else None
+    agents = [a.strip() for a in arguments.agents.split(",") if a.strip()] if arguments.agents is not None else None
+    if agents == []:  # `--agents ,` or `--agents ""`: not "all of them", which is no --agents at all
+        return usage_error("--agents names no agent; list them, e.g. --agents manip/a,grip/a")
     if arguments.transport == "zenoh":
         if not agents:
             return usage_error("--transport zenoh needs --agents: the agents this process runs, e.g. task/a")
@@ -204,7 +206,8 @@ def run(arguments: argparse.Namespace) -> int:
         return usage_error(str(error))
     except OSError as error:
         _close(transport)
-        return usage_error(f"cannot write the trace: {error}")
+        beside = " (the trace --plot draws from, beside the plot)" if arguments.plot else ""
+        return usage_error(f"cannot write the trace {arguments.trace}{beside}: {error.strerror or error}")
     except RuntimeError as error:  # the transport could not start
         _close(transport)
         print(f"earl run: {error}", file=sys.stderr)

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import re
 import threading
 import time as wall
 from collections.abc import Callable
@@ -67,7 +68,9 @@ def config_from_file(path: Path) -> zenoh.Config:
     try:
         return zenoh.Config.from_file(str(path))
     except Exception as error:
-        raise TransportError(f"cannot use the Zenoh configuration {path}: {error}") from None
+        # Zenoh's messages end with the Rust source line that raised them: of no use to the reader
+        reason = re.sub(r"\s+at \S+\.rs:\d+\.?\s*$", "", str(error))
+        raise TransportError(f"cannot use the Zenoh configuration {path}: {reason}") from None
 
 
 @dataclass
