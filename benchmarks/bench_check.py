@@ -106,10 +106,10 @@ def check_once(text: str) -> tuple[SpecRun, int, int, int]:
     return SpecRun(read, expand, rules), agents, subsystems, problems
 
 
-def measure_in_fresh_interpreter(workers: int) -> dict[str, Any]:
+def measure_in_fresh_interpreter(workers: int, option: str = "--measure-once") -> dict[str, Any]:
     """One run in a new interpreter, so that no run inherits the heap an earlier (larger) one left."""
     output = subprocess.run(
-        [sys.executable, str(Path(__file__).resolve()), "--measure-once", str(workers)],
+        [sys.executable, str(Path(__file__).resolve()), option, str(workers)],
         check=True,
         capture_output=True,
         text=True,
@@ -159,13 +159,7 @@ def bench_joints(joints: list[int], runs: int) -> dict[str, Any]:
     for count in joints:
         measured = []
         for _ in range(runs):
-            output = subprocess.run(
-                [sys.executable, str(Path(__file__).resolve()), "--measure-joints-once", str(count)],
-                check=True,
-                capture_output=True,
-                text=True,
-            ).stdout
-            one = json.loads(output)
+            one = measure_in_fresh_interpreter(count, "--measure-joints-once")
             if one["errors"]:
                 raise SystemExit(f"the example with N={count} has {one['errors']} errors")
             measured.append(one)

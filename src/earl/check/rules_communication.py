@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Iterator
+from operator import attrgetter
 
 from earl.check.context import CheckContext, ResolvedLink, instance_name, subsystem_name
 from earl.check.registry import Finding, rule
@@ -110,24 +111,14 @@ def _chain(context: CheckContext, middle: Kind, real: Kind, towards_real: bool) 
 
 
 def _ends_of_chains(links: list[ResolvedLink], middle: Kind, towards_real: bool) -> set[int]:
-    """The subsystems (by id) that a cs → middle → x chain reaches, or that start an x → middle → cs chain."""
-    if towards_real:
-        commanded = {
-            id(link.destination_subsystem) for link in links if link.source_subsystem.kind is Kind.CONTROL_SUBSYSTEM
-        }
-        return {
-            id(link.destination_subsystem)
-            for link in links
-            if link.source_subsystem.kind is middle and id(link.source_subsystem) in commanded
-        }
-    reporting = {
-        id(link.source_subsystem) for link in links if link.destination_subsystem.kind is Kind.CONTROL_SUBSYSTEM
-    }
-    return {
-        id(link.source_subsystem)
-        for link in links
-        if link.destination_subsystem.kind is middle and id(link.destination_subsystem) in reporting
-    }
+    """The subsystems (by id) that a cs → middle → x chain reaches, or that start an x → middle → cs chain.
+
+    Each link has an end towards the control subsystem (`near`) and one away from it (`far`): the
+    source and the destination for commands, the other way round for reports."""
+    ends = ("source_subsystem", "destination_subsystem")
+    near, far = map(attrgetter, ends if towards_real else reversed(ends))
+    next_to_cs = {id(far(link)) for link in links if near(link).kind is Kind.CONTROL_SUBSYSTEM}
+    return {id(far(link)) for link in links if near(link).kind is middle and id(near(link)) in next_to_cs}
 
 
 @rule("EARL-E014", Severity.ERROR, "every Real Effector is commanded through cs → ve → re", "§2.3, Figure 7")
