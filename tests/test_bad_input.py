@@ -78,6 +78,25 @@ def test_a_byte_order_mark_and_windows_line_ends_are_fine(tmp_path: Path) -> Non
     assert system.agent("a").control_subsystem.memories[0].location.line == 10
 
 
+def test_old_mac_line_ends_are_lines_and_end_comments(tmp_path: Path) -> None:
+    """A lone `\\r` ends a line: `// note\\rparam N …` must not hide the parameter inside the comment."""
+    path = tmp_path / "mac.earl"
+    path.write_bytes(b"system s\r// the number of joints\rparam N: int = 3\r")
+    system = earl.load(path)
+    assert [(p.name, p.location.line if p.location else 0) for p in system.parameters] == [("N", 3)]
+    assert system.parameters[0].comments.leading == ["// the number of joints"]
+
+
+def test_an_error_after_a_unicode_line_separator_quotes_its_own_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """U+2028 or U+0085 in a comment is no line end for the reader, so none for the quoted source either."""
+    path = tmp_path / "separators.earl"
+    path.write_text("system s\n// one \u2028 two \x85 three\nparam N: int = $\n", encoding="utf-8")
+    printed = _check_exits_1(path, capsys)
+    assert "3 | param N: int = $" in printed
+
+
 def test_a_10_mb_file_is_refused_before_it_is_read(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     path = tmp_path / "huge.earl"
     line = b"        x/pp = true or false and not true\n"

@@ -65,7 +65,9 @@ class SourceMap:
             text = self.texts.get(name)
             if text is None:
                 return None
-            lines = self._lines[name] = text.splitlines()
+            # lines as the reader counts them: `str.splitlines` would also break at U+2028, U+0085 …
+            # inside a comment or a string, and quote the wrong line after it
+            lines = self._lines[name] = [line.removesuffix("\r") for line in text.split("\n")]
         if 1 <= number <= len(lines):
             return lines[number - 1]
         return "" if number == len(lines) + 1 else None

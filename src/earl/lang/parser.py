@@ -158,6 +158,10 @@ def decode(data: bytes, path: str) -> str:
 
 def parse_text(text: str, path: str = "<text>", sources: SourceMap | None = None) -> ParsedFile:
     """The declarations of one file, or an `EarlError` with one located diagnostic."""
+    if "\r" in text:
+        # Windows' and old Macs' line ends are lines too: a lone `\r` would otherwise end no comment,
+        # and `// note\rparam N …` would hide the parameter in the comment
+        text = text.replace("\r\n", "\n").replace("\r", "\n")
     sources = sources if sources is not None else SourceMap()
     sources.add(path, text)
     _collector.comments = []
