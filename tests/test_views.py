@@ -32,7 +32,7 @@ viewer/a {
 
         false/pp = false
 
-        write/pf(sent/mi, level/mi -> sent/mo, clear/mo, level/mo, joints/mo, current[*]/mo, seen/mo) = python "viewing:write"
+        write/pf(sent/mi, level/mi, current[*]/mi -> sent/mo, clear/mo, level/mo, joints/mo, current[*]/mo, seen/mo) = python "viewing:write"
 
         run/bb {
             tf = {write/pf}
@@ -83,6 +83,8 @@ def write(inputs, outputs, context):
         outputs.level = math.nan
     elif mode == 7:
         inputs.sent = 100  # inputs are read-only: the call fails, and writes nothing
+    elif mode == 8:
+        inputs.current[1] = 2.0  # a member of a family read, likewise
 """
 
 
@@ -129,6 +131,7 @@ def test_writes_are_taken_when_the_call_returns_and_read_back_by_item(tmp_path: 
         (4, "undeclared-write", "`current` is a family: write one member"),
         (6, "type", "level/mo is NaN"),
         (7, "undeclared-write", "`write/pf` assigned `inputs.sent`; inputs are read-only"),
+        (8, "undeclared-write", "assigned `inputs.current[1]`; inputs are read-only"),
     ],
 )
 def test_a_value_the_quick_test_rejects_gets_the_precise_message(

@@ -52,6 +52,13 @@ class FamilyInputs:
             ) from None
         return store[key]
 
+    def __setitem__(self, index: int, value: Any) -> None:
+        raise UndeclaredAccess(
+            f"assigned `inputs.{self._name}[{index}]`; inputs are read-only: "
+            "a function writes only its declared outputs (`outputs.…`, the names after `->`)",
+            write=True,
+        )
+
     def __len__(self) -> int:
         return len(self._members)
 
