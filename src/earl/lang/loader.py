@@ -212,12 +212,10 @@ def save(system: System, path: str | Path) -> None:
     over `/dev/null` would put a file in the device's place.  An OSError says what went wrong.
     """
     target = Path(path)
-    if target.exists() or target.is_symlink():
-        target = target.resolve()
-        if not target.is_file():
-            raise OSError(
-                errno.EINVAL, "not a regular file (a device, a pipe or a directory); only files are rewritten"
-            )
+    if target.is_symlink():
+        target = _resolved(target)
+    if target.exists() and not target.is_file():
+        raise OSError(errno.EINVAL, "not a regular file (a device, a pipe or a directory); only files are rewritten")
     temporary = target.with_name(f".{target.name}.tmp")
     try:
         temporary.write_text(system.to_earl(), encoding="utf-8")
