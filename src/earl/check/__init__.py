@@ -41,6 +41,7 @@ def check(system: System, parameters: Mapping[str, bool | int | float | str] | N
 
 
 def unknown_parameters(system: System, parameters: Mapping[str, object]) -> list[Diagnostic]:
+    """EARL-R001 for each name in `parameters` that is not a system parameter of `system`."""
     known = [p.name for p in system.parameters]
     return [
         Diagnostic(

@@ -67,7 +67,7 @@ def _unreadable(path: Path, error: BaseException) -> TraceError:
     return TraceError(f"{path} is not a readable MCAP trace ({detail})")
 
 
-def _not_earl_s(path: Path, topic: str) -> TraceError:
+def _not_from_earl(path: Path, topic: str) -> TraceError:
     return TraceError(
         f"{path}: a message on `{topic}` is not one earl writes (the file is damaged or not an earl trace)"
     )
@@ -79,7 +79,7 @@ def summarise(path: Path) -> TraceSummary:
         try:
             summariser.add(topic, metadata, time, data)
         except (KeyError, TypeError, ValueError, AttributeError):
-            raise _not_earl_s(path, topic) from None
+            raise _not_from_earl(path, topic) from None
     if not summariser.seen_run:
         raise TraceError(f"{path} is an MCAP file but not an earl trace (it has no /earl/run topic)")
     return summariser.summary()
@@ -219,7 +219,7 @@ def read_signals(path: Path, names: list[str]) -> Signals:
                 found[0].append(seconds)
                 found[1].append(float(value))
         except (KeyError, TypeError, ValueError, AttributeError):
-            raise _not_earl_s(path, topic) from None
+            raise _not_from_earl(path, topic) from None
     series: list[Series] = []
     for name, subsystem, inner in owners:
         pattern = re.compile(re.escape(inner).replace(r"\[\*\]", r"\[\d+\]") + "$")
