@@ -11,6 +11,8 @@ from typing import Any
 
 import msgpack  # type: ignore[import-untyped]
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 import earl
 from earl.model.expand import expand
@@ -159,6 +161,36 @@ def test_a_bad_deployment_file_is_one_located_sentence(tmp_path: Path, text: str
         read_deployment(path)
     assert str(error.value).startswith(str(path))
     assert fragment in str(error.value)
+
+
+@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(
+    st.lists(
+        st.tuples(
+            st.integers(0, 10_000),
+            st.integers(0, 12),
+            st.sampled_from(['"', "'", "[", "]", "=", ",", "\n", "#", "-1", "1e400", "true", "{", "}", "[[", "]]", ""]),
+        ),
+        min_size=1,
+        max_size=3,
+    )
+)
+def test_a_damaged_deployment_file_is_refused_with_a_deployment_error_only(
+    tmp_path: Path, edits: list[tuple[int, int, str]]
+) -> None:
+    """Whatever is cut or inserted, reading and checking a deployment raises DeploymentError or nothing."""
+    text = (PICK_AND_PLACE / "deploy.toml").read_text()
+    for start, length, insert in edits:
+        start %= len(text) + 1
+        text = text[:start] + insert + text[start + length :]
+    path = tmp_path / "deploy.toml"
+    path.write_text(text)
+    try:
+        deployment = read_deployment(path)
+        deployment.check_agents(["task/a", "manip/a", "grip/a"])
+        assert all(isinstance(process.is_local, bool) for process in deployment.processes)
+    except DeploymentError as error:
+        assert str(error) and "\n" not in str(error)  # one sentence
 
 
 def test_a_deployment_must_cover_the_agents_of_the_system(tmp_path: Path) -> None:
