@@ -426,3 +426,18 @@ def test_check_never_imports_code_the_spec_names(tmp_path: Path) -> None:
             timeout=120,
         ).stdout
     )
+
+
+def test_on_a_terminal_a_spinner_names_the_phase_and_elsewhere_nothing_is_added() -> None:
+    """A spec of 100,000 subsystems takes seconds per phase: a terminal is told which one runs."""
+    example = str(Path(__file__).parent.parent / "examples" / "pick_and_place")
+    command = [sys.executable, "-m", "earl.cli.main", "check", example]
+    plain = subprocess.run(command, capture_output=True, text=True, timeout=120, check=False)
+    terminal = subprocess.run(
+        command, capture_output=True, text=True, timeout=120, check=False, env={**os.environ, "FORCE_COLOR": "1"}
+    )
+    assert plain.returncode == terminal.returncode == 0
+    assert plain.stderr == ""
+    for phase in ("reading the specification", "expanding the indexed families", "applying the rules to 17 subsystems"):
+        assert phase in terminal.stderr
+    assert plain.stdout.strip().endswith(terminal.stdout.strip()[-60:])  # the verdict itself is the same

@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import argparse
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import Any
 
 from rich.console import Console
+from rich.status import Status
 from rich.table import Table
 
 from earl.check import CheckContext, check_context, collector_paused, context_for
@@ -74,6 +77,34 @@ def _summary(system: System, context: CheckContext) -> None:
     Console(highlight=False).print(table)
 
 
+class _Phases:
+    """Which phase of `earl check` runs, said by a spinner on a terminal (`status`), or nowhere (None)."""
+
+    def __init__(self, status: Status | None) -> None:
+        self._status = status
+
+    def update(self, text: str) -> None:
+        if self._status is not None:
+            self._status.update(text, spinner="dots")  # a new spinner is drawn at once, not at the next tick
+
+    def stop(self) -> None:
+        if self._status is not None:
+            self._status.stop()
+
+
+@contextmanager
+def _phases(console: Console) -> Iterator[_Phases]:
+    """On a terminal, a spinner saying which phase runs: a spec of 100,000 subsystems takes seconds in
+    each. Nowhere else: a pipe or a file gets only the findings."""
+    if not console.is_terminal:
+        yield _Phases(None)
+        return
+    with console.status("") as status:
+        phases = _Phases(status)
+        phases.update("reading the specification …")
+        yield phases
+
+
 def run(arguments: argparse.Namespace) -> int:
     try:
         path = spec_path(arguments.spec)
@@ -81,14 +112,17 @@ def run(arguments: argparse.Namespace) -> int:
     except UsageError as error:
         return usage_error(str(error))
     # Reading and checking a large spec allocates millions of objects that all stay alive until the
-    # end: the collector's passes over them would cost more than the work (earl.check.collector).
-    with collector_paused():
+    # end: the collector's passes over them would cost more than the work (earl/collector.py).
+    with collector_paused(), _phases(Console(stderr=True)) as phase:
         try:
             system = load(path, parameters)
         except EarlError as error:
+            phase.stop()
             _print(error.diagnostics, arguments, error.sources)
             return 1
+        phase.update("expanding the indexed families …")
         context = context_for(system, parameters)
+        phase.update(f"applying the rules to {sum(len(a.subsystems) for a in context.system.agents):,} subsystems …")
         diagnostics = check_context(context)
     errors = sum(1 for d in diagnostics if d.severity is Severity.ERROR)
     warnings = sum(1 for d in diagnostics if d.severity is Severity.WARNING)
