@@ -7,8 +7,6 @@ import re
 from earl.model.elements import Duration
 
 _UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "min": 60.0, "": 1.0}
-#: the longest duration taken, the language's own (`1e400s` would be infinite)
-MAX_SECONDS = Duration.MAX_SECONDS
 _PATTERN = re.compile(r"^\s*([-+]?[0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)\s*(s|ms|us|min|)\s*$")
 
 
@@ -20,6 +18,6 @@ def parse_duration(text: str) -> float:
     value = float(match.group(1)) * _UNITS[match.group(2)]
     if value <= 0:
         raise ValueError(f"`{text}`: a duration must be positive")
-    if not value <= MAX_SECONDS:  # also catches the infinity of `1e400`
-        raise ValueError(f"`{text}` is too long: a duration is at most {MAX_SECONDS:,.0f} s (about 31 years)")
+    if not value <= Duration.MAX_SECONDS:  # the language's own limit; also catches the infinity of `1e400`
+        raise ValueError(f"`{text}` is too long: a duration is at most {Duration.MAX_SECONDS:,.0f} s (about 31 years)")
     return value

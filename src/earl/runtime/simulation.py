@@ -305,17 +305,18 @@ def read_run_settings(spec: Path) -> RunSettings:
         return ValueError(f"{path}: `{key}` is {wanted}, not {data[key]!r}")
 
     duration = data.get("duration")
-    if isinstance(duration, str):
+    if duration is not None:
+        wanted = 'a duration such as "13s" or a positive number of seconds'
+        if isinstance(duration, bool) or not isinstance(duration, str | int | float):
+            raise refuse("duration", wanted)
         from earl.runtime.durations import parse_duration
 
-        try:
-            duration = parse_duration(duration)
+        try:  # a number is seconds, as a bare number on the command line is: one set of rules for both
+            duration = parse_duration(str(duration))
         except ValueError as error:
+            if not isinstance(duration, str):
+                raise refuse("duration", wanted) from None
             raise ValueError(f"{path}: `duration`: {error}") from None
-    elif duration is not None and (
-        isinstance(duration, bool) or not isinstance(duration, int | float) or not 0 < duration <= Duration.MAX_SECONDS
-    ):
-        raise refuse("duration", 'a duration such as "13s" or a positive number of seconds')
     seed = data.get("seed")
     if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int) or seed < 0):
         raise refuse("seed", "a whole number >= 0")
