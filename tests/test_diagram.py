@@ -115,6 +115,32 @@ def test_each_view_is_valid_svg_naming_its_elements(
     assert missing == []
 
 
+def _block_left_edges(svg: str) -> dict[str, float]:
+    """The leftmost x of each node's drawing, by the node's DOT name (its SVG title)."""
+    root = ElementTree.fromstring(svg)
+    edges = {}
+    for group in root.iter(f"{SVG_NAMESPACE}g"):
+        title = group.find(f"{SVG_NAMESPACE}title")
+        if group.get("class") != "node" or title is None or title.text is None:
+            continue
+        xs = [
+            float(point.split(",")[0])
+            for polygon in group.iter(f"{SVG_NAMESPACE}polygon")
+            for point in (polygon.get("points") or "").split()
+        ]
+        if xs:
+            edges[title.text] = min(xs)
+    return edges
+
+
+def test_the_system_view_lays_agents_out_along_their_links(system: System) -> None:
+    """The task agent, which commands the two others, stands left of them, not in one column with them:
+    the links' label nodes are inside the robot cluster that holds both their ends."""
+    left = _block_left_edges(build_diagram(system, "system").svg())
+    task, manip, grip = left["n_agent_task_a"], left["n_agent_manip_a"], left["n_agent_grip_a"]
+    assert task + 100 < manip and task + 100 < grip
+
+
 def test_a_family_is_drawn_once_with_its_index_and_expand_draws_every_member(system: System) -> None:
     once = svg_text(build_diagram(system, "agent", "manip/a", parameters={"N": 3}).svg())
     assert once.count("motorController[K]/ve") == 1

@@ -92,35 +92,51 @@ def system_view(system: System, agent_type: AgentTypeOf = lambda agent: None) ->
         statements[id(agent)] = f'{nodes[id(agent)]} [shape="plain", label={label}, tooltip="{html(name)}"];'
 
     positions = {id(agent): position for position, agent in enumerate(system.agents)}
-    placed: set[int] = set()
     agents_by_key = {element_key(a, Kind.AGENT): a for a in system.agents}
+    #: robot number of each agent a robot lists (the first robot that lists it)
+    robot_of: dict[int, int] = {}
+    members: list[list[Agent]] = []
     for number, robot in enumerate(system.robots):
-        members = []
+        members.append([])
         for reference in robot.agents:
             for agent in _robot_members(reference, agents_by_key):
-                if id(agent) not in placed:
-                    placed.add(id(agent))
-                    members.append(agent)
+                if id(agent) not in robot_of:
+                    robot_of[id(agent)] = number
+                    members[number].append(agent)
+
+    # A link's label node sits in the robot that holds both its ends: dot keeps a cluster's nodes in one
+    # band of ranks, so a label node outside it would squeeze every agent of the robot into one column.
+    link_nodes: dict[int | None, list[str]] = {}
+    edges: list[str] = []
+    link_names: list[str] = []
+    for number, link in enumerate(links):
+        name = link_label(link.link)
+        link_names.append(name)
+        source = f"{nodes[id(link.source)]}:{_port('ob', link.source_buffer)}:e"
+        destination = f"{nodes[id(link.destination)]}:{_port('ib', link.destination_buffer)}:w"
+        backward = positions[id(link.destination)] < positions[id(link.source)]
+        node, *link_edges = link_statements(number, source, destination, name, link.data_type, backward)
+        source_robot, destination_robot = robot_of.get(id(link.source)), robot_of.get(id(link.destination))
+        shared = source_robot if source_robot == destination_robot else None
+        link_nodes.setdefault(shared, []).append(node)
+        edges.extend(link_edges)
+
+    for number, robot in enumerate(system.robots):
         robot_name = f"{robot.name}/r"
         names.append(robot_name)
         graph.add(f"subgraph cluster_robot_{number} {{")
         graph.add(f'  label=<<i>«Robot»</i> <b>{html(robot_name)}</b>>; style="dashed,rounded"; color="#777777";')
-        for agent in members:
+        for agent in members[number]:
             graph.add("  " + statements[id(agent)])
+        for node in link_nodes.get(number, []):
+            graph.add("  " + node)
         graph.add("}")
     for agent in system.agents:
-        if id(agent) not in placed:
+        if id(agent) not in robot_of:
             graph.add(statements[id(agent)])
-
-    for number, link in enumerate(links):
-        name = link_label(link.link)
-        names.append(name)
-        source = f"{nodes[id(link.source)]}:{_port('ob', link.source_buffer)}:e"
-        destination = f"{nodes[id(link.destination)]}:{_port('ib', link.destination_buffer)}:w"
-        backward = positions[id(link.destination)] < positions[id(link.source)]
-        for statement in link_statements(number, source, destination, name, link.data_type, backward):
-            graph.add(statement)
-    return Diagram("system", graph.header, graph.source(), "system", tuple(names))
+    for statement in link_nodes.get(None, []) + edges:
+        graph.add(statement)
+    return Diagram("system", graph.header, graph.source(), "system", (*names, *link_names))
 
 
 def _robot_members(reference: ElementReference, agents: dict[Key, Agent]) -> list[Agent]:
