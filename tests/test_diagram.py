@@ -115,30 +115,36 @@ def test_each_view_is_valid_svg_naming_its_elements(
     assert missing == []
 
 
-def _block_left_edges(svg: str) -> dict[str, float]:
-    """The leftmost x of each node's drawing, by the node's DOT name (its SVG title)."""
+def _block_centres(svg: str) -> dict[str, float]:
+    """The mean x of the text in each node's drawing, by the node's DOT name (its SVG title)."""
     root = ElementTree.fromstring(svg)
-    edges = {}
+    centres = {}
     for group in root.iter(f"{SVG_NAMESPACE}g"):
         title = group.find(f"{SVG_NAMESPACE}title")
         if group.get("class") != "node" or title is None or title.text is None:
             continue
-        xs = [
-            float(point.split(",")[0])
-            for polygon in group.iter(f"{SVG_NAMESPACE}polygon")
-            for point in (polygon.get("points") or "").split()
-        ]
+        xs = [float(text.get("x", "nan")) for text in group.iter(f"{SVG_NAMESPACE}text")]
         if xs:
-            edges[title.text] = min(xs)
-    return edges
+            centres[title.text] = sum(xs) / len(xs)
+    return centres
 
 
 def test_the_system_view_lays_agents_out_along_their_links(system: System) -> None:
     """The task agent, which commands the two others, stands left of them, not in one column with them:
     the links' label nodes are inside the robot cluster that holds both their ends."""
-    left = _block_left_edges(build_diagram(system, "system").svg())
+    left = _block_centres(build_diagram(system, "system").svg())
     task, manip, grip = left["n_agent_task_a"], left["n_agent_manip_a"], left["n_agent_grip_a"]
     assert task + 100 < manip and task + 100 < grip
+
+
+@pytest.mark.parametrize(("path", "agent"), [(EXAMPLE, "manip/a"), (MOBILE, "base/a")])
+def test_the_agent_view_draws_senders_left_and_receivers_right_of_every_subsystem(path: Path, agent: str) -> None:
+    left = _block_centres(build_diagram(earl.load(path), "agent", agent).svg())
+    subsystems = [x for name, x in left.items() if name.startswith("n_ss_")]
+    senders = [x for name, x in left.items() if name.startswith("n_ext_in_")]
+    receivers = [x for name, x in left.items() if name.startswith("n_ext_out_")]
+    assert len(subsystems) >= 3 and senders and receivers
+    assert max(senders) < min(subsystems) and min(receivers) > max(subsystems)
 
 
 def test_a_family_is_drawn_once_with_its_index_and_expand_draws_every_member(system: System) -> None:

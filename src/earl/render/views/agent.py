@@ -131,11 +131,15 @@ def _external_links(agent: Agent, system: System, graph: Graph, names: list[str]
 
     An agent that sends to this one is drawn on the left, one that receives on the
     right (an agent that does both appears twice), so every link runs left to right.
+    Invisible edges to and from every subsystem hold them there: the frame is a cluster,
+    and dot would otherwise put an outside node that shares a rank with the frame's
+    contents below the frame.
     """
     cs = agent.control_subsystem
     if cs is None:
         return
     cs_node = node_id("ss", "cs")
+    subsystem_nodes = [node_id("ss", subsystem_name(subsystem)) for subsystem in agent.subsystems]
     drawn: set[str] = set()
     for number, link in enumerate(inter_agent_links(system)):
         if link.source is agent and link.destination is not agent:
@@ -158,6 +162,9 @@ def _external_links(agent: Agent, system: System, graph: Graph, names: list[str]
                 f'{node} [shape="box", style="dashed,rounded", color="#777777", fontcolor="#555555", '
                 f"label=<<i>«Agent»</i><br/>{html(other)}>];"
             )
+            for subsystem_node in subsystem_nodes:
+                before, after = (subsystem_node, node) if destination == node else (node, subsystem_node)
+                graph.outside.append(f'{before} -> {after} [style="invis"];')
         statements = link_statements(number + 10_000, source, destination, link_label(link.link), link.data_type, False)
         graph.outside += [
             statement.replace("];", ', style="dashed"];') if "->" in statement else statement
