@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import shutil
 import signal
 import subprocess
@@ -207,13 +208,17 @@ def test_usage_errors_exit_2_with_one_line(arguments: list[str], fragment: str) 
     assert "Traceback" not in result.stderr
 
 
-def realtime_run_under_way(trace: Path) -> subprocess.Popen[str]:
-    """`earl run` of the counter in real time for a minute, a second after its trace appeared."""
+def realtime_run_under_way(
+    trace: Path, spec: Path = SPECS / "counter", own_group: bool = False
+) -> subprocess.Popen[str]:
+    """`earl run` of the counter in real time for a minute, a second after its trace appeared; `own_group`:
+    in a process group of its own, as `timeout` or a terminal starts it."""
     process = subprocess.Popen(
-        [*EARL, "run", str(SPECS / "counter"), "--realtime", "--duration", "60s", "--trace", str(trace)],
+        [*EARL, "run", str(spec), "--realtime", "--duration", "60s", "--trace", str(trace)],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
+        start_new_session=own_group,
     )
     deadline = time.monotonic() + 30
     while not trace.exists() and time.monotonic() < deadline:
@@ -233,6 +238,68 @@ def test_ctrl_c_stops_the_run_cleanly_and_the_trace_stays_readable(tmp_path: Pat
     summary = earl_cli("trace", "summary", str(trace))
     assert summary.returncode == 0, summary.stderr
     assert "counting,finished" in summary.stdout
+
+
+@pytest.mark.parametrize("stop", [signal.SIGTERM, signal.SIGHUP, signal.SIGINT])
+def test_a_stop_signal_to_the_whole_process_group_leaves_a_readable_trace(tmp_path: Path, stop: int) -> None:
+    """`timeout`, a closed terminal and Ctrl-C signal every process of the group, the trace's writer too:
+    the writer ignores them and finishes the file when the run, stopped in order, says so."""
+    trace = tmp_path / "run.mcap"
+    process = realtime_run_under_way(trace, own_group=True)
+    os.killpg(process.pid, stop)
+    _, stderr = process.communicate(timeout=30)
+    assert process.returncode == 130, stderr
+    assert "interrupted at" in stderr and "Traceback" not in stderr
+    summary = earl_cli("trace", "summary", str(trace))
+    assert summary.returncode == 0, summary.stderr
+    assert "counting,finished" in summary.stdout
+
+
+def test_ctrl_c_stops_the_run_even_when_the_specs_code_swallows_it(tmp_path: Path) -> None:
+    spec = counter_copy(tmp_path)
+    functions = spec.parent / "counting" / "cs.py"
+    functions.write_text(
+        "import time\n\n"
+        + functions.read_text().replace(
+            "def rest(inputs, outputs, context):\n",
+            "def rest(inputs, outputs, context):\n    try:\n        time.sleep(0.005)\n    except:  # noqa: E722\n        pass\n",
+        )
+    )
+    trace = tmp_path / "run.mcap"
+    process = realtime_run_under_way(trace, spec.parent)
+    started = time.monotonic()
+    process.send_signal(signal.SIGINT)
+    try:
+        _, stderr = process.communicate(timeout=30)
+    finally:
+        process.kill()
+    assert process.returncode == 130, stderr
+    assert time.monotonic() - started < 15  # at the next of the run's 200 steps (0.3 s), not after 60 s
+    assert earl_cli("trace", "summary", str(trace)).returncode == 0
+
+
+def test_text_of_the_specs_code_is_printed_as_it_is_never_as_markup(tmp_path: Path) -> None:
+    """An exception's message goes to the closing summary and `earl trace summary` unchanged: a Rich
+    tag in it (`[/dev/ttyUSB0]` closes one) neither fails nor vanishes; a huge one is cut for the terminal."""
+    spec = counter_copy(tmp_path)
+    functions = spec.parent / "counting" / "cs.py"
+    functions.write_text(
+        functions.read_text().replace(
+            "    outputs.count = inputs.count + 1\n",
+            "    outputs.count = inputs.count + 1\n"
+            "    if inputs.count == 1:\n"
+            "        raise OSError('cannot open [/dev/ttyUSB0] as [bold]root[/bold]' + 'x' * 3_000_000)\n",
+        )
+    )
+    trace = tmp_path / "run.mcap"
+    result = earl_cli("run", str(spec), "--duration", "100ms", "--trace", str(trace))
+    assert result.returncode == 0, result.stderr
+    assert "cannot open [/dev/ttyUSB0] as [bold]root[/bold]" in result.stdout
+    assert "more characters; the trace has them all" in result.stdout
+    assert len(result.stdout) < 10_000
+    summary = earl_cli("trace", "summary", str(trace))
+    assert summary.returncode == 0, summary.stderr
+    assert "cannot open [/dev/ttyUSB0] as [bold]root[/bold]" in summary.stdout
 
 
 def test_a_run_killed_with_sigkill_still_leaves_a_readable_trace(tmp_path: Path) -> None:

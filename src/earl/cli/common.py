@@ -46,3 +46,15 @@ def parse_parameter(text: str) -> tuple[str, ParameterValue]:
 def usage_error(message: str) -> int:
     sys.stderr.write(f"earl: error: {message}\n")
     return EXIT_USAGE
+
+
+#: characters of a message from the spec's code shown on the terminal (the trace keeps it whole)
+SHOWN_MESSAGE = 400
+
+
+def brief(text: str, limit: int = SHOWN_MESSAGE) -> str:
+    """A message the spec's code wrote (an exception's text), cut for the terminal: a megabyte-long
+    message would fill the screen, and the table renderer takes time quadratic in a line's length."""
+    if len(text) <= limit:
+        return text
+    return f"{text[:limit]}… ({len(text) - limit:,} more characters; the trace has them all)"

@@ -3,19 +3,22 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import gc
 import signal
 import statistics
 import sys
 import time
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
+from rich.text import Text
 
-from earl.cli.common import UsageError, parse_parameter, spec_path, usage_error
+from earl.cli.common import UsageError, brief, parse_parameter, spec_path, usage_error
 from earl.cli.output import print_diagnostics
 from earl.diagnostics import EarlError
 
@@ -215,19 +218,42 @@ def run(arguments: argparse.Namespace) -> int:
     if transport is not None:
         from earl.transport.process import wait_for_peers
 
-        def stop(*_: object) -> None:
-            raise KeyboardInterrupt
-
-        previous = signal.signal(signal.SIGTERM, stop)
         try:
-            wait_for_peers(transport, arguments)
+            with _stopped_like_ctrl_c():
+                wait_for_peers(transport, arguments)
         except KeyboardInterrupt:
             simulation.close()  # nothing ran; the trace is still closed and readable
             print("earl run: interrupted while waiting for the other processes", file=sys.stderr)
             return EXIT_INTERRUPTED
-        finally:
-            signal.signal(signal.SIGTERM, previous)
     return _execute(simulation, duration, arguments, None if no_environment else settings.report, path)
+
+
+#: signals that end a run as Ctrl-C does: `kill`, `timeout`, a service manager, a closed terminal
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+
+
+class _StopRequest:
+    """Whether a stop signal came, remembered: a function of the spec that catches every exception
+    (`except: pass`) swallows the KeyboardInterrupt, and the run must still stop at its next step."""
+
+    requested = False
+
+
+@contextlib.contextmanager
+def _stopped_like_ctrl_c() -> Iterator[_StopRequest]:
+    """Ctrl-C, SIGTERM and SIGHUP raise KeyboardInterrupt meanwhile, so that the run ends in order (exit 130)."""
+    request = _StopRequest()
+
+    def stop(*_: object) -> None:
+        request.requested = True
+        raise KeyboardInterrupt
+
+    previous = {number: signal.signal(number, stop) for number in STOP_SIGNALS}
+    try:
+        yield request
+    finally:
+        for number, handler in previous.items():
+            signal.signal(number, handler)
 
 
 def _close(transport: Any) -> None:
@@ -249,16 +275,11 @@ def _seed(text: str) -> int:
 def _execute(simulation: Any, duration: float, arguments: argparse.Namespace, report: str | None, path: Path) -> int:
     from earl.runtime.trace import TraceWriteError
 
-    console = Console(stderr=True, highlight=False)
+    # markup off: what is printed includes text of the spec's code (`[/dev/ttyUSB0]` is no Rich tag)
+    console = Console(stderr=True, highlight=False, markup=False)
     interrupted = False
     failed: TraceWriteError | None = None
     exited: SystemExit | None = None
-    previous = signal.getsignal(signal.SIGTERM)
-
-    def stop(*_: object) -> None:
-        raise KeyboardInterrupt
-
-    signal.signal(signal.SIGTERM, stop)
     from earl.cli import main as program
 
     if program.AS_PROGRAM:
@@ -267,25 +288,9 @@ def _execute(simulation: Any, duration: float, arguments: argparse.Namespace, re
         # garbage of the set-up is frozen with it, and goes with the process.)
         gc.freeze()
     started = time.perf_counter()
-    steps = 200
-    progress: Progress | None = None
     try:
-        for step in range(1, steps + 1):
-            simulation.advance_to(duration * step / steps)
-            elapsed = time.perf_counter() - started
-            if progress is None and elapsed > 1.0 and not arguments.no_progress and console.is_terminal:
-                progress = Progress(
-                    TextColumn("[bold]earl run[/bold]"),
-                    BarColumn(),
-                    TextColumn("{task.fields[simulated]}"),
-                    TimeRemainingColumn(),
-                    console=console,
-                    transient=True,
-                )
-                progress.start()
-                progress.add_task("run", total=steps, completed=step, simulated="")
-            if progress is not None:
-                progress.update(progress.task_ids[0], completed=step, simulated=f"{simulation.time:.2f} s")
+        with _stopped_like_ctrl_c() as stop:
+            _advance(simulation, duration, arguments, console, started, stop)
     except KeyboardInterrupt:
         interrupted = True
     except TraceWriteError as error:  # a full disk, say: the run stops, what was written stays readable
@@ -293,14 +298,11 @@ def _execute(simulation: Any, duration: float, arguments: argparse.Namespace, re
     except SystemExit as request:  # the spec's own code called sys.exit(): the run ends there, in order
         exited = request
     finally:
-        if progress is not None:
-            progress.stop()
         wall = time.perf_counter() - started
         try:
             simulation.close()
         except TraceWriteError as error:
             failed = failed or error
-        signal.signal(signal.SIGTERM, previous)
     if failed is not None:
         print(f"earl run: {failed} (the run reached {simulation.time:.3f} s)", file=sys.stderr)
         return EXIT_FAILED
@@ -326,8 +328,43 @@ def _execute(simulation: Any, duration: float, arguments: argparse.Namespace, re
     return EXIT_OK
 
 
+def _advance(
+    simulation: Any,
+    duration: float,
+    arguments: argparse.Namespace,
+    console: Console,
+    started: float,
+    stop: _StopRequest,
+) -> None:
+    """Run to `duration` in 200 steps; a progress bar on a terminal once the run takes more than a second."""
+    steps = 200
+    progress: Progress | None = None
+    try:
+        for step in range(1, steps + 1):
+            simulation.advance_to(duration * step / steps)
+            if stop.requested:  # the spec's code swallowed the KeyboardInterrupt
+                raise KeyboardInterrupt
+            elapsed = time.perf_counter() - started
+            if progress is None and elapsed > 1.0 and not arguments.no_progress and console.is_terminal:
+                progress = Progress(
+                    TextColumn("[bold]earl run[/bold]"),
+                    BarColumn(),
+                    TextColumn("{task.fields[simulated]}"),
+                    TimeRemainingColumn(),
+                    console=console,
+                    transient=True,
+                )
+                progress.start()
+                progress.add_task("run", total=steps, completed=step, simulated="")
+            if progress is not None:
+                progress.update(progress.task_ids[0], completed=step, simulated=f"{simulation.time:.2f} s")
+    finally:
+        if progress is not None:
+            progress.stop()
+
+
 def _summary(simulation: Any, wall: float, arguments: argparse.Namespace) -> None:
-    console = Console(highlight=False)
+    console = Console(highlight=False, markup=False)
     table = Table(title=f"system {simulation.system.name}: {simulation.time:.3f} s", title_justify="left")
     table.add_column("subsystem")
     table.add_column("state at the end")
@@ -355,9 +392,11 @@ def _summary(simulation: Any, wall: float, arguments: argparse.Namespace) -> Non
     console.print(table)
     faults = simulation.faults
     if faults:
-        console.print(f"[yellow]{len(faults)} fault(s)[/yellow]; the first:")
+        console.print(Text.assemble((f"{len(faults)} fault(s)", "yellow"), "; the first:"))
         first = faults[0]
-        console.print(f"  t={first.time / 1e9:.6f} s {first.subsystem} ({first.kind}): {first.message}")
+        console.print(
+            f"  t={first.time / 1e9:.6f} s {first.subsystem} ({first.kind}): {brief(first.message)}", soft_wrap=True
+        )
     ratio = simulation.time / wall if wall > 0 else float("inf")
     mode = "real time" if arguments.realtime else "virtual time"
     console.print(f"ran {simulation.time:.3f} s of {mode} in {wall:.2f} s of wall time ({ratio:.1f}x real time)")

@@ -10,7 +10,7 @@ from typing import Any
 from rich.console import Console
 from rich.table import Table
 
-from earl.cli.common import usage_error
+from earl.cli.common import brief, usage_error
 
 EXIT_OK, EXIT_FAILED = 0, 1
 
@@ -62,7 +62,7 @@ def run_summary(arguments: argparse.Namespace) -> int:
     except TraceError as error:
         sys.stderr.write(f"earl trace: {error}\n")
         return EXIT_FAILED
-    console = Console(highlight=False)
+    console = Console(highlight=False, markup=False)  # fault messages are the spec's code's text
     end = summary.end_time * 1e-9
     settings = ", ".join(f"{k}={v}" for k, v in summary.settings.items())
     table = Table(title=f"{path.name}: {end:.3f} s ({settings})", title_justify="left")
@@ -81,7 +81,10 @@ def run_summary(arguments: argparse.Namespace) -> int:
     console.print(table)
     console.print(f"{summary.messages} messages on links, {len(summary.faults)} faults")
     for fault in summary.faults[:10]:
-        console.print(f"  t={fault['time'] * 1e-9:.6f} s {fault['subsystem']} ({fault['kind']}): {fault['message']}")
+        console.print(
+            f"  t={fault['time'] * 1e-9:.6f} s {fault['subsystem']} ({fault['kind']}): {brief(str(fault['message']))}",
+            soft_wrap=True,
+        )
     if len(summary.faults) > 10:
         console.print(f"  … and {len(summary.faults) - 10} more")
     return EXIT_OK

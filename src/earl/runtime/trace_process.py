@@ -2,9 +2,10 @@
 
 It reads length-prefixed msgpack batches from its standard input, written by
 `BackgroundSink` in the run's process (trusted: its parent), and applies them to a
-`McapSink`.  Ctrl-C reaches every process of the terminal: this one ignores it and
-finishes the file when the run says so, or when its input ends because the run
-was killed.  A write that fails (a full disk) ends it with exit code 1 and one line on
+`McapSink`.  Ctrl-C reaches every process of the terminal, and SIGTERM or SIGHUP
+every process of the group (`timeout`, a closed terminal): this one ignores them
+all and finishes the file when the run says so, or when its input ends because
+the run was killed.  A write that fails (a full disk) ends it with exit code 1 and one line on
 standard error, which the run reports.
 """
 
@@ -52,7 +53,8 @@ def write(path: str, source: BinaryIO) -> None:
 
 
 def main(argv: list[str]) -> int:
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    for stop in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+        signal.signal(stop, signal.SIG_IGN)
     # The SDK logs a line for every message it cannot write; the run reads this process's last
     # line of standard error only at the end, so the first error is reported (above) instead.
     logging.disable(logging.CRITICAL)
