@@ -164,7 +164,9 @@ def test_a_function_with_the_wrong_signature_is_refused_before_the_run(tmp_path:
         earl.simulate(earl.load(spec))
     [diagnostic] = raised.value.diagnostics
     assert diagnostic.code == "EARL-X005"
-    assert "with 3 arguments" in diagnostic.message
+    assert "calls `counting.cs:increment` with 3 arguments, but it is defined as `increment(inputs, outputs)`" in (
+        diagnostic.message
+    )
     assert diagnostic.location is not None and diagnostic.location.line > 1
 
 
@@ -174,6 +176,67 @@ def test_a_module_that_fails_to_import_is_reported_with_its_error(tmp_path: Path
     with pytest.raises(EarlError) as raised:
         earl.simulate(earl.load(spec))
     assert any("the lab printer is offline" in d.message and d.code == "EARL-X003" for d in raised.value.diagnostics)
+
+
+REST = "\n\ndef send(inputs, outputs, context):\n    pass\n\n\ndef rest(inputs, outputs, context):\n    pass\n"
+
+
+@pytest.mark.parametrize(
+    ("increment", "code", "fragment"),
+    [
+        ("async def increment(inputs, outputs, context):\n    pass\n", "EARL-X005", "a coroutine function"),
+        ("def increment(inputs, outputs, context):\n    yield\n", "EARL-X005", "a generator function"),
+        ("class increment:\n    def __init__(self, a, b, c):\n        pass\n", "EARL-X005", "a class"),
+        ("increment = None\n", "EARL-X004", "which is a NoneType, not a function"),
+        ("import sys\nsys.exit(4)\n", "EARL-X003", "it called sys.exit(4) while being imported"),
+        ("class Odd(BaseException):\n    pass\n\nraise Odd('no')\n", "EARL-X003", "Odd: no (/"),
+        ("def increment(inputs, outputs, context)\n    pass\n", "EARL-X003", "SyntaxError"),
+        ("import no_such_helper_module\n", "EARL-X003", "No module named 'no_such_helper_module' (/"),
+    ],
+    ids=["async", "generator", "class", "None", "sys.exit", "BaseException", "syntax", "import inside"],
+)
+def test_code_the_runtime_cannot_call_as_a_function_is_refused_before_the_run(
+    tmp_path: Path, increment: str, code: str, fragment: str
+) -> None:
+    spec = counter_copy(tmp_path)
+    (spec.parent / "counting" / "cs.py").write_text(increment + REST)
+    with pytest.raises(EarlError) as raised:
+        earl.simulate(earl.load(spec))
+    diagnostic = raised.value.diagnostics[0]  # the first function the module fails to give
+    assert (diagnostic.code, fragment in diagnostic.message) == (code, True), diagnostic.message
+    assert "<frozen" not in diagnostic.message
+
+
+@pytest.mark.parametrize(
+    ("raising", "message"),
+    [
+        ("class Odd(BaseException):\n    pass\n", "`increment/pf` raised Odd: odd"),
+        (
+            "class Odd(Exception):\n    def __str__(self):\n        raise RuntimeError\n",
+            "`increment/pf` raised Odd: (its message cannot be shown: its __str__ failed)",
+        ),
+        ("Odd = GeneratorExit\n", "`increment/pf` raised GeneratorExit: odd"),
+    ],
+    ids=["BaseException", "broken __str__", "GeneratorExit"],
+)
+def test_any_exception_of_a_function_is_its_fault_and_the_run_goes_on(
+    tmp_path: Path, raising: str, message: str
+) -> None:
+    spec = counter_copy(tmp_path)
+    functions = spec.parent / "counting" / "cs.py"
+    functions.write_text(
+        raising
+        + "\n\n"
+        + functions.read_text().replace(
+            "    outputs.count = inputs.count + 1\n",
+            "    outputs.count = inputs.count + 1\n    if inputs.count == 1:\n        raise Odd('odd')\n",
+        )
+    )
+    simulation = earl.simulate(earl.load(spec))
+    simulation.advance_to(0.05)
+    simulation.close()
+    assert simulation.faults and simulation.faults[0].message == message
+    assert simulation.state_of("counter/a.display/re").iterations == 6  # everything else ran on
 
 
 def test_the_checker_runs_first_and_its_errors_stop_the_run(tmp_path: Path) -> None:
@@ -300,6 +363,63 @@ def test_text_of_the_specs_code_is_printed_as_it_is_never_as_markup(tmp_path: Pa
     summary = earl_cli("trace", "summary", str(trace))
     assert summary.returncode == 0, summary.stderr
     assert "cannot open [/dev/ttyUSB0] as [bold]root[/bold]" in summary.stdout
+
+
+def test_a_message_that_is_not_utf8_text_is_recorded_escaped_and_the_trace_stays_whole(tmp_path: Path) -> None:
+    """A file name of undecodable bytes in an exception's message (a lone surrogate) used to lose the trace."""
+    spec = counter_copy(tmp_path)
+    functions = spec.parent / "counting" / "cs.py"
+    functions.write_text(
+        "import os\n\n"
+        + functions.read_text().replace(
+            "    outputs.count = inputs.count + 1\n",
+            "    outputs.count = inputs.count + 1\n"
+            "    if inputs.count == 1:\n"
+            "        raise FileNotFoundError('cannot open ' + os.fsdecode(b'/dev/tty\\xff'))\n",
+        )
+    )
+    trace = tmp_path / "run.mcap"
+    result = earl_cli("run", str(spec), "--duration", "100ms", "--trace", str(trace))
+    assert result.returncode == 0, result.stderr
+    summary = earl_cli("trace", "summary", str(trace))
+    assert summary.returncode == 0, summary.stderr
+    assert "counter/a.display/re" in summary.stdout  # the trace is whole: every subsystem to the end
+    assert "cannot open /dev/tty\\udcff" in summary.stdout
+
+
+def test_a_message_that_is_not_utf8_text_in_a_trace_written_to_a_stream(tmp_path: Path) -> None:
+    import io
+
+    from earl.runtime.trace_reader import summarise
+
+    spec = counter_copy(tmp_path)
+    functions = spec.parent / "counting" / "cs.py"
+    functions.write_text(
+        "import os\n\n"
+        + functions.read_text().replace(
+            "    outputs.count = inputs.count + 1\n",
+            "    outputs.count = inputs.count + 1\n    raise OSError(os.fsdecode(b'/dev/tty\\xff'))\n",
+        )
+    )
+    stream = io.BytesIO()
+    simulation = earl.simulate(earl.load(spec), trace=stream)
+    simulation.advance_to(0.05)
+    simulation.close()
+    (tmp_path / "api.mcap").write_bytes(stream.getvalue())
+    faults = summarise(tmp_path / "api.mcap").faults
+    assert faults and faults[0]["message"].endswith("/dev/tty\udcff")
+
+
+def test_a_trace_never_replaces_a_file_that_is_not_a_trace(tmp_path: Path) -> None:
+    spec = counter_copy(tmp_path)
+    before = spec.read_bytes()
+    result = earl_cli("run", str(spec.parent), "--duration", "10ms", "--trace", str(spec))
+    assert result.returncode == 2
+    assert "the file exists and is not an MCAP trace" in result.stderr
+    assert spec.read_bytes() == before
+    trace = tmp_path / "run.mcap"
+    for _ in range(2):  # an earlier trace is replaced
+        assert earl_cli("run", str(spec.parent), "--duration", "10ms", "--trace", str(trace)).returncode == 0
 
 
 def test_a_run_killed_with_sigkill_still_leaves_a_readable_trace(tmp_path: Path) -> None:

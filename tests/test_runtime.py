@@ -373,6 +373,34 @@ def test_the_python_api_refuses_a_parameter_the_system_does_not_declare() -> Non
 
 
 @pytest.mark.parametrize(
+    ("value", "fragment"),
+    [
+        ("abc", "its value is 'abc'"),
+        (1.5, "its value is 1.5"),
+        (True, "its value is True"),
+        (None, "its value is None"),
+        (10**30, "its value (a whole number of 31 digits) does not fit it"),
+    ],
+)
+def test_the_python_api_refuses_a_parameter_value_of_the_wrong_type(value: Any, fragment: str) -> None:
+    """As `--param` does (EARL-R005): `LIMIT` is an `int`, 64 bits at most."""
+    with pytest.raises(earl.EarlError) as refused:
+        earl.simulate(earl.load(SPECS / "counter"), parameters={"LIMIT": value})
+    [diagnostic] = refused.value.diagnostics
+    assert diagnostic.code == "EARL-R005" and "parameter `LIMIT` is `int` but" in diagnostic.message
+    assert fragment in diagnostic.message
+
+
+def test_a_whole_number_beyond_64_bits_is_refused_for_an_int_parameter_on_the_command_line(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    from earl.cli.main import main
+
+    assert main(["run", str(SPECS / "counter"), "--param", "LIMIT=" + "9" * 25, "--duration", "10ms"]) == 1
+    assert "EARL-R005" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
     ("time", "error"), [(float("nan"), ValueError), (float("inf"), ValueError), (2e9, ValueError), ("1s", TypeError)]
 )
 def test_advance_to_takes_a_finite_number_of_seconds(time: Any, error: type[Exception]) -> None:

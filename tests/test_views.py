@@ -315,8 +315,9 @@ def test_every_element_of_an_array_of_reals_is_tested_at_every_size(size: int) -
         (-(10**300), "uint8", "x/mo = -(a whole number of 301 digits) does not fit uint8"),
         (10**400, "double", "x/mo = (a whole number of 401 digits) is too large for a double"),
         ("y" * 10_000, "int", "not the string 'yyyy"),
+        ("/dev/tty\udcff", "string", "x/mo is not text: it holds the lone surrogate U+DCFF at index 8"),
     ],
-    ids=["uint8", "int", "int64 beyond printing", "negative uint8", "double", "long string"],
+    ids=["uint8", "int", "int64 beyond printing", "negative uint8", "double", "long string", "lone surrogate"],
 )
 def test_a_value_of_any_size_is_refused_in_a_short_message(value: Any, type_name: str, message: str) -> None:
     from earl.model.elements import System

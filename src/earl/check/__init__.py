@@ -17,6 +17,7 @@ from earl.collector import paused as collector_paused
 from earl.diagnostics import Diagnostic, Severity, did_you_mean
 from earl.model.elements import System
 from earl.model.expand import expand
+from earl.model.types import PARAMETER_TYPES, parameter_value_problem
 
 # The rule modules register themselves on import; they are listed here so that none is forgotten.
 RULE_MODULES = (rules_structure, rules_communication, rules_behaviour, fsm_analysis)
@@ -33,7 +34,7 @@ def check(system: System, parameters: Mapping[str, bool | int | float | str] | N
 
     A parameter the system does not declare is EARL-R001, as `load(path, parameters)` reports it:
     a misspelt `N` must not leave the default in place without a word."""
-    unknown = unknown_parameters(system, parameters or {})
+    unknown = unknown_parameters(system, parameters or {}) + wrong_parameter_values(system, parameters or {})
     if unknown:
         return unknown
     with collector_paused():
@@ -54,6 +55,23 @@ def unknown_parameters(system: System, parameters: Mapping[str, object]) -> list
         for name in parameters
         if name not in known
     ]
+
+
+def wrong_parameter_values(system: System, parameters: Mapping[str, object]) -> list[Diagnostic]:
+    """EARL-R005 for each value in `parameters` that its system parameter's type does not take, as
+    `load(path, parameters)` and `--param` report it (`"abc"` for an `int`, 10**30 beyond 64 bits)."""
+    declared = {p.name: getattr(p.data_type, "name", "") for p in system.parameters}
+    found = []
+    for name, value in parameters.items():
+        type_name = declared.get(name)
+        if type_name not in PARAMETER_TYPES:
+            continue  # unknown (EARL-R001), or a parameter whose own type is wrong (EARL-R003)
+        wrong = parameter_value_problem(type_name, value)
+        if wrong is not None:
+            found.append(
+                Diagnostic(Severity.ERROR, f"parameter `{name}` is `{type_name}` but {wrong}", None, "EARL-R005")
+            )
+    return found
 
 
 def check_context(context: CheckContext) -> list[Diagnostic]:

@@ -54,7 +54,11 @@ SHOWN_MESSAGE = 400
 
 def brief(text: str, limit: int = SHOWN_MESSAGE) -> str:
     """A message the spec's code wrote (an exception's text), cut for the terminal: a megabyte-long
-    message would fill the screen, and the table renderer takes time quadratic in a line's length."""
-    if len(text) <= limit:
-        return text
-    return f"{text[:limit]}… ({len(text) - limit:,} more characters; the trace has them all)"
+    message would fill the screen, and the table renderer takes time quadratic in a line's length.
+    Text that is not UTF-8 (a lone surrogate from undecodable bytes) is shown escaped, `\\udcff`."""
+    shown = (
+        text
+        if len(text) <= limit
+        else f"{text[:limit]}… ({len(text) - limit:,} more characters; the trace has them all)"
+    )
+    return shown if shown.isascii() else shown.encode("utf-8", "backslashreplace").decode("utf-8")

@@ -42,31 +42,21 @@ from earl.model.expressions import (
 from earl.model.kinds import KIND_TITLES, Kind
 from earl.model.location import SourceLocation
 from earl.model.text import reference_text
-from earl.model.types import PRIMITIVE_TYPES, ArrayType, DataType, PrimitiveType, StructType, TypeReference
+from earl.model.types import (
+    PARAMETER_TYPES,
+    PRIMITIVE_TYPES,
+    ArrayType,
+    DataType,
+    PrimitiveType,
+    StructType,
+    TypeReference,
+    parameter_value_problem,
+)
 
 Value = bool | int | float | str
 
 #: A family larger than this is almost certainly a typo (`1..1000000`), and would exhaust memory.
 MAX_FAMILY_MEMBERS = 100_000
-
-#: Parameter types and the Python values they accept.
-PARAMETER_TYPES: dict[str, tuple[type, ...]] = {
-    "boolean": (bool,),
-    "int": (int,),
-    "int8": (int,),
-    "int16": (int,),
-    "int32": (int,),
-    "int64": (int,),
-    "uint8": (int,),
-    "uint16": (int,),
-    "uint32": (int,),
-    "uint64": (int,),
-    "double": (int, float),
-    "float32": (int, float),
-    "float64": (int, float),
-    "string": (str,),
-}
-
 
 _INTEGER_TYPES = {name for name, accepted in PARAMETER_TYPES.items() if accepted == (int,)}
 
@@ -182,10 +172,10 @@ class Resolver:
                 except ConstantError as problem:
                     self.error(str(problem), problem.location or parameter.location, "EARL-R004")
                     continue
-            accepted = PARAMETER_TYPES[type_name]
-            if not isinstance(value, accepted) or (isinstance(value, bool) and bool not in accepted):
+            wrong = parameter_value_problem(type_name, value)
+            if wrong is not None:
                 self.error(
-                    f"parameter `{parameter.name}` is `{type_name}` but its value is {value!r}",
+                    f"parameter `{parameter.name}` is `{type_name}` but {wrong}",
                     parameter.value.location or parameter.location,
                     "EARL-R005",
                 )

@@ -27,6 +27,49 @@ PRIMITIVE_TYPES: tuple[str, ...] = (
     "bytes",
 )
 
+#: The whole numbers each integer type holds (`int` is 64 bits, as in the runtime and on the wire).
+INTEGER_RANGES: dict[str, tuple[int, int]] = {
+    "int8": (-(2**7), 2**7 - 1),
+    "int16": (-(2**15), 2**15 - 1),
+    "int32": (-(2**31), 2**31 - 1),
+    "int64": (-(2**63), 2**63 - 1),
+    "int": (-(2**63), 2**63 - 1),
+    "uint8": (0, 2**8 - 1),
+    "uint16": (0, 2**16 - 1),
+    "uint32": (0, 2**32 - 1),
+    "uint64": (0, 2**64 - 1),
+}
+
+#: The types a `param` may have, and the Python values each accepts (a boolean is no number here).
+PARAMETER_TYPES: dict[str, tuple[type, ...]] = {
+    "boolean": (bool,),
+    **{name: (int,) for name in INTEGER_RANGES},
+    "double": (int, float),
+    "float32": (int, float),
+    "float64": (int, float),
+    "string": (str,),
+}
+
+
+def parameter_value_problem(type_name: str, value: object) -> str | None:
+    """Why `value` cannot be a parameter of type `type_name` ("its value is 'abc'"), or None."""
+    accepted = PARAMETER_TYPES[type_name]
+    if not isinstance(value, accepted) or (isinstance(value, bool) and bool not in accepted):
+        return f"its value is {_briefly(value)}"
+    if type_name in INTEGER_RANGES:
+        assert isinstance(value, int)
+        low, high = INTEGER_RANGES[type_name]
+        if not low <= value <= high:
+            return f"its value {_briefly(value)} does not fit it ({low}..{high})"
+    return None
+
+
+def _briefly(value: object) -> str:
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value) >= 10**30:
+        return f"{'-' if value < 0 else ''}(a whole number of {len(str(abs(value))) if abs(value) < 10**4000 else 'over 4000'} digits)"
+    text = repr(value)
+    return text if len(text) <= 60 else f"{text[:50]}… ({len(text)} characters)"
+
 
 @quick_init
 @dataclass(frozen=True, slots=True)

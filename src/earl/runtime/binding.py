@@ -90,33 +90,9 @@ def resolve_callable(
                 hint='e.g. `= python "pick_and_place.manip:joint_move"`',
             )
         )
-    try:
-        module = importlib.import_module(module_name)
-    except ModuleNotFoundError as error:
-        missing = error.name or module_name
-        raise BindingProblem(
-            Diagnostic(
-                Severity.ERROR,
-                f"{what} names the module `{module_name}`, which cannot be found (no module `{missing}`)",
-                location,
-                code="EARL-X002",
-                hint="modules are looked up next to the spec file first, then on the Python path; "
-                f"create `{module_name.replace('.', '/')}.py` there",
-            )
-        ) from None
-    except Exception as error:  # the user's module failed while importing: say where, briefly
-        frame = traceback.extract_tb(error.__traceback__)[-1] if error.__traceback__ else None
-        at = f" ({frame.filename}:{frame.lineno})" if frame else ""
-        raise BindingProblem(
-            Diagnostic(
-                Severity.ERROR,
-                f"importing `{module_name}` for {what} failed: {type(error).__name__}: {error}{at}",
-                location,
-                code="EARL-X003",
-            )
-        ) from None
-    function = getattr(module, function_name, None)
-    if function is None:
+    module = _import(module_name, what, location)
+    function = getattr(module, function_name, _ABSENT)
+    if function is _ABSENT:
         available = sorted(n for n, v in vars(module).items() if callable(v) and not n.startswith("_"))
         from earl.diagnostics import did_you_mean
 
@@ -130,17 +106,92 @@ def resolve_callable(
                 hint=suggestion or f"define `{signature.replace('NAME', function_name)}` in `{module.__file__}`",
             )
         )
-    if not callable(function):
+    kind = _not_a_plain_function(function)
+    if kind is not None:
         raise BindingProblem(
             Diagnostic(
                 Severity.ERROR,
-                f"{what} names `{module_name}:{function_name}`, which is a {type(function).__name__}, not a function",
+                f"{what} names `{module_name}:{function_name}`, which is {kind}, not a function",
                 location,
-                code="EARL-X004",
+                code="EARL-X004" if not callable(function) else "EARL-X005",
+                hint=f"write it as `{signature.replace('NAME', function_name)}`: the runtime calls it and uses what "
+                "it wrote (and a predicate, what it returned) at once",
             )
         )
     _check_arity(function, arity, f"{module_name}:{function_name}", what, location, signature)
-    return function  # type: ignore[no-any-return]
+    return function  # type: ignore[return-value]
+
+
+_ABSENT = object()
+
+
+def _import(module_name: str, what: str, location: SourceLocation | None) -> Any:
+    """The module, or a BindingProblem that says why it cannot be imported."""
+    try:
+        return importlib.import_module(module_name)
+    except ModuleNotFoundError as error:
+        missing = error.name or module_name
+        if missing == module_name or module_name.startswith(missing + "."):
+            raise BindingProblem(
+                Diagnostic(
+                    Severity.ERROR,
+                    f"{what} names the module `{module_name}`, which cannot be found (no module `{missing}`)",
+                    location,
+                    code="EARL-X002",
+                    hint="modules are looked up next to the spec file first, then on the Python path; "
+                    f"create `{module_name.replace('.', '/')}.py` there",
+                )
+            ) from None
+        failure: BaseException = error  # the module is there, but something it imports is not
+    except KeyboardInterrupt:
+        raise
+    except BaseException as error:  # the user's module failed while importing, sys.exit() included
+        failure = error
+    raise BindingProblem(
+        Diagnostic(
+            Severity.ERROR,
+            f"importing `{module_name}` for {what} failed: {_import_failure(failure)}{_where(failure)}",
+            location,
+            code="EARL-X003",
+        )
+    ) from None
+
+
+def _import_failure(error: BaseException) -> str:
+    from earl.runtime.engine import exception_text
+
+    if isinstance(error, SystemExit):
+        return f"it called sys.exit({'' if error.code is None else repr(error.code)}) while being imported"
+    return exception_text(error)
+
+
+def _where(error: BaseException) -> str:
+    """` (usr.py:3)`: where in the user's files the import failed; never a frame of Python's import machinery."""
+    if isinstance(error, SyntaxError) and error.filename and error.lineno:
+        return f" ({error.filename}:{error.lineno})"
+    try:
+        frames = [f for f in traceback.extract_tb(error.__traceback__) if not f.filename.startswith("<frozen ")]
+    except Exception:  # an exception class that breaks its own traceback
+        return ""
+    return f" ({frames[-1].filename}:{frames[-1].lineno})" if frames else ""
+
+
+def _not_a_plain_function(function: object) -> str | None:
+    """What `function` is when the runtime cannot use what calling it does ("a generator function"), or None.
+
+    A coroutine or generator function returns an object and runs none of its body; a class makes an
+    instance: the writes would vanish and a predicate would always hold."""
+    if not callable(function):
+        return f"a {type(function).__name__}"
+    if inspect.isclass(function):
+        return "a class"
+    if inspect.iscoroutinefunction(function):
+        return "a coroutine function (`async def`)"
+    if inspect.isasyncgenfunction(function):
+        return "an asynchronous generator function"
+    if inspect.isgeneratorfunction(function):
+        return "a generator function (it uses `yield`)"
+    return None
 
 
 def _split(path: str) -> tuple[str, str]:
@@ -156,15 +207,16 @@ def _check_arity(
 ) -> None:
     try:
         actual = inspect.signature(function)
-    except (TypeError, ValueError):
-        return  # a builtin or C function: trust it
+    except Exception:  # a builtin or C function (or a `__signature__` that fails): trust it
+        return
     try:
         actual.bind(*range(arity))
     except TypeError:
         raise BindingProblem(
             Diagnostic(
                 Severity.ERROR,
-                f"`{name}`{actual} cannot be called as {what} needs: with {arity} arguments",
+                f"{what} calls `{name}` with {arity} arguments, but it is defined as "
+                f"`{name.rpartition(':')[2]}{actual}`",
                 location,
                 code="EARL-X005",
                 hint=f"write it as `{signature.replace('NAME', name.rpartition(':')[2])}` (see docs/runtime.md)",

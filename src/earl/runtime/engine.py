@@ -178,7 +178,7 @@ class SubsystemEngine:
 
         return first
 
-    def _function_fault(self, time: int, function: str, raised: Exception) -> None:
+    def _function_fault(self, time: int, function: str, raised: BaseException) -> None:
         error = explain(raised)
         if isinstance(error, UndeclaredAccess):
             kind = "undeclared-write" if error.write else "undeclared-read"
@@ -187,7 +187,7 @@ class SubsystemEngine:
         else:
             kind = "exception"
         trace = _user_traceback(raised)
-        self.report_fault(time, kind, f"`{function}/pf` raised {type(error).__name__}: {error}", function, trace)
+        self.report_fault(time, kind, f"`{function}/pf` raised {exception_text(error)}", function, trace)
         # Faults section of docs/semantics.md: the behaviour's error condition becomes true
         self._error_in_iteration = True
 
@@ -263,9 +263,10 @@ class SubsystemEngine:
     def _evaluate(self, time: int, predicate: CompiledPredicate, what: str) -> bool:
         try:
             return bool(predicate(self.inputs, self.new_data, self.timed_out, self.memory, self.predicates))
-        except Exception as raised:
-            error = explain(raised)
-            self.report_fault(time, "predicate", f"evaluating {what} raised {type(error).__name__}: {error}")
+        except (KeyboardInterrupt, SystemExit):
+            raise
+        except BaseException as raised:  # a Python predicate's own exception class may derive from BaseException
+            self.report_fault(time, "predicate", f"evaluating {what} raised {exception_text(explain(raised))}")
             return False
 
     def decide(self, time: int) -> None:
@@ -286,10 +287,11 @@ class SubsystemEngine:
                 terminal = behaviour.terminal_condition(
                     self.inputs, self.new_data, self.timed_out, self.memory, self.predicates
                 )
-            except Exception as raised:
-                failure = explain(raised)
+            except (KeyboardInterrupt, SystemExit):
+                raise
+            except BaseException as raised:
                 what = f"the terminal condition of `{behaviour.name}/bb`"
-                self.report_fault(time, "predicate", f"evaluating {what} raised {type(failure).__name__}: {failure}")
+                self.report_fault(time, "predicate", f"evaluating {what} raised {exception_text(explain(raised))}")
                 terminal = False
             if not terminal:
                 return
@@ -323,6 +325,16 @@ class SubsystemEngine:
         return dict(self.memory)
 
 
+def exception_text(error: BaseException) -> str:
+    """`OSError: no such device`: the class and message of an exception of the spec's code, even when its
+    `__str__` raises or returns no string (the fault must be recorded whatever the class does)."""
+    try:
+        message = str(error)
+    except BaseException:  # anything at all: this is the spec's code misbehaving
+        message = "(its message cannot be shown: its __str__ failed)"
+    return f"{type(error).__name__}: {message}"
+
+
 def _user_traceback(error: BaseException) -> str:
     """The traceback of a function's error from its own code down, without the runtime's frames.
 
@@ -330,12 +342,15 @@ def _user_traceback(error: BaseException) -> str:
     after the call returned: such an error has no frame of user code, and gets no traceback
     (its message names the function and the write).
     """
-    frames = traceback.extract_tb(error.__traceback__)
-    user = [frame for frame in frames if not _is_runtime_frame(frame.filename)]
-    if not user:
+    try:
+        frames = traceback.extract_tb(error.__traceback__)
+        user = [frame for frame in frames if not _is_runtime_frame(frame.filename)]
+        if not user:
+            return ""
+        lines = ["Traceback (most recent call last):\n", *traceback.format_list(user)]
+        return "".join(lines + traceback.format_exception_only(type(error), error))
+    except Exception:  # an exception class of the spec's code that breaks `__traceback__`: no traceback then
         return ""
-    lines = ["Traceback (most recent call last):\n", *traceback.format_list(user)]
-    return "".join(lines + traceback.format_exception_only(type(error), error))
 
 
 def _is_runtime_frame(filename: str) -> bool:

@@ -132,7 +132,11 @@ def _call(n: int, call: Call, target: str, namespace: dict[str, Any]) -> list[st
     else:
         lines += [f"        if set_{n}:", f"            refuse_{n}(next(iter(set_{n})))"]
     lines += [
-        "    except Exception as error:",
+        # any exception of the function is its fault (a BaseException subclass too), but an interruption
+        # or sys.exit() ends the run
+        "    except (KeyboardInterrupt, SystemExit):",
+        "        raise",
+        "    except BaseException as error:",
         f"        clear_{n}()",
         f"        fault(time, name_{n}, error)",
         "    else:",

@@ -109,8 +109,8 @@ def _encode(value: Any) -> bytes:
     """
     try:
         return _to_json_text(value).encode()
-    except (TypeError, ValueError):
-        return _ENCODER.encode(to_json(value)).encode()
+    except (TypeError, ValueError):  # UnicodeEncodeError too: a lone surrogate is written as JSON's `\udcff`
+        return _ENCODER.encode(to_json(value)).encode("utf-8", "backslashreplace")
 
 
 class McapSink:
@@ -386,6 +386,27 @@ class TraceWriteError(OSError):
     """The trace file could not be written (a full disk, a removed directory): the message says why."""
 
 
+#: the first bytes of every MCAP file
+MCAP_MAGIC = b"\x89MCAP0\r\n"
+
+
+def refuse_to_replace(path: Path) -> None:
+    """A trace replaces an earlier trace or an empty file, never other data: `--trace system.earl`,
+    a slip of the keyboard, must not destroy the spec."""
+    try:
+        if not path.is_file() or path.stat().st_size == 0:
+            return
+        with open(path, "rb") as existing:
+            head = existing.read(len(MCAP_MAGIC))
+    except OSError:
+        return  # what cannot be read is reported when it is written
+    if head != MCAP_MAGIC:
+        raise TraceWriteError(
+            "the file exists and is not an MCAP trace, and only an earlier trace is replaced "
+            "(choose another name, or remove the file first)"
+        )
+
+
 class BackgroundSink:
     """A McapSink in a second process (`python -m earl.runtime.trace_process FILE`), fed in batches.
 
@@ -407,6 +428,7 @@ class BackgroundSink:
 
     def __init__(self, path: Path) -> None:
         self.path = path
+        refuse_to_replace(path)
         open(path, "wb").close()  # only to fail now if the file cannot be written
         # the writer imports earl from where this process found it, installed or not
         package_root = str(Path(__file__).resolve().parents[2])
@@ -484,7 +506,13 @@ class BackgroundSink:
 
     def _send(self, finish: bool = False) -> None:
         batch = (self._channels, self._numbers, self._times, self._values, finish)
-        data = self._packer.pack(batch)
+        try:
+            data = self._packer.pack(batch)
+        except (UnicodeEncodeError, OverflowError, TypeError, ValueError):
+            # Text that is not UTF-8 (a lone surrogate in an exception's message, say) or an int beyond
+            # 64 bits, which the type checks keep out of values but not out of what the spec's code
+            # says: recorded as near as can be, rather than losing the batch and the trace with it.
+            data = msgpack.packb(_packable(batch), use_bin_type=True, default=_plain)
         self._numbers.clear()
         self._times.clear()
         self._values.clear()
@@ -572,6 +600,25 @@ PIPE_SIZE = 1 << 20
 #: the length of each batch, before it
 _LENGTH = struct.Struct("<Q")
 _clock = time.monotonic
+
+
+def _packable(value: Any) -> Any:
+    """`value` with text that UTF-8 cannot carry escaped (`\\udcff`), ints beyond 64 bits as text, and
+    what msgpack cannot pack as its `repr`."""
+    if isinstance(value, str):
+        return value.encode("utf-8", "backslashreplace").decode("utf-8")
+    if isinstance(value, bool) or value is None or isinstance(value, float):
+        return value
+    if isinstance(value, int):
+        return value if -(1 << 63) <= value < (1 << 64) else str(value)
+    if isinstance(value, dict):
+        return {_packable(key): _packable(item) for key, item in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_packable(item) for item in value]
+    if isinstance(value, bytes):
+        return value
+    plain = _plain(value)
+    return repr(value) if plain is value else _packable(plain)
 
 
 def _plain(value: Any) -> Any:

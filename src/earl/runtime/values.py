@@ -22,22 +22,20 @@ from typing import Any, NoReturn
 
 from earl.model.elements import System
 from earl.model.expressions import ListLiteral, Literal, Negate
-from earl.model.types import ArrayType, DataType, PrimitiveType, StructType, TypeAlias, TypeReference, type_text
+from earl.model.types import (
+    INTEGER_RANGES,
+    ArrayType,
+    DataType,
+    PrimitiveType,
+    StructType,
+    TypeAlias,
+    TypeReference,
+    type_text,
+)
 from earl.runtime.codegen import compiled
 
 Value = Any  # bool | int | float | str | bytes | tuple[Value, ...] | Record | None
 
-_INTEGER_RANGES: dict[str, tuple[int, int]] = {
-    "int8": (-(2**7), 2**7 - 1),
-    "int16": (-(2**15), 2**15 - 1),
-    "int32": (-(2**31), 2**31 - 1),
-    "int64": (-(2**63), 2**63 - 1),
-    "int": (-(2**63), 2**63 - 1),
-    "uint8": (0, 2**8 - 1),
-    "uint16": (0, 2**16 - 1),
-    "uint32": (0, 2**32 - 1),
-    "uint64": (0, 2**64 - 1),
-}
 _REAL_TYPES = ("double", "float32", "float64")
 _FLOAT_ONLY = frozenset({float})
 #: arrays of reals up to this size get their element types tested one by one, written out
@@ -261,8 +259,8 @@ class TypeSystem:
                 return QuickTest("real")
             if resolved.name == "boolean":
                 return QuickTest("boolean")
-            if resolved.name in _INTEGER_RANGES:
-                low, high = _INTEGER_RANGES[resolved.name]
+            if resolved.name in INTEGER_RANGES:
+                low, high = INTEGER_RANGES[resolved.name]
                 return QuickTest("integer", low, high)
         if isinstance(resolved, ArrayType) and self._holds_reals(resolved):
             return QuickTest("real_array", size=_fixed_size(resolved))
@@ -313,8 +311,8 @@ class TypeSystem:
                 test = f"type({variable}) is float and {variable} == {variable}"
             elif primitive == "boolean":
                 test = f"type({variable}) is bool"
-            elif primitive in _INTEGER_RANGES:
-                low, high = _INTEGER_RANGES[primitive]
+            elif primitive in INTEGER_RANGES:
+                low, high = INTEGER_RANGES[primitive]
                 test = f"type({variable}) is int and {low} <= {variable} <= {high}"
             else:
                 names[f"c{position}"] = self.coercer(field.data_type, f"{where}.{field.name}")
@@ -413,18 +411,26 @@ def _coerce_primitive(value: Any, name: str, where: str) -> Value:
         if math.isnan(result):
             raise ValueTypeError(f"{where} is NaN (not a number): a computation went wrong upstream")
         return result
-    if name in _INTEGER_RANGES:
+    if name in INTEGER_RANGES:
         if isinstance(value, bool) or not isinstance(value, int):
             if isinstance(value, float) and value.is_integer():
                 value = int(value)
             else:
                 raise ValueTypeError(f"{where} must be a whole number ({name}), not {_describe(value)}")
-        low, high = _INTEGER_RANGES[name]
+        low, high = INTEGER_RANGES[name]
         if not low <= value <= high:
             raise ValueTypeError(f"{where} = {_shown(value)} does not fit {name} ({low}..{high})")
         return value
     if name == "string":
         if isinstance(value, str):
+            if not value.isascii():
+                try:
+                    value.encode("utf-8")
+                except UnicodeEncodeError as error:  # a lone surrogate, from bytes decoded with "surrogateescape"
+                    raise ValueTypeError(
+                        f"{where} is not text: it holds the lone surrogate U+{ord(value[error.start]):04X} at index "
+                        f"{error.start}, which no trace or peer can carry (decode bytes with errors='replace')"
+                    ) from None
             return value
         raise ValueTypeError(f"{where} must be a string, not {_describe(value)}")
     if name == "bytes":
