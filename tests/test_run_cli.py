@@ -239,6 +239,63 @@ def test_any_exception_of_a_function_is_its_fault_and_the_run_goes_on(
     assert simulation.state_of("counter/a.display/re").iterations == 6  # everything else ran on
 
 
+PLANT = """\
+class Plant:
+    def advance(self, seconds):
+        if seconds > 0.03 and {advance}:
+            raise RuntimeError("physics diverged")
+
+    def close(self):
+        if {close}:
+            raise RuntimeError("the viewer is gone")
+
+
+def make(system, seed):
+    return Plant()
+"""
+
+
+@pytest.mark.parametrize(
+    ("advance", "close", "fragment"),
+    [
+        (True, False, "the environment's advance(0.030000) raised RuntimeError: physics diverged at 0.030 s"),
+        (False, True, "the environment's close() raised RuntimeError: the viewer is gone"),
+    ],
+)
+def test_an_environment_that_fails_ends_the_run_with_one_line_and_a_readable_trace(
+    tmp_path: Path, advance: bool, close: bool, fragment: str
+) -> None:
+    spec = counter_copy(tmp_path)
+    (spec.parent / "plant.py").write_text(PLANT.format(advance=advance, close=close))
+    (spec.parent / "run.toml").write_text('environment = "plant:make"\n')
+    trace = tmp_path / "run.mcap"
+    result = earl_cli("run", str(spec), "--duration", "100ms", "--trace", str(trace))
+    assert result.returncode == 1, result.stderr
+    assert fragment in result.stderr
+    assert "Traceback" not in result.stderr
+    assert earl_cli("trace", "summary", str(trace)).returncode == 0
+
+
+def test_a_simulation_stopped_inside_an_instant_refuses_to_go_on(tmp_path: Path) -> None:
+    """A KeyboardInterrupt raised in a function leaves its subsystem halfway through an iteration: going on
+    would silently skip the rest of it (the subsystem used to stop for good, with no word)."""
+    spec = counter_copy(tmp_path)
+    functions = spec.parent / "counting" / "cs.py"
+    functions.write_text(
+        functions.read_text().replace(
+            "    outputs.count = inputs.count + 1\n",
+            "    outputs.count = inputs.count + 1\n    if inputs.count == 1:\n        raise KeyboardInterrupt\n",
+        )
+    )
+    simulation = earl.simulate(earl.load(spec))
+    with pytest.raises(KeyboardInterrupt):
+        simulation.advance_to(0.05)
+    with pytest.raises(RuntimeError, match=r"stopped inside an instant \(KeyboardInterrupt at 0\.010000 s\)"):
+        simulation.advance_to(0.1)
+    assert simulation.state_of("counter/a.cs").state == "counting"  # what it reached can still be read
+    simulation.close()
+
+
 def test_the_checker_runs_first_and_its_errors_stop_the_run(tmp_path: Path) -> None:
     spec = counter_copy(tmp_path, "counterRobot/r {\n    counter/a\n}", "")
     marker = tmp_path / "ran"

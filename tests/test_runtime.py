@@ -3,6 +3,7 @@ snapshot isolation, refused undeclared writes, faults and recovery, FIFOs, timeo
 
 from __future__ import annotations
 
+import re
 import shutil
 from pathlib import Path
 from typing import Any
@@ -389,6 +390,28 @@ def test_the_python_api_refuses_a_parameter_value_of_the_wrong_type(value: Any, 
     [diagnostic] = refused.value.diagnostics
     assert diagnostic.code == "EARL-R005" and "parameter `LIMIT` is `int` but" in diagnostic.message
     assert fragment in diagnostic.message
+
+
+@pytest.mark.parametrize(
+    ("call", "fragment"),
+    [
+        (lambda system: earl.simulate(str(SPECS / "counter")), "a simulation runs a System, as earl.load(path)"),
+        (lambda system: earl.simulate(system, trace=5), "trace takes a file name or a binary stream, not int"),
+        (lambda system: earl.simulate(system, record_memory="counter/a.cs"), "record_memory takes a list of names"),
+        (lambda system: earl.simulate(system, agents="counter/a"), "agents takes a list of names"),
+    ],
+    ids=["path", "trace", "record_memory", "agents"],
+)
+def test_the_python_api_says_what_an_argument_takes(call: Any, fragment: str) -> None:
+    with pytest.raises(TypeError, match=re.escape(fragment)):
+        call(earl.load(SPECS / "counter"))
+
+
+def test_state_of_something_that_is_no_subsystem_name_is_a_key_error_that_says_how_they_look() -> None:
+    simulation = earl.simulate(earl.load(SPECS / "counter"))
+    with pytest.raises(KeyError, match=re.escape("subsystems are named like `counter/a.cs`")):
+        simulation.state_of(None)  # type: ignore[arg-type]
+    simulation.close()
 
 
 def test_a_whole_number_beyond_64_bits_is_refused_for_an_int_parameter_on_the_command_line(

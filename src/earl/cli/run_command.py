@@ -273,6 +273,7 @@ def _seed(text: str) -> int:
 
 
 def _execute(simulation: Any, duration: float, arguments: argparse.Namespace, report: str | None, path: Path) -> int:
+    from earl.runtime.simulation import EnvironmentFailed
     from earl.runtime.trace import TraceWriteError
 
     # markup off: what is printed includes text of the spec's code (`[/dev/ttyUSB0]` is no Rich tag)
@@ -280,6 +281,7 @@ def _execute(simulation: Any, duration: float, arguments: argparse.Namespace, re
     interrupted = False
     failed: TraceWriteError | None = None
     exited: SystemExit | None = None
+    broken: EnvironmentFailed | None = None
     from earl.cli import main as program
 
     if program.AS_PROGRAM:
@@ -297,12 +299,16 @@ def _execute(simulation: Any, duration: float, arguments: argparse.Namespace, re
         failed = error
     except SystemExit as request:  # the spec's own code called sys.exit(): the run ends there, in order
         exited = request
+    except EnvironmentFailed as error:  # the plant failed (a diverging simulation): the run ends there
+        broken = error
     finally:
         wall = time.perf_counter() - started
         try:
             simulation.close()
         except TraceWriteError as error:
             failed = failed or error
+        except EnvironmentFailed as error:
+            broken = broken or error
     if failed is not None:
         print(f"earl run: {failed} (the run reached {simulation.time:.3f} s)", file=sys.stderr)
         return EXIT_FAILED
@@ -315,6 +321,9 @@ def _execute(simulation: Any, duration: float, arguments: argparse.Namespace, re
         _plot(arguments, console)
     if report:
         _report(simulation, report, path, console)
+    if broken is not None:
+        console.print(f"earl run: {brief(str(broken))} at {simulation.time:.3f} s; the run stopped there")
+        return EXIT_FAILED
     if interrupted:
         console.print(f"earl run: interrupted at {simulation.time:.3f} s; the trace is closed")
         return EXIT_INTERRUPTED

@@ -25,6 +25,7 @@ from earl.model.elements import Duration, System
 from earl.model.expand import expand
 from earl.runtime.binding import BindingProblem, resolve_callable, user_code_path
 from earl.runtime.builder import NANOSECONDS, Network, RemoteLinks, build_network, to_nanoseconds
+from earl.runtime.engine import exception_text
 from earl.runtime.events import Fault, Recorder, Recorders, StatisticsRecorder
 from earl.runtime.scheduler import Inbox, Scheduler
 from earl.runtime.trace import TraceWriter
@@ -88,6 +89,7 @@ class Simulation:
         recorders: list[Recorder] | None = None,
         transport: Transport | None = None,
     ) -> None:
+        _refuse_wrong_arguments(system, trace, record_memory=record_memory, record_links=record_links, agents=agents)
         parameters = dict(parameters or {})
         if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
             # NumPy's seed sequences take whole numbers >= 0; anything else would fail inside the first
@@ -147,12 +149,14 @@ class Simulation:
         self.scheduler = Scheduler(
             self.network,
             self.recorder,
-            self.environment,
+            _Guarded(self.environment),
             realtime=realtime,
             record_memory=memory,
             inbox=None if transport is None else transport.inbox,
         )
         self.closed = False
+        #: why `advance_to` ended inside an instant, after which the run cannot go on
+        self._stopped_inside: str | None = None
 
     # ------------------------------------------------------------------ running
     @property
@@ -170,7 +174,19 @@ class Simulation:
             raise ValueError(
                 f"advance_to takes a finite run time of at most {Duration.MAX_SECONDS:g} s, not {seconds!r}"
             )
-        self.scheduler.advance_to(to_nanoseconds(seconds), should_stop)
+        if self._stopped_inside is not None:
+            raise RuntimeError(
+                f"this simulation stopped inside an instant ({self._stopped_inside}), so a subsystem may be "
+                "halfway through an iteration and its run cannot go on: read its state, close it, and make a new "
+                "one with earl.simulate"
+            )
+        try:
+            self.scheduler.advance_to(to_nanoseconds(seconds), should_stop)
+        except BaseException as error:
+            # Ctrl-C, sys.exit() or a failed environment can stop the run between the steps of an iteration
+            # (a function run, its writes not yet applied); going on from there would silently skip them
+            self._stopped_inside = f"{type(error).__name__} at {self.time:.6f} s"
+            raise
 
     def advance_by(self, seconds: float) -> None:
         self.advance_to(self.time + seconds)
@@ -187,7 +203,10 @@ class Simulation:
             self.trace.close(self.scheduler.now, {"faults": len(self._faults.faults), "iterations": iterations})
         close = getattr(self.environment, "close", None)
         if callable(close):
-            close()
+            try:
+                close()
+            except Exception as error:  # the trace is finished by now: say so, as a failure of the run
+                raise EnvironmentFailed(f"the environment's close() raised {exception_text(error)}") from error
         if self.transport is not None:
             self.transport.close()
 
@@ -208,11 +227,12 @@ class Simulation:
 
     def state_of(self, subsystem: str) -> SubsystemState:
         """The FSM state, behaviour, buffers and memory of `subsystem` (e.g. "manip/a.cs")."""
-        engine = self.network.by_name.get(subsystem)
+        engine = self.network.by_name.get(subsystem) if isinstance(subsystem, str) else None
         if engine is None:
             from earl.diagnostics import did_you_mean
 
-            hint = did_you_mean(subsystem, list(self.network.by_name)) or ""
+            hint = did_you_mean(subsystem, list(self.network.by_name)) if isinstance(subsystem, str) else None
+            hint = hint or f"subsystems are named like `{next(iter(self.network.by_name), 'manip/a.cs')}`"
             raise KeyError(f"no subsystem `{subsystem}` in this run. {hint}".strip())
         state = engine.state
         return SubsystemState(
@@ -246,6 +266,49 @@ def _check(system: System, parameters: Mapping[str, ParameterValue]) -> None:
 
 def _code_directories(system: System) -> list[Path]:
     return [Path(system.source_file).resolve().parent] if system.source_file else []
+
+
+def _refuse_wrong_arguments(system: object, trace: object, **lists: object) -> None:
+    """A TypeError that says what an argument takes, before anything fails deeper with Python's own words."""
+    if not isinstance(system, System):
+        raise TypeError(
+            f"a simulation runs a System, as earl.load(path) returns it, not {type(system).__name__} {system!r:.60}"
+        )
+    if trace is not None and not isinstance(trace, (str, Path)) and not callable(getattr(trace, "write", None)):
+        raise TypeError(f"trace takes a file name or a binary stream, not {type(trace).__name__}")
+    for name, value in lists.items():
+        if isinstance(value, (str, bytes)):
+            raise TypeError(f"{name} takes a list of names, e.g. [{value!r:.60}], not a single string")
+
+
+class EnvironmentFailed(RuntimeError):
+    """The environment (the simulated plant, `run.toml`'s `environment`) raised: the run cannot go on."""
+
+
+class _Guarded:
+    """The environment as the scheduler sees it: an `advance` that raises EnvironmentFailed, saying when.
+
+    One call more per advance of the plant, which steps a physics engine each time."""
+
+    def __init__(self, environment: object) -> None:
+        advance = getattr(environment, "advance", None)
+        if advance is None:
+            return
+        if not callable(advance):
+            message = f"the environment's `advance` is a {type(advance).__name__}, not a method"
+            raise EarlError([Diagnostic(Severity.ERROR, message, None, code="EARL-X020")])
+
+        def guarded(seconds: float) -> None:
+            try:
+                advance(seconds)
+            except (KeyboardInterrupt, SystemExit):
+                raise
+            except BaseException as error:  # a diverging simulation, a plant's own exception class
+                raise EnvironmentFailed(
+                    f"the environment's advance({seconds:.6f}) raised {exception_text(error)}"
+                ) from error
+
+        self.advance = guarded
 
 
 def _environment(
