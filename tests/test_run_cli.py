@@ -296,6 +296,26 @@ def test_a_simulation_stopped_inside_an_instant_refuses_to_go_on(tmp_path: Path)
     simulation.close()
 
 
+def test_modules_next_to_the_spec_named_like_earl_or_its_libraries_break_nothing(tmp_path: Path) -> None:
+    spec = counter_copy(tmp_path)
+    for name in ("earl", "msgpack", "json"):
+        (spec.parent / f"{name}.py").write_text("raise RuntimeError('imported by mistake')\n")
+    trace = spec.parent / "run.mcap"
+
+    def earl_script(*arguments: str) -> subprocess.CompletedProcess[str]:
+        # as the `earl` command runs: the current directory is not on the module path (-P)
+        command = [sys.executable, "-P", "-m", "earl.cli.main", *arguments]
+        return subprocess.run(command, capture_output=True, text=True, timeout=120, cwd=spec.parent, check=False)
+
+    result = earl_script("run", ".", "--duration", "50ms", "--trace", "run.mcap")
+    assert result.returncode == 0, result.stderr
+    assert earl_cli("trace", "summary", str(trace)).returncode == 0
+    spec.write_text(spec.read_text().replace('"counting.cs:increment"', '"earl:increment"'))
+    result = earl_script("run", ".", "--duration", "50ms")
+    assert result.returncode == 1
+    assert "EARL-X002" in result.stderr and "`earl` is also the name of a module that earl or Python" in result.stderr
+
+
 def test_the_checker_runs_first_and_its_errors_stop_the_run(tmp_path: Path) -> None:
     spec = counter_copy(tmp_path, "counterRobot/r {\n    counter/a\n}", "")
     marker = tmp_path / "ran"

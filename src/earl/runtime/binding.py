@@ -45,6 +45,7 @@ def user_code_path(directories: list[Path]) -> Iterator[None]:
     its own, so each run binds the code beside its spec.
     """
     resolved = [d.resolve() for d in directories]
+    _SHADOWING.clear()
     for directory in resolved:
         _forget_shadowed(directory)
     added = [str(d) for d in resolved if str(d) not in sys.path]
@@ -65,11 +66,31 @@ def _forget_shadowed(directory: Path) -> None:
         return
     importable = {e.name for e in entries if e.is_dir()} | {e.stem for e in entries if e.suffix == ".py"}
     for name, module in list(sys.modules.items()):
-        if name.partition(".")[0] not in importable:
+        top = name.partition(".")[0]
+        if top not in importable:
             continue
         location = getattr(module, "__file__", None)
-        if location is None or not Path(location).resolve().is_relative_to(directory):
-            del sys.modules[name]
+        if location is not None and Path(location).resolve().is_relative_to(directory):
+            continue
+        if top in sys.stdlib_module_names or top in sys.builtin_module_names or _installed(location):
+            # earl itself, a library it uses (msgpack, numpy) or Python's own: forgetting it would break the
+            # runtime; the spec's module of that name cannot be imported, which binding it then says
+            _SHADOWING[top] = directory
+            continue
+        del sys.modules[name]
+
+
+#: names of modules next to a spec that an installed module of the same name hides, and where they are
+_SHADOWING: dict[str, Path] = {}
+
+
+def _installed(location: str | None) -> bool:
+    """Whether a module's file belongs to Python's installation or environment, or to earl itself."""
+    if location is None:
+        return True  # a namespace or built-in module: nothing of a spec's
+    path = Path(location).resolve()
+    roots = {sys.prefix, sys.base_prefix, sys.exec_prefix, str(Path(__file__).resolve().parents[1])}
+    return any(path.is_relative_to(Path(root).resolve()) for root in roots)
 
 
 def resolve_callable(
@@ -127,6 +148,18 @@ _ABSENT = object()
 
 def _import(module_name: str, what: str, location: SourceLocation | None) -> Any:
     """The module, or a BindingProblem that says why it cannot be imported."""
+    top = module_name.partition(".")[0]
+    if top in _SHADOWING:
+        raise BindingProblem(
+            Diagnostic(
+                Severity.ERROR,
+                f"{what} names the module `{module_name}`, but `{top}` is also the name of a module that earl or "
+                "Python itself uses, which is imported instead",
+                location,
+                code="EARL-X002",
+                hint=f"rename `{top}` in {_SHADOWING[top]} (and the spec's `python \"{top}…\"` with it)",
+            )
+        )
     try:
         return importlib.import_module(module_name)
     except ModuleNotFoundError as error:

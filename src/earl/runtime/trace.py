@@ -434,7 +434,8 @@ class BackgroundSink:
         package_root = str(Path(__file__).resolve().parents[2])
         search_path = os.pathsep.join(p for p in (package_root, os.environ.get("PYTHONPATH", "")) if p)
         self._process = subprocess.Popen(
-            [sys.executable, "-m", "earl.runtime.trace_process", str(path)],
+            # -P: the current directory is not searched first, so that a spec's `msgpack.py` cannot stand in
+            [sys.executable, "-P", "-m", "earl.runtime.trace_process", str(path)],
             stdin=subprocess.PIPE,
             stdout=subprocess.DEVNULL,
             stderr=subprocess.PIPE,
