@@ -157,7 +157,7 @@ def _import(module_name: str, what: str, location: SourceLocation | None) -> Any
                 "Python itself uses, which is imported instead",
                 location,
                 code="EARL-X002",
-                hint=f"rename `{top}` in {_SHADOWING[top]} (and the spec's `python \"{top}…\"` with it)",
+                hint=f'rename `{top}` in {_SHADOWING[top]} (and the spec\'s `python "{top}…"` with it)',
             )
         )
     try:
