@@ -320,6 +320,133 @@ def test_launch_starts_each_process_prefixes_its_output_and_stops_them_all_on_ct
     assert "Traceback" not in output
 
 
+def _started_pids(output: str) -> list[int]:
+    return [int(line.split("(pid ")[1].split(")")[0]) for line in output.splitlines() if "] started (pid " in line]
+
+
+def _gone(pid: int, seconds: float = 10.0) -> bool:
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        try:
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            return True
+        time.sleep(0.05)
+    return False
+
+
+@pytest.mark.parametrize("stop", [signal.SIGTERM, signal.SIGHUP])
+def test_a_stop_signal_while_launch_starts_its_processes_leaves_none_running(
+    tmp_path: Path, processes: list[Process], stop: int
+) -> None:
+    deploy = deployment(tmp_path, [(["sender/a"], False), (["receiver/a"], False)])
+    launch = Process(
+        tmp_path / "launch.log", [str(PINGPONG), "--deployment", str(deploy), "--duration", "60s"], "launch"
+    )
+    processes.append(launch)
+    launch.wait_for("] started (pid ", 60)
+    launch.child.send_signal(stop)  # at once: the second process may be starting
+    assert launch.finish(30) == 130, launch.output
+    pids = _started_pids(launch.output)
+    assert pids
+    assert all(_gone(pid) for pid in pids), launch.output
+    assert "Traceback" not in launch.output
+
+
+def test_launch_whose_reader_goes_away_stops_every_process(tmp_path: Path) -> None:
+    """`earl launch … | head -1`: the output is closed, so the processes are stopped, not left to block."""
+    deploy = deployment(tmp_path, [(["sender/a"], False), (["receiver/a"], False)])
+    launch = subprocess.Popen(
+        [
+            *(sys.executable, "-m", "earl.cli.main", "launch", str(PINGPONG)),
+            "--deployment",
+            str(deploy),
+            "--duration",
+            "60s",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        stdin=subprocess.DEVNULL,
+    )
+    try:
+        assert launch.stdout is not None and launch.stderr is not None
+        first = launch.stdout.readline().decode()
+        assert "started (pid" in first
+        time.sleep(1.0)
+        launch.stdout.close()
+        assert launch.wait(timeout=30) == 1
+        assert "the output was closed; every process was stopped" in launch.stderr.read().decode()
+    finally:
+        launch.kill()
+        launch.wait()
+    assert all(_gone(pid) for pid in _started_pids(first))
+
+
+def test_a_zenoh_run_whose_output_is_closed_still_ends(tmp_path: Path) -> None:
+    """`earl run … --transport zenoh 2>&1 | true`: printing fails, and the Zenoh session must still close,
+    or its threads keep the process alive for ever."""
+    deploy = deployment(tmp_path, [(["sender/a"], False), (["receiver/a"], False)])
+    run = subprocess.Popen(
+        [
+            *(sys.executable, "-m", "earl.cli.main", "run", str(PINGPONG), "--transport", "zenoh"),
+            "--deployment",
+            str(deploy),
+            "--agents",
+            "receiver/a",
+            "--duration",
+            "1s",
+            "--wait-for-peers",
+            "1s",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        stdin=subprocess.DEVNULL,
+    )
+    assert run.stdout is not None
+    run.stdout.close()  # the reader is gone before anything is printed
+    try:
+        run.wait(timeout=40)
+    finally:
+        run.kill()
+        run.wait()
+
+
+def test_launch_checks_the_duration_and_names_processes_of_other_hosts_before_starting(tmp_path: Path) -> None:
+    deploy = deployment(tmp_path, [(["sender/a"], False), (["receiver/a"], False)])
+    result = subprocess.run(
+        [
+            *(sys.executable, "-m", "earl.cli.main", "launch", str(PINGPONG)),
+            "--deployment",
+            str(deploy),
+            "--duration",
+            "abc",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=False,
+    )
+    assert result.returncode == 2 and "--duration `abc` is not a duration" in result.stderr
+    assert "started" not in result.stdout
+    deploy.write_text(
+        deploy.read_text().replace("environment = false\n", 'environment = false\nhost = "locahost"\n', 1)
+    )
+    result = subprocess.run(
+        [
+            *(sys.executable, "-m", "earl.cli.main", "launch", str(PINGPONG)),
+            "--deployment",
+            str(deploy),
+            "--duration",
+            "1s",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
+    assert "[sender/a  ] runs on host `locahost`, not started here" in result.stdout, result.stdout
+
+
 def test_pick_and_place_split_over_two_processes_survives_a_killed_task_agent_and_completes(
     tmp_path: Path, processes: list[Process]
 ) -> None:

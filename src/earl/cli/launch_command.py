@@ -2,7 +2,8 @@
 
 Each process is `earl run SPEC --transport zenoh --agents …` for one `[[process]]` of the
 deployment file.  Their output is shown line by line, prefixed with the process's
-agents; Ctrl-C or SIGTERM stops them all (SIGTERM, a bounded wait, then SIGKILL).
+agents; Ctrl-C, SIGTERM or SIGHUP stops them all (SIGTERM, a bounded wait, then SIGKILL;
+a second Ctrl-C kills at once), and so does a reader of the output that goes away.
 A process that fails is reported and the others go on: the distributed runtime is
 built to outlive a lost peer (docs/distributed.md).
 """
@@ -10,17 +11,22 @@ built to outlive a lost peer (docs/distributed.md).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
+import select
+import shutil
 import signal
 import subprocess
 import sys
 import threading
 import time
+from collections.abc import Iterator
 from pathlib import Path
 from typing import IO, Any
 
 from earl.cli.common import UsageError, spec_path, usage_error
 from earl.cli.output import print_diagnostics
+from earl.cli.run_command import STOP_SIGNALS
 from earl.diagnostics import EarlError
 
 EXIT_OK, EXIT_FAILED, EXIT_INTERRUPTED = 0, 1, 130
@@ -90,19 +96,33 @@ def run(arguments: argparse.Namespace) -> int:
     if not local:
         print(f"earl launch: {deployment_path} has no process for this host", file=sys.stderr)
         return EXIT_FAILED
+    if arguments.duration:
+        from earl.runtime.durations import parse_duration
+
+        try:
+            parse_duration(arguments.duration)
+        except ValueError as error:
+            return usage_error(f"--duration {error}")
     common = [str(path), "--transport", "zenoh", "--deployment", str(deployment_path), "--no-progress"]
     if arguments.duration:
         common += ["--duration", arguments.duration]
     for parameter in arguments.param:
         common += ["--param", parameter]
-    supervisor = _Supervisor()
-    for process in local:
-        command = [sys.executable, "-m", "earl.cli.main", "run", *common, "--agents", process.label]
-        if not process.environment:
-            command += ["--environment", "none"]
-        command += list(process.args)
-        supervisor.start(process.label, command)
-    return supervisor.wait()
+    supervisor = _Supervisor([process.label for process in deployment.processes])
+    for process in deployment.processes:
+        if not process.is_local:
+            # said, not silent: a misspelt host would otherwise leave its agents' links stale without a word
+            supervisor.say(process.label, f"runs on host `{process.host}`, not started here")
+    with supervisor.stopping_on_signals():
+        for process in local:
+            if supervisor.stop_requested:
+                break
+            command = [sys.executable, "-m", "earl.cli.main", "run", *common, "--agents", process.label]
+            if not process.environment:
+                command += ["--environment", "none"]
+            command += list(process.args)
+            supervisor.start(process.label, command)
+        return supervisor.wait()
 
 
 def _agents(spec: Path, parameters: list[str]) -> list[str]:
@@ -117,16 +137,41 @@ def _agents(spec: Path, parameters: list[str]) -> list[str]:
 
 
 class _Supervisor:
-    """The children, the threads that copy their output, and the stop on Ctrl-C / SIGTERM."""
+    """The children, the threads that copy their output, and the stop on Ctrl-C, SIGTERM or SIGHUP.
 
-    def __init__(self) -> None:
+    The signal handlers only take note: a stop requested while a child is being started must not lose
+    that child (it runs in a session of its own, where nothing else would ever stop it). A second
+    Ctrl-C while the children finish their traces kills them at once.
+    """
+
+    def __init__(self, labels: list[str]) -> None:
         self.children: list[tuple[str, subprocess.Popen[bytes]]] = []
         self.copiers: list[threading.Thread] = []
         self.lock = threading.Lock()
-        self.width = 0
+        self.width = max((len(label) for label in labels), default=0)
+        self.signals = 0
+        #: the reader of our output went away (`earl launch … | head`): the children are stopped
+        self.output_closed = False
+
+    @property
+    def stop_requested(self) -> bool:
+        return self.signals > 0 or self.output_closed
+
+    @contextlib.contextmanager
+    def stopping_on_signals(self) -> Iterator[None]:
+        def note(*_: object) -> None:
+            self.signals += 1
+
+        previous = {number: signal.signal(number, note) for number in STOP_SIGNALS}
+        try:
+            yield
+        finally:
+            for number, handler in previous.items():
+                signal.signal(number, handler)
 
     def start(self, label: str, command: list[str]) -> None:
-        self.width = max(self.width, len(label))
+        # Rich draws the children's tables for a pipe 80 columns wide unless told otherwise
+        columns = max(100, shutil.get_terminal_size((160, 24)).columns - self.width - 3)
         child = subprocess.Popen(
             command,
             stdout=subprocess.PIPE,
@@ -134,61 +179,100 @@ class _Supervisor:
             stdin=subprocess.DEVNULL,
             # a session of its own: Ctrl-C reaches the supervisor, which stops the children in order
             start_new_session=True,
-            env={**os.environ, "PYTHONUNBUFFERED": "1"},
+            env={**os.environ, "PYTHONUNBUFFERED": "1", "COLUMNS": str(columns)},
         )
         self.children.append((label, child))
         assert child.stdout is not None
         copier = threading.Thread(target=self._copy, args=(label, child.stdout), daemon=True)
         copier.start()
         self.copiers.append(copier)
-        self._print(label, f"started (pid {child.pid}): earl {' '.join(command[3:])}")
+        self.say(label, f"started (pid {child.pid}): earl {' '.join(command[3:])}")
 
     def _copy(self, label: str, stream: IO[bytes]) -> None:
+        # read to the end even when our output is gone: a child whose pipe fills up would block for ever
         for raw in iter(stream.readline, b""):
-            self._print(label, raw.decode("utf-8", errors="replace").rstrip("\n"))
+            self.say(label, raw.decode("utf-8", errors="replace").rstrip("\n"))
 
-    def _print(self, label: str, line: str) -> None:
+    def say(self, label: str, line: str) -> None:
         with self.lock:
-            sys.stdout.write(f"[{label.ljust(self.width)}] {line}\n")
-            sys.stdout.flush()
+            if self.output_closed:
+                return
+            try:
+                sys.stdout.write(f"[{label.ljust(self.width)}] {line}\n")
+                sys.stdout.flush()
+            except (BrokenPipeError, OSError):
+                self.output_closed = True
 
     def wait(self) -> int:
-        previous = signal.getsignal(signal.SIGTERM)
-
-        def stop(*_: object) -> None:
-            raise KeyboardInterrupt
-
-        signal.signal(signal.SIGTERM, stop)
-        try:
-            while any(child.poll() is None for _, child in self.children):
-                time.sleep(0.1)
-        except KeyboardInterrupt:
+        while any(child.poll() is None for _, child in self.children) and not self.stop_requested:
+            time.sleep(0.1)
+            if _reader_gone():
+                self.output_closed = True
+        if self.stop_requested:
             self.stop_all()
             self._join()
+            if self.output_closed:
+                with contextlib.suppress(OSError):
+                    print("earl launch: the output was closed; every process was stopped", file=sys.stderr)
+                return EXIT_FAILED
             return EXIT_INTERRUPTED
-        finally:
-            signal.signal(signal.SIGTERM, previous)
         self._join()
         failed = [(label, child.returncode) for label, child in self.children if child.returncode != 0]
         for label, code in failed:
-            self._print(label, f"failed with exit code {code}")
+            self.say(label, f"failed with {_exit_status(code)}")
         return EXIT_FAILED if failed else EXIT_OK
 
     def stop_all(self) -> None:
-        """SIGTERM to each (they close their traces and exit 130), then SIGKILL after a bounded wait."""
+        """SIGTERM to each (they close their traces and exit 130), then SIGKILL after a bounded wait, or at
+        a second stop signal."""
+        signals_before = self.signals
         for label, child in self.children:
             if child.poll() is None:
-                self._print(label, "stopping")
+                self.say(label, "stopping")
                 child.send_signal(signal.SIGTERM)
         deadline = time.monotonic() + STOP_GRACE
-        for label, child in self.children:
-            try:
-                child.wait(timeout=max(0.0, deadline - time.monotonic()))
-            except subprocess.TimeoutExpired:
-                self._print(label, f"did not stop within {STOP_GRACE:g} s; killed")
-                child.kill()
-                child.wait()
+        while any(child.poll() is None for _, child in self.children):
+            if time.monotonic() >= deadline or self.signals > max(signals_before, 1):
+                late = time.monotonic() >= deadline
+                for label, child in self.children:
+                    if child.poll() is None:
+                        self.say(label, f"did not stop within {STOP_GRACE:g} s; killed" if late else "killed")
+                        _kill_session(child)
+                break
+            time.sleep(0.05)
+        for _, child in self.children:
+            child.wait()
 
     def _join(self) -> None:
         for copier in self.copiers:
             copier.join(timeout=2.0)
+
+
+def _reader_gone() -> bool:
+    """Whether our standard output is a pipe whose reader has closed it (`| head` is done): known at once,
+    not only at the next line a child prints, which may come at the end of a long run."""
+    try:
+        poller = select.poll()
+        poller.register(sys.stdout.fileno(), select.POLLOUT)
+        return any(events & (select.POLLERR | select.POLLHUP) for _, events in poller.poll(0))
+    except (OSError, ValueError, AttributeError):  # no file descriptor (a test's stream), no poll here
+        return False
+
+
+def _kill_session(child: subprocess.Popen[bytes]) -> None:
+    """SIGKILL to the child's whole session, its trace writer with it (the writer ignores SIGTERM)."""
+    try:
+        os.killpg(child.pid, signal.SIGKILL)
+    except OSError:
+        child.kill()
+
+
+def _exit_status(code: int) -> str:
+    """`exit code 1`, or `signal 9 (SIGKILL)` for a process a signal ended (Popen's negative codes)."""
+    if code >= 0:
+        return f"exit code {code}"
+    try:
+        name = signal.Signals(-code).name
+    except ValueError:
+        return f"signal {-code}"
+    return f"signal {-code} ({name})"

@@ -215,17 +215,23 @@ def run(arguments: argparse.Namespace) -> int:
         _close(transport)
         print(f"earl run: {error}", file=sys.stderr)
         return EXIT_FAILED
-    if transport is not None:
-        from earl.transport.process import wait_for_peers
+    try:
+        if transport is not None:
+            from earl.transport.process import wait_for_peers
 
-        try:
-            with _stopped_like_ctrl_c():
-                wait_for_peers(transport, arguments)
-        except KeyboardInterrupt:
-            simulation.close()  # nothing ran; the trace is still closed and readable
-            print("earl run: interrupted while waiting for the other processes", file=sys.stderr)
-            return EXIT_INTERRUPTED
-    return _execute(simulation, duration, arguments, None if no_environment else settings.report, path)
+            try:
+                with _stopped_like_ctrl_c():
+                    wait_for_peers(transport, arguments)
+            except KeyboardInterrupt:
+                simulation.close()  # nothing ran; the trace is still closed and readable
+                print("earl run: interrupted while waiting for the other processes", file=sys.stderr)
+                return EXIT_INTERRUPTED
+        return _execute(simulation, duration, arguments, None if no_environment else settings.report, path)
+    finally:
+        # Closed already, unless printing failed (a reader that went away: `earl run … | head`); an open
+        # Zenoh session's threads would keep the process from ever ending.
+        with contextlib.suppress(Exception):
+            simulation.close()
 
 
 #: signals that end a run as Ctrl-C does: `kill`, `timeout`, a service manager, a closed terminal

@@ -198,17 +198,23 @@ class Simulation:
         self.closed = True
         self.scheduler.close()
         self.statistics.close(self.scheduler.now)
-        if self.trace is not None:
-            iterations = {engine.name: engine.total_iterations for engine in self.network.engines}
-            self.trace.close(self.scheduler.now, {"faults": len(self._faults.faults), "iterations": iterations})
-        close = getattr(self.environment, "close", None)
-        if callable(close):
+        # each part closes even when one before it fails (a full disk, a plant's own error): an open Zenoh
+        # session would keep the process from ending
+        try:
+            if self.trace is not None:
+                iterations = {engine.name: engine.total_iterations for engine in self.network.engines}
+                self.trace.close(self.scheduler.now, {"faults": len(self._faults.faults), "iterations": iterations})
+        finally:
             try:
-                close()
-            except Exception as error:  # the trace is finished by now: say so, as a failure of the run
-                raise EnvironmentFailed(f"the environment's close() raised {exception_text(error)}") from error
-        if self.transport is not None:
-            self.transport.close()
+                close = getattr(self.environment, "close", None)
+                if callable(close):
+                    try:
+                        close()
+                    except Exception as error:  # the trace is finished by now: a failure of the run
+                        raise EnvironmentFailed(f"the environment's close() raised {exception_text(error)}") from error
+            finally:
+                if self.transport is not None:
+                    self.transport.close()
 
     def __enter__(self) -> Simulation:
         return self

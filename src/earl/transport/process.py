@@ -7,6 +7,7 @@ transport before the network is built (docs/distributed.md, "Running by hand").
 from __future__ import annotations
 
 import argparse
+import contextlib
 import sys
 from collections.abc import Mapping
 from pathlib import Path
@@ -24,7 +25,10 @@ SWITCH_INTERVAL = 0.0005
 
 
 def log(line: str) -> None:
-    print(line, file=sys.stderr, flush=True)
+    """A line about the links on standard error; dropped when nobody reads it any more (`2>&1 | head`),
+    since it is also called on Zenoh's threads, where a failure would leave the session open for ever."""
+    with contextlib.suppress(OSError):  # BrokenPipeError is one
+        print(line, file=sys.stderr, flush=True)
 
 
 def open_transport(
