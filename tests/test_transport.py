@@ -31,6 +31,7 @@ from earl.transport.deployment import DeploymentError, read_deployment
 from earl.transport.inbox import Inbox
 from earl.transport.keys import alive_key, escape, link_key, unescape
 
+BAD_PORT = Path(__file__).parent / "distributed_specs" / "bad_port.json5"
 PINGPONG = Path(__file__).parent / "distributed_specs" / "pingpong"
 PICK_AND_PLACE = Path(__file__).parent.parent / "examples" / "pick_and_place"
 
@@ -148,8 +149,16 @@ def test_the_examples_deployment_puts_every_agent_in_one_process() -> None:
         ),
         (
             "[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:1'\n[[process]]\nagents = ['b']\nlisten = 'tcp/127.0.0.1:1'\n",
-            "already process 1's endpoint",
+            "the same endpoint as process 1's",
         ),
+        (
+            "[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:7'\n[[process]]\nagents = ['b']\nlisten = 'tcp/localhost:7'\n",
+            "`tcp/localhost:7` is the same endpoint as process 1's",
+        ),
+        ("[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:notaport'\n", "`notaport` is not a port"),
+        ("[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:99999'\n", "`99999` is not a port"),
+        ("[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1'\n", "write it as tcp/HOST:PORT"),
+        ("[[process]]\nagents = ['a', 'a/a']\nlisten = 'tcp/127.0.0.1:1'\n", "`a/a` is listed twice"),
         ("[[process]\n", "not valid TOML"),
         ("mode = 'peer'\n", "unknown setting `mode`"),
     ],
@@ -368,6 +377,12 @@ def test_the_inbox_wakes_its_sleeper_and_hands_over_in_arrival_order() -> None:
         (["--transport", "zenoh", "--agents", "sender/a", "--wait-for-peers", "soon"], "is not a duration"),
         (["--transport", "zenoh", "--agents", "sender/a", "--zenoh-config", "/no/such.json5"], "no such file"),
         (["--transport", "zenoh", "--agents", "sender/a", "--zenoh-config", __file__], "cannot use the Zenoh"),
+        (["--transport", "zenoh", "--agents", "sender/a", "--zenoh-config", "/tmp"], "a directory, not a file"),
+        (["--transport", "zenoh", "--agents", "sender/b"], "`sender/b` is not an agent of this system"),
+        (
+            ["--transport", "zenoh", "--agents", "sender/a", "--zenoh-config", str(BAD_PORT)],
+            "Zenoh could not start: ",
+        ),
     ],
 )
 def test_distributed_usage_errors_exit_2_with_one_line(
@@ -378,6 +393,7 @@ def test_distributed_usage_errors_exit_2_with_one_line(
     assert main(["run", str(PINGPONG), *arguments]) == 2
     error = capsys.readouterr().err
     assert fragment in error and "Traceback" not in error
+    assert ".rs:" not in error  # Zenoh's Rust source lines are of no use to the reader
 
 
 def test_a_deployment_that_does_not_cover_the_system_stops_earl_run(
@@ -598,6 +614,20 @@ def test_what_fails_while_serving_is_raised_in_the_scheduler_thread(tmp_path: Pa
     with pytest.raises(OSError, match="the disk is full"):
         simulation.advance_to(simulation.time + 0.05)
     simulation.close()
+
+
+def test_zenohs_messages_are_given_in_plain_words() -> None:
+    from earl.transport.zenoh_transport import zenoh_reason
+
+    raw = (
+        "Can not create a new TCP listener bound to tcp/127.0.0.1:7451: [Address already in use (os error 98) "
+        "at /root/.cargo/git/checkouts/zenoh-1/io/tcp.rs:61.] at /root/.cargo/git/checkouts/zenoh-1/unicast.rs:338."
+    )
+    assert zenoh_reason(RuntimeError(raw)) == (
+        "Can not create a new TCP listener bound to tcp/127.0.0.1:7451: Address already in use (os error 98)"
+    )
+    json = 'JSON error: Message { msg: "unknown variant `bogus`, expected `peer`", location: Some(Location { line: 1, column: 9 }) }'
+    assert zenoh_reason(RuntimeError(json)) == "JSON error: unknown variant `bogus`, expected `peer` (line 1, column 9)"
 
 
 def test_a_zenoh_configuration_zenoh_refuses_is_explained_without_rust_source_lines(tmp_path: Path) -> None:

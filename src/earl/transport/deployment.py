@@ -85,9 +85,39 @@ class Deployment:
 
 
 def normalise_agent(name: str) -> str:
-    """`task` and `task/a` both name the agent `task/a`."""
+    """`task` and `task/a` both name the agent `task/a`; a name with another `/` part stays as written,
+    so that the message refusing it shows what was written (`sender/b`, not `sender/b/a`)."""
     name = name.strip()
-    return name if name.endswith("/a") else f"{name}/a"
+    return name if "/" in name else f"{name}/a"
+
+
+#: protocols whose endpoints are `PROTOCOL/HOST:PORT`
+_NETWORK_PROTOCOLS = frozenset({"tcp", "udp", "tls", "quic", "ws"})
+
+
+def endpoint_problem(endpoint: str) -> str | None:
+    """What is wrong with a `listen` endpoint of the network protocols, checked before anything starts
+    (Zenoh would say it only as the process opens, in its own words); None when it looks right."""
+    protocol, _, address = endpoint.partition("/")
+    if protocol not in _NETWORK_PROTOCOLS:
+        return None  # unixsock-stream/…, serial/…: Zenoh's own to check
+    address = address.split("#", 1)[0].split("?", 1)[0]  # Zenoh's endpoint metadata and configuration
+    host, colon, port = address.rpartition(":")
+    if not colon or not host:
+        return f"write it as {protocol}/HOST:PORT, e.g. {protocol}/127.0.0.1:7451"
+    if not port.isdigit() or not 1 <= int(port) <= 65535:
+        return f"`{port}` is not a port (a whole number from 1 to 65535)"
+    return None
+
+
+def _endpoint_key(endpoint: str) -> tuple[str, str, str]:
+    """An endpoint as a listener sees it: `localhost`, `127.0.0.1` and `[::1]` are the same host."""
+    protocol, _, address = endpoint.partition("/")
+    host, _, port = address.split("#", 1)[0].split("?", 1)[0].rpartition(":")
+    host = host.strip("[]")
+    if host in LOCAL_HOSTS or host in {"0.0.0.0", "::"}:
+        host = "this host"
+    return (protocol, host, port) if port else (protocol, address, "")
 
 
 def read_deployment(path: Path) -> Deployment:
@@ -109,9 +139,10 @@ def read_deployment(path: Path) -> Deployment:
         raise DeploymentError(f"{path}: no `[[process]]` table; each names its `agents` and `listen` endpoint")
     processes: list[ProcessGroup] = []
     seen_agents: dict[str, int] = {}
-    seen_endpoints: dict[str, int] = {}
+    seen_endpoints: dict[tuple[str, str, str], int] = {}
     for number, table in enumerate(tables, start=1):
         where = f"{path}: process {number}"
+        listed: set[str] = set()
         if not isinstance(table, dict):
             raise DeploymentError(f"{where} is not a table")
         extra = sorted(set(table) - {"agents", "listen", "environment", "host", "args"})
@@ -122,15 +153,24 @@ def read_deployment(path: Path) -> Deployment:
             raise DeploymentError(f'{where}: `agents` must be a list of agent names, e.g. ["manip/a", "grip/a"]')
         names = tuple(normalise_agent(a) for a in agents)
         for agent in names:
+            if agent in listed:
+                raise DeploymentError(f"{where}: `{agent}` is listed twice in its `agents`")
             if agent in seen_agents:
                 raise DeploymentError(f"{where}: `{agent}` already runs in process {seen_agents[agent]}")
+            listed.add(agent)
             seen_agents[agent] = number
         listen = table.get("listen")
         if not isinstance(listen, str) or "/" not in listen:
             raise DeploymentError(f'{where}: `listen` must be a Zenoh endpoint such as "tcp/127.0.0.1:7451"')
-        if listen in seen_endpoints:
-            raise DeploymentError(f"{where}: `{listen}` is already process {seen_endpoints[listen]}'s endpoint")
-        seen_endpoints[listen] = number
+        problem = endpoint_problem(listen)
+        if problem is not None:
+            raise DeploymentError(f"{where}: `listen = {listen!r}`: {problem}")
+        key = _endpoint_key(listen)
+        if key in seen_endpoints:
+            raise DeploymentError(
+                f"{where}: `{listen}` is the same endpoint as process {seen_endpoints[key]}'s; give each its own port"
+            )
+        seen_endpoints[key] = number
         environment = table.get("environment", True)
         host = table.get("host", "localhost")
         args = table.get("args", [])

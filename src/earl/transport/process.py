@@ -40,7 +40,8 @@ def open_transport(
     if arguments.zenoh_config:
         config_path = Path(arguments.zenoh_config)
         if not config_path.is_file():
-            raise ValueError(f"--zenoh-config: no such file: {config_path}")
+            kind = "a directory, not a file" if config_path.is_dir() else "no such file"
+            raise ValueError(f"--zenoh-config: {kind}: {config_path}")
         try:
             config = config_from_file(config_path)
         except TransportError as error:
@@ -65,7 +66,12 @@ def open_transport(
     # Zenoh's callbacks need the GIL: while the scheduler runs Python, a message would wait up
     # to the interpreter's switch interval (5 ms) to be taken; 0.5 ms bounds that delay
     sys.setswitchinterval(SWITCH_INTERVAL)
-    transport = ZenohTransport(system.name, names, config, log)
+    try:
+        transport = ZenohTransport(system.name, names, config, log)
+    except TransportError as error:
+        if arguments.zenoh_config:  # the user's own file, which Zenoh refuses: a usage error (exit 2)
+            raise ValueError(f"{error} (with {where})") from None
+        raise TransportError(f"{error} ({where}, as {path} says)") from None
     log(f"earl run: {', '.join(names)} over Zenoh ({where})")
     return names, transport
 

@@ -59,8 +59,22 @@ def default_config(listen: list[str], connect: list[str]) -> zenoh.Config:
             ),
         )
     except Exception as error:  # zenoh reports a bad endpoint as a plain exception
-        raise TransportError(f"the Zenoh endpoints {listen + connect} are not valid: {error}") from None
+        raise TransportError(f"the Zenoh endpoints {listen + connect} are not valid: {zenoh_reason(error)}") from None
     return config
+
+
+def zenoh_reason(error: BaseException) -> str:
+    """Zenoh's message for a reader: without the Rust source lines it names (`at …/tcp.rs:61.`), of no
+    use to them, and with a JSON5 error's own words and place instead of Rust's debug form."""
+    text = re.sub(r"\s*at \S+\.rs:\d+\.?", "", str(error))
+    text = re.sub(
+        r'Message \{ msg: "(.*?)", location: Some\(Location \{ line: (\d+), column: (\d+) \}\) \}',
+        r"\1 (line \2, column \3)",
+        text,
+    )
+    text = re.sub(r'Message \{ msg: "(.*?)", location: None \}', r"\1", text)
+    text = re.sub(r": \[(.*)\]$", r": \1", text.strip().rstrip(".").strip())  # Zenoh's nesting of causes
+    return text or type(error).__name__
 
 
 def config_from_file(path: Path) -> zenoh.Config:
@@ -68,9 +82,7 @@ def config_from_file(path: Path) -> zenoh.Config:
     try:
         return zenoh.Config.from_file(str(path))
     except Exception as error:
-        # Zenoh's messages end with the Rust source line that raised them: of no use to the reader
-        reason = re.sub(r"\s+at \S+\.rs:\d+\.?\s*$", "", str(error))
-        raise TransportError(f"cannot use the Zenoh configuration {path}: {reason}") from None
+        raise TransportError(f"cannot use the Zenoh configuration {path}: {zenoh_reason(error)}") from None
 
 
 @dataclass
@@ -209,7 +221,7 @@ class ZenohTransport:
         try:
             self.session = zenoh.open(config)
         except Exception as error:
-            raise TransportError(f"Zenoh could not start: {error}") from None
+            raise TransportError(f"Zenoh could not start: {zenoh_reason(error)}") from None
         self._declared.append(self.session.declare_queryable(f"earl/{escape(system)}/types/*", self._answer_type_query))
         self._declared.append(
             self.session.liveliness().declare_subscriber(alive_prefix(system) + "*", self._on_liveliness, history=True)
