@@ -294,6 +294,27 @@ def test_malformed_bytes_injected_on_a_link_key_are_counted_and_dropped(
     assert "Traceback" not in output
 
 
+def test_a_peer_that_finishes_its_run_is_no_fault_but_one_killed_is(tmp_path: Path, processes: list[Process]) -> None:
+    deploy = deployment(tmp_path, [(["sender/a"], False), (["receiver/a"], False)])
+    common = [str(PINGPONG), "--transport", "zenoh", "--deployment", str(deploy)]
+    receiver = run(
+        processes,
+        tmp_path / "receiver.log",
+        [*common, "--agents", "receiver/a", "--duration", "6s", "--trace", str(tmp_path / "r.mcap")],
+    )
+    sender = run(processes, tmp_path / "sender.log", [*common, "--agents", "sender/a", "--duration", "2s"])
+    assert sender.finish(60) == 0, sender.output
+    receiver.wait_for("sender/a finished its run: ", 30)
+    again = run(processes, tmp_path / "again.log", [*common, "--agents", "sender/a", "--duration", "60s"])
+    back = receiver.wait_for("sender/a is alive: receiver/a.cs ", 30)
+    time.sleep(0.5)
+    os.kill(again.child.pid, signal.SIGKILL)
+    receiver.wait_for("sender/a disappeared", 30, after=back)
+    assert receiver.finish(60) == 0, receiver.output
+    faults = [data for topic, _, data in trace(tmp_path / "r.mcap") if topic == "/earl/faults"]
+    assert [f["kind"] for f in faults if f["kind"] == "stale"] == ["stale"], faults  # the kill alone
+
+
 def test_launch_starts_each_process_prefixes_its_output_and_stops_them_all_on_ctrl_c(
     tmp_path: Path, processes: list[Process]
 ) -> None:

@@ -39,6 +39,15 @@ def alive_prefix(system: str) -> str:
     return f"earl/{escape(system)}/alive/"
 
 
+def finished_key(system: str, agent: str) -> str:
+    """Where a process says, as it closes in order, that its agent has finished (not crashed)."""
+    return f"earl/{escape(system)}/finished/{escape(agent)}"
+
+
+def finished_prefix(system: str) -> str:
+    return f"earl/{escape(system)}/finished/"
+
+
 def type_key(system: str, fingerprint: bytes) -> str:
     return f"earl/{escape(system)}/types/{fingerprint.hex()}"
 

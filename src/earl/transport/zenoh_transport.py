@@ -33,11 +33,24 @@ from earl.runtime.engine import SubsystemEngine
 from earl.runtime.values import TypeSystem
 from earl.transport.codec import FingerprintMismatch, LinkCodec, MalformedMessage
 from earl.transport.inbox import Inbox
-from earl.transport.keys import alive_key, alive_prefix, escape, link_key, type_key, unescape
+from earl.transport.keys import (
+    alive_key,
+    alive_prefix,
+    escape,
+    finished_key,
+    finished_prefix,
+    link_key,
+    type_key,
+    unescape,
+)
 
 #: how long a restarted peer waits between attempts to reach the others (ms): restarts resume quickly
 RETRY_INITIAL_MS = 100
 RETRY_MAX_MS = 1000
+
+
+#: seconds between saying an agent finished and withdrawing its liveliness token, as a run closes
+FINISHED_LEAD = 0.05
 
 
 class TransportError(RuntimeError):
@@ -226,6 +239,9 @@ class ZenohTransport:
         self._declared.append(
             self.session.liveliness().declare_subscriber(alive_prefix(system) + "*", self._on_liveliness, history=True)
         )
+        #: peers that said they finished (closed in order): their going is no fault
+        self._finished: set[str] = set()
+        self._declared.append(self.session.declare_subscriber(finished_prefix(system) + "*", self._on_finished))
 
     # ---------------------------------------------------------------- building (RemoteLinks)
     def outgoing(
@@ -286,6 +302,11 @@ class ZenohTransport:
                     return sorted(missing)
                 self._alive_changed.wait(min(remaining, 0.5))
 
+    def _on_finished(self, sample: zenoh.Sample) -> None:
+        """On Zenoh's thread: a peer agent is about to go because its run ended in order."""
+        with self._alive_changed:
+            self._finished.add(unescape(str(sample.key_expr).rsplit("/", 1)[-1]))
+
     def _on_liveliness(self, sample: zenoh.Sample) -> None:
         """On Zenoh's thread: a peer agent appeared or disappeared."""
         agent = unescape(str(sample.key_expr).rsplit("/", 1)[-1])
@@ -293,6 +314,7 @@ class ZenohTransport:
         with self._alive_changed:
             if alive:
                 self._alive.add(agent)
+                self._finished.discard(agent)  # back (restarted): a later loss is news again
             else:
                 self._alive.discard(agent)
             self._alive_changed.notify_all()
@@ -317,6 +339,11 @@ class ZenohTransport:
                 self.log(f"earl run: {agent} is alive: {name} {listed} receive {again}from it")
             else:
                 engine.stale.update(remote.buffer for remote in remotes)
+                with self._alive_changed:
+                    finished = agent in self._finished
+                if finished:  # its run ended in order: no fault, though nothing more comes
+                    self.log(f"earl run: {name}: {agent} finished its run: {listed} receive nothing more (stale)")
+                    continue
                 message = (
                     f"{agent} disappeared: {listed} are stale (newData false, stale and timeout true) until it returns"
                 )
@@ -359,6 +386,13 @@ class ZenohTransport:
 
     # ---------------------------------------------------------------- the end
     def close(self) -> None:
+        if self._tokens:
+            # said before the liveliness tokens go, and given a moment to arrive first (declarations and
+            # data may travel at different priorities): the peers then know this is an end, not a crash
+            for agent in self.local_agents:
+                with contextlib.suppress(Exception):
+                    self.session.put(finished_key(self.system, agent), b"")
+            wall.sleep(FINISHED_LEAD)
         for token in self._tokens:
             with contextlib.suppress(Exception):  # already gone with the session
                 token.undeclare()  # type: ignore[no-untyped-call]
