@@ -231,6 +231,8 @@ class ZenohTransport:
         self._declared: list[Any] = []
         self._tokens: list[zenoh.LivelinessToken] = []
         self._types: TypeSystem | None = None
+        #: peers that said they finished (closed in order): their going is no fault
+        self._finished: set[str] = set()
         try:
             self.session = zenoh.open(config)
         except Exception as error:
@@ -239,8 +241,6 @@ class ZenohTransport:
         self._declared.append(
             self.session.liveliness().declare_subscriber(alive_prefix(system) + "*", self._on_liveliness, history=True)
         )
-        #: peers that said they finished (closed in order): their going is no fault
-        self._finished: set[str] = set()
         self._declared.append(self.session.declare_subscriber(finished_prefix(system) + "*", self._on_finished))
 
     # ---------------------------------------------------------------- building (RemoteLinks)
