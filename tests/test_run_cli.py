@@ -316,6 +316,21 @@ def test_modules_next_to_the_spec_named_like_earl_or_its_libraries_break_nothing
     assert "EARL-X002" in result.stderr and "`earl` is also the name of a module that earl or Python" in result.stderr
 
 
+def test_a_thread_the_specs_code_leaves_running_does_not_keep_earl_run_alive(tmp_path: Path) -> None:
+    spec = counter_copy(tmp_path)
+    functions = spec.parent / "counting" / "cs.py"
+    functions.write_text(
+        "import threading, time\n\nthreading.Thread(target=time.sleep, args=(3600,), name='poller').start()\n\n"
+        + functions.read_text()
+    )
+    started = time.monotonic()
+    result = earl_cli("run", str(spec), "--duration", "50ms")
+    assert result.returncode == 0, result.stderr
+    assert time.monotonic() - started < 60
+    assert "threads still running at the end (poller) are stopped with the program" in result.stderr
+    assert "counter/a.cs" in result.stdout  # the summary came out before the end
+
+
 def test_the_checker_runs_first_and_its_errors_stop_the_run(tmp_path: Path) -> None:
     spec = counter_copy(tmp_path, "counterRobot/r {\n    counter/a\n}", "")
     marker = tmp_path / "ran"

@@ -9,6 +9,7 @@ Exit codes (documented in README and docs/cli.md):
 from __future__ import annotations
 
 import argparse
+import contextlib
 import gc
 import importlib
 import sys
@@ -136,9 +137,37 @@ def script() -> int:
     AS_PROGRAM = True
     collector.FREEZE_ON_RESUME = True  # what a command builds lives until the process ends
     code = main()
+    _end_lingering_threads(code)
     gc.collect()
     gc.freeze()
     return code
+
+
+#: seconds threads left running by the spec's code get to end before the program ends without them
+THREAD_GRACE = 2.0
+
+
+def _end_lingering_threads(code: int) -> None:
+    """A thread that the spec's code started and never ended (not a daemon) would keep the program
+    from ever exiting once the command is done; it gets a moment, then the program ends without it."""
+    import os
+    import threading
+    import time
+
+    deadline = time.monotonic() + THREAD_GRACE
+    lingering = [t for t in threading.enumerate() if t is not threading.main_thread() and not t.daemon]
+    for thread in lingering:
+        thread.join(max(0.0, deadline - time.monotonic()))
+    alive = [t.name for t in lingering if t.is_alive()]
+    if not alive:
+        return
+    with contextlib.suppress(OSError):
+        sys.stderr.write(f"earl: threads still running at the end ({', '.join(alive)}) are stopped with the program\n")
+    with contextlib.suppress(OSError):
+        sys.stdout.flush()
+    with contextlib.suppress(OSError):
+        sys.stderr.flush()
+    os._exit(code)
 
 
 if __name__ == "__main__":  # pragma: no cover
