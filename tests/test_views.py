@@ -329,3 +329,14 @@ def test_a_value_of_any_size_is_refused_in_a_short_message(value: Any, type_name
         coerce(value)
     assert message in str(refused.value)
     assert len(str(refused.value)) < 200
+
+
+def test_an_array_of_reals_the_specs_code_makes_from_the_runtimes_own_class_is_checked() -> None:
+    """`type(inputs.position)(…)` makes the runtime's class of checked arrays: its elements are checked too,
+    so that NaN cannot pass as an array the runtime checked before."""
+    from earl.runtime.values import Reals, ValueTypeError
+
+    assert Reals([1, 2.5]) == (1.0, 2.5) and type(Reals([1])[0]) is float
+    for wrong in ([1.0, float("nan")], ["a"], [True], [None]):
+        with pytest.raises(ValueTypeError):
+            Reals(wrong)

@@ -23,7 +23,7 @@ from typing import Any
 import msgpack  # type: ignore[import-untyped]
 
 from earl.model.types import ArrayType, DataType, PrimitiveType, StructType
-from earl.runtime.values import Reals, TypeSystem, ValueTypeError
+from earl.runtime.values import Reals, TypeSystem, ValueTypeError, new_tuple
 
 FINGERPRINT_SIZE = 8
 #: the msgpack ext type of an array of reals: its data is the elements as little-endian float64
@@ -153,9 +153,9 @@ class _FixedReals:
         # two memchr calls prove it without looking at the floats
         top = payload[start + 7 :: 8]
         if b"\x7f" not in top and b"\xff" not in top:
-            return Reals(values)
+            return new_tuple(Reals, values)
         total = sum(values)
-        return Reals(values) if total == total else None
+        return new_tuple(Reals, values) if total == total else None
 
 
 def _fixed_reals(types: TypeSystem, data_type: DataType, fingerprint: bytes) -> _FixedReals | None:
