@@ -379,6 +379,7 @@ def test_the_inbox_wakes_its_sleeper_and_hands_over_in_arrival_order() -> None:
         (["--transport", "zenoh", "--agents", "sender/a", "--zenoh-config", __file__], "cannot use the Zenoh"),
         (["--transport", "zenoh", "--agents", "sender/a", "--zenoh-config", "/tmp"], "a directory, not a file"),
         (["--transport", "zenoh", "--agents", "sender/b"], "`sender/b` is not an agent of this system"),
+        (["--agents", "sender,sender/a"], "`sender/a` is named twice"),
         (
             ["--transport", "zenoh", "--agents", "sender/a", "--zenoh-config", str(BAD_PORT)],
             "Zenoh could not start: ",

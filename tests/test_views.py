@@ -340,3 +340,15 @@ def test_an_array_of_reals_the_specs_code_makes_from_the_runtimes_own_class_is_c
     for wrong in ([1.0, float("nan")], ["a"], [True], [None]):
         with pytest.raises(ValueTypeError):
             Reals(wrong)
+
+
+def test_a_null_leaf_of_a_trace_is_a_gap_in_a_plot_not_a_missing_signal() -> None:
+    """JSON writes an infinite real as null; the plot shows a gap there instead of saying the signal is not
+    in the trace."""
+    import math
+
+    from earl.runtime.values import iter_leaves
+
+    leaves = list(iter_leaves({"position": [1.0, None], "stop": False}))
+    assert [name for name, _ in leaves] == ["position[0]", "position[1]", "stop"]
+    assert leaves[0][1] == 1.0 and math.isnan(leaves[1][1]) and leaves[2][1] is False

@@ -78,6 +78,8 @@ def run(arguments: argparse.Namespace) -> int:
     except UsageError as error:
         return usage_error(str(error))
     deployment_path = Path(arguments.deployment) if arguments.deployment else path.parent / DEPLOYMENT_FILE
+    if deployment_path.is_dir():
+        return usage_error(f"the deployment {deployment_path} is a directory; name its file, e.g. {DEPLOYMENT_FILE}")
     if not deployment_path.is_file():
         return usage_error(f"no deployment file {deployment_path}; name one with --deployment (docs/distributed.md)")
     try:

@@ -504,8 +504,13 @@ def json_schema(types: TypeSystem, data_type: DataType) -> dict[str, Any]:
 
 
 def iter_leaves(value: Value, prefix: str = "") -> Iterator[tuple[str, Any]]:
-    """(path, number) for every numeric or Boolean leaf: `position[0]`, `pose.x` — for plots."""
-    if isinstance(value, dict):
+    """(path, number) for every numeric or Boolean leaf: `position[0]`, `pose.x` — for plots.
+
+    A null leaf of a trace (an infinite value, which JSON cannot write, or an absent optional
+    field) is NaN: a gap in the plot, not a signal that seems never to have been recorded."""
+    if value is None:
+        yield prefix, math.nan
+    elif isinstance(value, dict):
         for key, inner in value.items():
             yield from iter_leaves(inner, f"{prefix}.{key}" if prefix else key)
     elif isinstance(value, (list, tuple)):

@@ -80,9 +80,11 @@ def agents_of(system: System, parameters: Mapping[str, Any], agents: list[str]) 
     """`--agents` normalised (`task` is `task/a`); `ValueError` naming one that the system does not have."""
     known = [agent_name(agent) for agent in expand(system, dict(parameters)).agents]
     names = [normalise_agent(a) for a in agents]
-    for name in names:
+    for position, name in enumerate(names):
         if name not in known:
             raise ValueError(f"--agents: `{name}` is not an agent of this system (its agents: {', '.join(known)})")
+        if name in names[:position]:
+            raise ValueError(f"--agents: `{name}` is named twice")
     return names
 
 
