@@ -374,17 +374,17 @@ def test_a_stop_signal_while_launch_starts_its_processes_leaves_none_running(
     assert "Traceback" not in launch.output
 
 
+def launch_command(deploy: Path, duration: str) -> list[str]:
+    """`earl launch` of the ping-pong spec over `deploy`, each process running `duration`."""
+    program = [sys.executable, "-m", "earl.cli.main", "launch"]
+    return [*program, str(PINGPONG), "--deployment", str(deploy), "--duration", duration]
+
+
 def test_launch_whose_reader_goes_away_stops_every_process(tmp_path: Path) -> None:
     """`earl launch … | head -1`: the output is closed, so the processes are stopped, not left to block."""
     deploy = deployment(tmp_path, [(["sender/a"], False), (["receiver/a"], False)])
     launch = subprocess.Popen(
-        [
-            *(sys.executable, "-m", "earl.cli.main", "launch", str(PINGPONG)),
-            "--deployment",
-            str(deploy),
-            "--duration",
-            "60s",
-        ],
+        launch_command(deploy, "60s"),
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         stdin=subprocess.DEVNULL,
@@ -435,13 +435,7 @@ def test_a_zenoh_run_whose_output_is_closed_still_ends(tmp_path: Path) -> None:
 def test_launch_checks_the_duration_and_names_processes_of_other_hosts_before_starting(tmp_path: Path) -> None:
     deploy = deployment(tmp_path, [(["sender/a"], False), (["receiver/a"], False)])
     result = subprocess.run(
-        [
-            *(sys.executable, "-m", "earl.cli.main", "launch", str(PINGPONG)),
-            "--deployment",
-            str(deploy),
-            "--duration",
-            "abc",
-        ],
+        launch_command(deploy, "abc"),
         capture_output=True,
         text=True,
         timeout=60,
@@ -453,13 +447,7 @@ def test_launch_checks_the_duration_and_names_processes_of_other_hosts_before_st
         deploy.read_text().replace("environment = false\n", 'environment = false\nhost = "locahost"\n', 1)
     )
     result = subprocess.run(
-        [
-            *(sys.executable, "-m", "earl.cli.main", "launch", str(PINGPONG)),
-            "--deployment",
-            str(deploy),
-            "--duration",
-            "1s",
-        ],
+        launch_command(deploy, "1s"),
         capture_output=True,
         text=True,
         timeout=120,

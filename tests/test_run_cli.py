@@ -35,6 +35,16 @@ def counter_copy(tmp_path: Path, old: str = "", new: str = "") -> Path:
     return spec
 
 
+def counter_whose_increment_then(tmp_path: Path, code: str, prelude: str = "") -> Path:
+    """The counter, its `increment` running `code` (indented lines) after it counts, `prelude` at the top of
+    its module: how these tests put misbehaving code in a real spec."""
+    spec = counter_copy(tmp_path)
+    functions = spec.parent / "counting" / "cs.py"
+    line = "    outputs.count = inputs.count + 1\n"
+    functions.write_text(prelude + functions.read_text().replace(line, line + code))
+    return spec
+
+
 def test_run_prints_a_summary_and_writes_a_trace_that_summary_and_plot_read(tmp_path: Path) -> None:
     trace = tmp_path / "run.mcap"
     result = earl_cli(
@@ -114,14 +124,9 @@ def test_a_damaged_trace_is_a_clear_error_for_summary_and_plot(
 
 @pytest.mark.parametrize(("status", "code"), [("", 0), ("0", 0), ("3", 1), ("'gave up'", 1)])
 def test_a_function_that_calls_sys_exit_ends_the_run_in_order(tmp_path: Path, status: str, code: int) -> None:
-    spec = counter_copy(tmp_path)
-    functions = spec.parent / "counting" / "cs.py"
-    text = functions.read_text()
-    functions.write_text(
-        text.replace(
-            "    outputs.count = inputs.count + 1\n",
-            f"    outputs.count = inputs.count + 1\n    if inputs.count == 2:\n        import sys\n        sys.exit({status})\n",
-        )
+    spec = counter_whose_increment_then(
+        tmp_path,
+        f"    if inputs.count == 2:\n        import sys\n        sys.exit({status})\n",
     )
     trace = tmp_path / "run.mcap"
     result = earl_cli("run", str(spec), "--duration", "200ms", "--trace", str(trace))
@@ -222,15 +227,10 @@ def test_code_the_runtime_cannot_call_as_a_function_is_refused_before_the_run(
 def test_any_exception_of_a_function_is_its_fault_and_the_run_goes_on(
     tmp_path: Path, raising: str, message: str
 ) -> None:
-    spec = counter_copy(tmp_path)
-    functions = spec.parent / "counting" / "cs.py"
-    functions.write_text(
-        raising
-        + "\n\n"
-        + functions.read_text().replace(
-            "    outputs.count = inputs.count + 1\n",
-            "    outputs.count = inputs.count + 1\n    if inputs.count == 1:\n        raise Odd('odd')\n",
-        )
+    spec = counter_whose_increment_then(
+        tmp_path,
+        "    if inputs.count == 1:\n        raise Odd('odd')\n",
+        prelude=raising + "\n\n",
     )
     simulation = earl.simulate(earl.load(spec))
     simulation.advance_to(0.05)
@@ -279,13 +279,9 @@ def test_an_environment_that_fails_ends_the_run_with_one_line_and_a_readable_tra
 def test_a_simulation_stopped_inside_an_instant_refuses_to_go_on(tmp_path: Path) -> None:
     """A KeyboardInterrupt raised in a function leaves its subsystem halfway through an iteration: going on
     would silently skip the rest of it (the subsystem used to stop for good, with no word)."""
-    spec = counter_copy(tmp_path)
-    functions = spec.parent / "counting" / "cs.py"
-    functions.write_text(
-        functions.read_text().replace(
-            "    outputs.count = inputs.count + 1\n",
-            "    outputs.count = inputs.count + 1\n    if inputs.count == 1:\n        raise KeyboardInterrupt\n",
-        )
+    spec = counter_whose_increment_then(
+        tmp_path,
+        "    if inputs.count == 1:\n        raise KeyboardInterrupt\n",
     )
     simulation = earl.simulate(earl.load(spec))
     with pytest.raises(KeyboardInterrupt):
@@ -436,15 +432,10 @@ def test_ctrl_c_stops_the_run_even_when_the_specs_code_swallows_it(tmp_path: Pat
 def test_text_of_the_specs_code_is_printed_as_it_is_never_as_markup(tmp_path: Path) -> None:
     """An exception's message goes to the closing summary and `earl trace summary` unchanged: a Rich
     tag in it (`[/dev/ttyUSB0]` closes one) neither fails nor vanishes; a huge one is cut for the terminal."""
-    spec = counter_copy(tmp_path)
-    functions = spec.parent / "counting" / "cs.py"
-    functions.write_text(
-        functions.read_text().replace(
-            "    outputs.count = inputs.count + 1\n",
-            "    outputs.count = inputs.count + 1\n"
-            "    if inputs.count == 1:\n"
-            "        raise OSError('cannot open [/dev/ttyUSB0] as [bold]root[/bold]' + 'x' * 3_000_000)\n",
-        )
+    spec = counter_whose_increment_then(
+        tmp_path,
+        "    if inputs.count == 1:\n"
+        "        raise OSError('cannot open [/dev/ttyUSB0] as [bold]root[/bold]' + 'x' * 3_000_000)\n",
     )
     trace = tmp_path / "run.mcap"
     result = earl_cli("run", str(spec), "--duration", "100ms", "--trace", str(trace))
@@ -459,16 +450,10 @@ def test_text_of_the_specs_code_is_printed_as_it_is_never_as_markup(tmp_path: Pa
 
 def test_a_message_that_is_not_utf8_text_is_recorded_escaped_and_the_trace_stays_whole(tmp_path: Path) -> None:
     """A file name of undecodable bytes in an exception's message (a lone surrogate) used to lose the trace."""
-    spec = counter_copy(tmp_path)
-    functions = spec.parent / "counting" / "cs.py"
-    functions.write_text(
-        "import os\n\n"
-        + functions.read_text().replace(
-            "    outputs.count = inputs.count + 1\n",
-            "    outputs.count = inputs.count + 1\n"
-            "    if inputs.count == 1:\n"
-            "        raise FileNotFoundError('cannot open ' + os.fsdecode(b'/dev/tty\\xff'))\n",
-        )
+    spec = counter_whose_increment_then(
+        tmp_path,
+        "    if inputs.count == 1:\n        raise FileNotFoundError('cannot open ' + os.fsdecode(b'/dev/tty\\xff'))\n",
+        prelude="import os\n\n",
     )
     trace = tmp_path / "run.mcap"
     result = earl_cli("run", str(spec), "--duration", "100ms", "--trace", str(trace))
@@ -484,14 +469,10 @@ def test_a_message_that_is_not_utf8_text_in_a_trace_written_to_a_stream(tmp_path
 
     from earl.runtime.trace_reader import summarise
 
-    spec = counter_copy(tmp_path)
-    functions = spec.parent / "counting" / "cs.py"
-    functions.write_text(
-        "import os\n\n"
-        + functions.read_text().replace(
-            "    outputs.count = inputs.count + 1\n",
-            "    outputs.count = inputs.count + 1\n    raise OSError(os.fsdecode(b'/dev/tty\\xff'))\n",
-        )
+    spec = counter_whose_increment_then(
+        tmp_path,
+        "    raise OSError(os.fsdecode(b'/dev/tty\\xff'))\n",
+        prelude="import os\n\n",
     )
     stream = io.BytesIO()
     simulation = earl.simulate(earl.load(spec), trace=stream)
