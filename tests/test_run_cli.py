@@ -508,6 +508,8 @@ def test_a_run_killed_with_sigkill_still_leaves_a_readable_trace(tmp_path: Path)
         summary = earl_cli("trace", "summary", str(trace))
     assert summary.returncode == 0, summary.stderr
     assert "counter/a.cs" in summary.stdout
+    # the counts are written at the end, which never came: unknown, not 0
+    assert "without the run's end (the run was killed)" in summary.stdout
 
 
 @pytest.mark.skipif(not Path("/dev/full").exists(), reason="no /dev/full here")

@@ -77,8 +77,14 @@ def run_summary(arguments: argparse.Namespace) -> int:
             for state, duration in sorted(subsystem.state_time.items(), key=lambda item: -item[1])
         )
         transitions = "\n".join(f"{t} ×{n}" for t, n in sorted(subsystem.transitions.items())) or "–"
-        table.add_row(name, states, transitions, str(subsystem.iterations), str(subsystem.faults))
+        iterations = str(subsystem.iterations) if summary.ended else "?"
+        table.add_row(name, states, transitions, iterations, str(subsystem.faults))
     console.print(table)
+    if not summary.ended:
+        console.print(
+            f"the trace ends at {end:.3f} s without the run's end (the run was killed): what it holds is whole, "
+            "but the iteration counts, written at the end, are not known"
+        )
     console.print(f"{summary.messages} messages on links, {len(summary.faults)} faults")
     for fault in summary.faults[:10]:
         console.print(

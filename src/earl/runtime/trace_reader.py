@@ -42,6 +42,8 @@ class TraceSummary:
     faults: list[dict[str, Any]]
     messages: int
     settings: dict[str, Any]
+    #: whether the run's end is in the trace (with the iteration counts); not when the run was killed
+    ended: bool = True
 
 
 def _messages(path: Path, topics: list[str] | None = None) -> Iterator[tuple[str, dict[str, str], int, Any]]:
@@ -96,6 +98,7 @@ class _Summariser:
         self.messages = 0
         self.settings: dict[str, Any] = {}
         self.seen_run = False
+        self.ended = False
 
     def of(self, name: str) -> SubsystemSummary:
         found = self.subsystems.get(name)
@@ -110,6 +113,7 @@ class _Summariser:
             if data.get("event") == "start":
                 self.settings = {k: v for k, v in data.items() if k != "event"}
             elif data.get("event") == "end":
+                self.ended = True
                 for name, count in data.get("iterations", {}).items():
                     self.of(name).iterations = int(count)
         elif topic == "/earl/faults":
@@ -133,7 +137,7 @@ class _Summariser:
         for name, (state, since) in self.entered.items():
             summary = self.subsystems[name]
             summary.state_time[state] = summary.state_time.get(state, 0) + self.end_time - since
-        return TraceSummary(self.end_time, self.subsystems, self.faults, self.messages, self.settings)
+        return TraceSummary(self.end_time, self.subsystems, self.faults, self.messages, self.settings, self.ended)
 
 
 def topics(path: Path) -> dict[str, dict[str, str]]:
