@@ -315,6 +315,25 @@ def test_a_peer_that_finishes_its_run_is_no_fault_but_one_killed_is(tmp_path: Pa
     assert [f["kind"] for f in faults if f["kind"] == "stale"] == ["stale"], faults  # the kill alone
 
 
+def test_an_agent_started_in_two_processes_is_reported(tmp_path: Path, processes: list[Process]) -> None:
+    deploy = deployment(tmp_path, [(["sender/a"], False), (["receiver/a"], False)])
+    _, receiver_endpoint = endpoints(deploy)
+    common = [str(PINGPONG), "--transport", "zenoh", "--duration", "20s"]
+    receiver = run(processes, tmp_path / "receiver.log", [*common, "--deployment", str(deploy), "--agents", "receiver"])
+    run(processes, tmp_path / "first.log", [*common, "--deployment", str(deploy), "--agents", "sender"])
+    receiver.wait_for("sender/a is alive", 30)
+    # the same agent once more, on an endpoint of its own (its own Zenoh configuration)
+    [port] = free_ports(1)
+    config = tmp_path / "again.json5"
+    config.write_text(
+        f"{{ mode: 'peer', listen: {{ endpoints: ['tcp/127.0.0.1:{port}'] }}, "
+        f"connect: {{ endpoints: ['{receiver_endpoint}'] }}, scouting: {{ multicast: {{ enabled: false }} }} }}\n"
+    )
+    again = run(processes, tmp_path / "again.log", [*common, "--zenoh-config", str(config), "--agents", "sender"])
+    receiver.wait_for("sender/a runs in 2 processes: the messages of its links mix", 30)
+    again.wait_for("sender/a runs here and in another process", 30)
+
+
 def test_launch_starts_each_process_prefixes_its_output_and_stops_them_all_on_ctrl_c(
     tmp_path: Path, processes: list[Process]
 ) -> None:

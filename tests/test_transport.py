@@ -125,7 +125,7 @@ def test_link_names_become_single_key_chunks_that_read_back() -> None:
         assert "/" not in chunk and not set(chunk) & set("*$?#@ ")
         if text:
             assert unescape(chunk) == text
-    assert alive_key("pickAndPlace", "task/a") == "earl/pickAndPlace/alive/task%2Fa"
+    assert alive_key("pickAndPlace", "task/a", "1f2e") == "earl/pickAndPlace/alive/task%2Fa/1f2e"
 
 
 def test_the_examples_deployment_puts_every_agent_in_one_process() -> None:

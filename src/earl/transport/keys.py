@@ -31,8 +31,10 @@ def link_key(system: str, link: str) -> str:
     return f"earl/{escape(system)}/{escape(link)}"
 
 
-def alive_key(system: str, agent: str) -> str:
-    return f"earl/{escape(system)}/alive/{escape(agent)}"
+def alive_key(system: str, agent: str, process: str) -> str:
+    """The liveliness token of `agent` as run by one process (`process`: an id of its own), so that the
+    same agent started twice is seen as two tokens, not one."""
+    return f"earl/{escape(system)}/alive/{escape(agent)}/{escape(process)}"
 
 
 def alive_prefix(system: str) -> str:

@@ -21,6 +21,7 @@ import json
 import re
 import threading
 import time as wall
+import uuid
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -233,13 +234,19 @@ class ZenohTransport:
         self._types: TypeSystem | None = None
         #: peers that said they finished (closed in order): their going is no fault
         self._finished: set[str] = set()
+        #: this process among those that run agents of the system: its liveliness tokens carry it
+        self.process_id = uuid.uuid4().hex[:12]
+        #: the processes each agent is seen alive in (more than one: the agent was started twice)
+        self._instances: dict[str, set[str]] = {}
         try:
             self.session = zenoh.open(config)
         except Exception as error:
             raise TransportError(f"Zenoh could not start: {zenoh_reason(error)}") from None
         self._declared.append(self.session.declare_queryable(f"earl/{escape(system)}/types/*", self._answer_type_query))
         self._declared.append(
-            self.session.liveliness().declare_subscriber(alive_prefix(system) + "*", self._on_liveliness, history=True)
+            self.session.liveliness().declare_subscriber(
+                alive_prefix(system) + "*/*", self._on_liveliness, history=True
+            )
         )
         self._declared.append(self.session.declare_subscriber(finished_prefix(system) + "*", self._on_finished))
 
@@ -280,7 +287,7 @@ class ZenohTransport:
         """Declare this process's agents alive: called once every link is declared, so a peer that
         sees the token also finds the subscribers."""
         for agent in self.local_agents:
-            self._tokens.append(self.session.liveliness().declare_token(alive_key(self.system, agent)))
+            self._tokens.append(self.session.liveliness().declare_token(alive_key(self.system, agent, self.process_id)))
 
     # ---------------------------------------------------------------- peers
     @property
@@ -308,18 +315,35 @@ class ZenohTransport:
             self._finished.add(unescape(str(sample.key_expr).rsplit("/", 1)[-1]))
 
     def _on_liveliness(self, sample: zenoh.Sample) -> None:
-        """On Zenoh's thread: a peer agent appeared or disappeared."""
-        agent = unescape(str(sample.key_expr).rsplit("/", 1)[-1])
-        alive = sample.kind == zenoh.SampleKind.PUT
+        """On Zenoh's thread: a process declared one of its agents alive, or that token went."""
+        chunks = str(sample.key_expr).rsplit("/", 2)
+        agent, process = unescape(chunks[-2]), unescape(chunks[-1])
+        if process == self.process_id:
+            return  # our own token
         with self._alive_changed:
+            instances = self._instances.setdefault(agent, set())
+            was_alive = bool(instances)
+            if sample.kind == zenoh.SampleKind.PUT:
+                instances.add(process)
+            else:
+                instances.discard(process)
+            alive = bool(instances)
+            twice = len(instances) > 1 or (bool(instances) and agent in self.local_agents)
             if alive:
                 self._alive.add(agent)
                 self._finished.discard(agent)  # back (restarted): a later loss is news again
             else:
                 self._alive.discard(agent)
             self._alive_changed.notify_all()
-        # always handed over: the buffers it feeds may not be declared yet (the token can come first)
-        self.inbox.put(self._peer_changed, (agent, alive))
+        if twice and sample.kind == zenoh.SampleKind.PUT:
+            where = "here and in another process" if agent in self.local_agents else f"in {len(instances)} processes"
+            self.log(
+                f"earl run: {agent} runs {where}: the messages of its links mix, as if one agent sent them; "
+                "stop all but one (each agent belongs to one process of the deployment)"
+            )
+        if alive != was_alive:
+            # always handed over: the buffers it feeds may not be declared yet (the token can come first)
+            self.inbox.put(self._peer_changed, (agent, alive))
 
     def _peer_changed(self, time: int, item: tuple[str, bool]) -> None:
         """On the scheduler's thread: the buffers fed by `agent` go stale, or flow again."""
