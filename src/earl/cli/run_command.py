@@ -32,7 +32,8 @@ examples:
   earl run spec.earl --realtime --duration 5s             paced by the wall clock, jitter reported
 
 Subsystems are named like manip/a.cs or manip/a.motorController[3]/ve. A `run.toml` next
-to the spec may set defaults: environment, duration, seed, record_memory, report.
+to the spec may set defaults: environment, duration, seed, record_memory, record_links,
+plot, report.
 `--environment none` runs without it (a process whose agents have no physics).
 
 distributed (docs/distributed.md):

@@ -244,7 +244,7 @@ class Resolver:
                             f"type `{name}` contains itself ({cycle}), so it has no finite size",
                             definition.location,
                             "EARL-R011",
-                            "break the cycle with a variable array (`T[]`) or an optional field in another type",
+                            "break the cycle with a variable array (`T[]`): an optional field does not end it",
                         )
                     elif child not in visited:
                         visited.add(child)

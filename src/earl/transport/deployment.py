@@ -72,11 +72,14 @@ class Deployment:
     def check_agents(self, system_agents: list[str]) -> None:
         """Every agent of the system runs in one process, and the file names no other."""
         deployed = [agent for process in self.processes for agent in process.agents]
-        unknown = sorted(set(deployed) - set(system_agents))
-        if unknown:
-            raise DeploymentError(
-                f"{self.path}: `{unknown[0]}` is not an agent of this system (its agents: {', '.join(system_agents)})"
-            )
+        known = set(system_agents)
+        for number, process in enumerate(self.processes, start=1):
+            for agent in process.agents:
+                if agent not in known:
+                    raise DeploymentError(
+                        f"{self.path}: process {number}: `{agent}` is not an agent of this system "
+                        f"(its agents: {', '.join(system_agents)})"
+                    )
         missing = [agent for agent in system_agents if agent not in deployed]
         if missing:
             raise DeploymentError(
