@@ -364,3 +364,16 @@ def test_a_mutated_example_gets_a_verdict_never_a_traceback(
         assert "Traceback" not in printed
         if code == 1 and command[0] == "check":
             assert f"{example.name}:" in printed and "error" in printed
+
+
+def test_a_named_pipe_nobody_writes_to_is_read_as_empty_not_waited_on(tmp_path: Path) -> None:
+    import os
+    import subprocess
+    import sys
+
+    pipe = tmp_path / "pipe.earl"
+    os.mkfifo(pipe)
+    result = subprocess.run(
+        [sys.executable, "-m", "earl.cli.main", "check", str(pipe)], capture_output=True, text=True, timeout=60
+    )
+    assert result.returncode == 1 and "EARL-S033" in result.stderr

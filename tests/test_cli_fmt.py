@@ -53,6 +53,41 @@ def test_fmt_write_follows_a_link_and_keeps_the_file_s_permissions(tmp_path: Pat
     assert sorted(p.name for p in tmp_path.iterdir()) == ["link.earl", "real.earl"]  # no temporary left
 
 
+@pytest.mark.parametrize("line_end", ["\r\n", "\r"])
+def test_fmt_check_finds_line_ends_other_than_newline_and_write_makes_them_newlines(
+    tmp_path: Path, line_end: str
+) -> None:
+    spec = tmp_path / "s.earl"
+    spec.write_bytes(CANONICAL.replace("\n", line_end).encode())
+    assert main(["fmt", "--check", str(spec)]) == 1
+    assert main(["fmt", "--write", str(spec)]) == 0
+    assert spec.read_bytes() == CANONICAL.encode()
+
+
+def test_fmt_write_refuses_a_read_only_file(tmp_path: Path) -> None:
+    locked = tmp_path / "locked.earl"
+    locked.write_text(MESSY)
+    locked.chmod(0o444)  # no one may write it: root neither, though the system would let root
+    assert main(["fmt", "--write", str(locked)]) == 1
+    assert locked.read_text() == MESSY
+
+
+def test_fmt_write_keeps_hard_links_a_users_temp_like_file_and_long_names(tmp_path: Path) -> None:
+    spec = tmp_path / "s.earl"
+    spec.write_text(MESSY)
+    other = tmp_path / "other-name.earl"
+    other.hardlink_to(spec)
+    theirs = tmp_path / ".s.earl.tmp"  # the user's own file, named as an old temporary was
+    theirs.write_text("mine")
+    assert main(["fmt", "--write", str(spec)]) == 0
+    assert spec.read_text() == CANONICAL and other.read_text() == CANONICAL  # one file, two names
+    assert theirs.read_text() == "mine"
+    long = tmp_path / ("x" * 245 + ".earl")  # a temporary named after it would be too long
+    long.write_text(MESSY)
+    assert main(["fmt", "--write", str(long)]) == 0
+    assert long.read_text() == CANONICAL
+
+
 def test_save_replaces_only_a_regular_file_and_leaves_it_whole_when_writing_fails(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

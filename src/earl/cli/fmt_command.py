@@ -43,7 +43,8 @@ def run(arguments: argparse.Namespace) -> int:
             print_diagnostics(error.diagnostics, error.sources)
             status = 1
             continue
-        original = path.read_text(encoding="utf-8")
+        # as the bytes are: `\r\n` or `\r` line ends are not canonical (universal newlines would hide them)
+        original = path.read_bytes().decode("utf-8", errors="replace")
         canonical = system.to_earl()
         if arguments.check:
             if original != canonical:

@@ -3,10 +3,13 @@
 from __future__ import annotations
 
 import errno
+import fcntl
 import os
 import shutil
+import tempfile
 from collections.abc import Mapping
 from pathlib import Path
+from typing import BinaryIO
 
 from earl.collector import paused as collection_paused
 from earl.diagnostics import Diagnostic, EarlError, Severity, SourceMap
@@ -36,10 +39,23 @@ def _resolved(path: Path) -> Path:
         return path.absolute()
 
 
+def _opened(path: Path) -> BinaryIO:
+    """The file, opened for reading without waiting: opening a named pipe that nobody writes to would
+    block for ever; opened so, it reads as empty (and a pipe with a writer reads as usual)."""
+    descriptor = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
+    try:
+        flags = fcntl.fcntl(descriptor, fcntl.F_GETFL)
+        fcntl.fcntl(descriptor, fcntl.F_SETFL, flags & ~os.O_NONBLOCK)  # from here on, reads wait for data
+    except OSError:
+        os.close(descriptor)
+        raise
+    return os.fdopen(descriptor, "rb")
+
+
 def read_file(path: Path, sources: SourceMap, location: SourceLocation | None = None) -> ParsedFile:
     shown = _display_path(path)
     try:
-        with path.open("rb") as file:
+        with _opened(path) as file:
             # at most one byte more than a spec may have: `/dev/zero` or a pipe must not be read for ever
             data = file.read(MAX_FILE_BYTES + 1)
             if len(data) > MAX_FILE_BYTES:
@@ -216,15 +232,36 @@ def save(system: System, path: str | Path) -> None:
         target = _resolved(target)
     if target.exists() and not target.is_file():
         raise OSError(errno.EINVAL, "not a regular file (a device, a pipe or a directory); only files are rewritten")
-    temporary = target.with_name(f".{target.name}.tmp")
+    text = system.to_earl()
+    if target.exists():
+        if not os.access(target, os.W_OK) or not target.stat().st_mode & 0o222:
+            # renaming over it would succeed, since that needs only the directory (and root may write
+            # anything): its mode says no
+            raise OSError(errno.EACCES, "the file is read-only; make it writable first (chmod u+w)")
+        if target.stat().st_nlink > 1:
+            # a rename would leave its other names with the old text: written in place instead
+            target.write_text(text, encoding="utf-8")
+            return
+    # a name of our own beside it (never a user's file), short enough whatever the target's name
+    descriptor, name = tempfile.mkstemp(prefix=".earl-", suffix=".tmp", dir=target.parent)
+    temporary = Path(name)
     try:
-        temporary.write_text(system.to_earl(), encoding="utf-8")
+        with os.fdopen(descriptor, "w", encoding="utf-8") as stream:
+            stream.write(text)
         if target.exists():
             shutil.copymode(target, temporary)
+        else:
+            os.chmod(temporary, 0o666 & ~_umask())  # mkstemp's 0600 is for secrets, not specs
         temporary.replace(target)
     except BaseException:
         temporary.unlink(missing_ok=True)
         raise
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
 
 
 def loads(text: str, path: str = "<text>", parameters: Mapping[str, ParameterValue] | None = None) -> System:
