@@ -308,3 +308,21 @@ def test_importing_the_model_loads_no_renderer() -> None:
     code = "import sys, earl, earl.model; print(sorted(m for m in sys.modules if m.startswith('earl.render')))"
     completed = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert completed.stdout.strip() == "[]"
+
+
+def test_diagram_and_export_never_write_over_a_file_of_the_spec(tmp_path: Path) -> None:
+    import shutil
+
+    copy = tmp_path / "mobile"
+    shutil.copytree(MOBILE.parent, copy)
+    spec = copy / "system.earl"
+    before = {path: path.read_bytes() for path in copy.glob("*.earl")}
+    (tmp_path / "view.svg").symlink_to(copy / "types.earl")  # through a link too
+    attempts = [
+        ["diagram", str(copy), "--view", "system", "--format", "svg", "-o", str(spec)],
+        ["diagram", str(copy), "--view", "system", "-o", str(tmp_path / "view.svg")],
+        ["export", "sysml", str(copy), "-o", str(spec)],
+    ]
+    for arguments in attempts:
+        assert main(arguments) == 2, arguments
+    assert {path: path.read_bytes() for path in copy.glob("*.earl")} == before

@@ -387,3 +387,21 @@ def test_a_second_run_leaves_no_stale_diagram(tmp_path: Path) -> None:
     result = write_site(Subject(renamed), [], tmp_path)
     assert sorted((tmp_path / "diagrams").glob("*.svg")) == sorted(result.diagrams)
     assert not any("worker" in path.name for path in result.diagrams)
+
+
+def test_doc_leaves_what_it_did_not_write_and_refuses_a_users_index(tmp_path: Path) -> None:
+    """`earl doc -o docs/` in a folder of the user's: their own pictures stay, their index is not replaced."""
+    diagrams = tmp_path / "diagrams"
+    diagrams.mkdir()
+    logo = diagrams / "logo.svg"
+    logo.write_text("<svg/>")
+    system = earl.loads(AGENT_FAMILY, "swarm.earl")
+    write_site(Subject(system), [], tmp_path)
+    write_site(Subject(system), [], tmp_path)  # a second run replaces its own files
+    assert logo.read_text() == "<svg/>"
+    own = tmp_path / "mine"
+    own.mkdir()
+    (own / "index.html").write_text("<html>my project page</html>")
+    assert main(["doc", str(EXAMPLE), "-o", str(own)]) == 2
+    assert (own / "index.html").read_text() == "<html>my project page</html>"
+    assert not (own / "diagrams").exists()

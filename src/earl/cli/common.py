@@ -62,3 +62,16 @@ def brief(text: str, limit: int = SHOWN_MESSAGE) -> str:
         else f"{text[:limit]}… ({len(text) - limit:,} more characters; the trace has them all)"
     )
     return shown if shown.isascii() else shown.encode("utf-8", "backslashreplace").decode("utf-8")
+
+
+def refuse_to_overwrite_inputs(output: Path, sources: object) -> None:
+    """UsageError when `output` is a file the command read (the spec or a file it imports), even through
+    a symbolic link: `-o system.earl`, a slip of the keyboard, must not replace the spec."""
+    texts = getattr(sources, "texts", {})
+    try:
+        target = output.resolve()
+        read = {Path(name).resolve() for name in texts}
+    except (OSError, RuntimeError):  # a loop of links: the write then says what is wrong
+        return
+    if target in read:
+        raise UsageError(f"cannot write {output}: it is a file of the specification itself; choose another name")

@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from earl.cli.common import UsageError, parse_parameter, spec_path, usage_error
+from earl.cli.common import UsageError, parse_parameter, refuse_to_overwrite_inputs, spec_path, usage_error
 from earl.cli.output import print_diagnostics
 from earl.diagnostics import EarlError
 from earl.lang.loader import load
@@ -104,6 +104,10 @@ def run(arguments: argparse.Namespace) -> int:
     except (TargetError, GraphvizError) as error:
         return usage_error(str(error))
     if arguments.output:
+        try:
+            refuse_to_overwrite_inputs(Path(arguments.output), system.sources)
+        except UsageError as error:
+            return usage_error(str(error))
         try:
             Path(arguments.output).write_bytes(data)
         except OSError as error:

@@ -16,7 +16,8 @@ from earl.render.document import write_site
 from earl.render.graphviz import GraphvizError, dot_program
 
 EPILOG = """\
-writes (SVG files in SITE/diagrams/ left by an earlier run and not drawn again are removed):
+writes (diagrams an earlier run wrote and this one did not draw are removed; other files stay,
+and an index.html or index.md that earl doc did not write stops it):
   SITE/index.html       one static page: inline CSS, no script, works offline
   SITE/index.md         the same document in Markdown
   SITE/diagrams/*.svg   every diagram, referenced by both

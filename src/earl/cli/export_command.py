@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from earl.check import check
-from earl.cli.common import UsageError, parse_parameter, spec_path, usage_error
+from earl.cli.common import UsageError, parse_parameter, refuse_to_overwrite_inputs, spec_path, usage_error
 from earl.cli.output import print_diagnostics
 from earl.diagnostics import EarlError, Severity, SourceMap
 from earl.export.sysml import LIBRARY_FILE, export_sysml, library_text
@@ -68,6 +68,12 @@ def run(arguments: argparse.Namespace) -> int:
     if output is None:
         sys.stdout.write(text)
         return 0
+    try:
+        refuse_to_overwrite_inputs(output, system.sources)
+        if not arguments.no_library:
+            refuse_to_overwrite_inputs(output.parent / LIBRARY_FILE, system.sources)
+    except UsageError as error:
+        return usage_error(str(error))
     written = [output]
     try:
         output.write_text(text, encoding="utf-8")
