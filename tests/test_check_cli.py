@@ -319,6 +319,29 @@ def test_an_unknown_parameter_is_an_invalid_spec(capsys: pytest.CaptureFixture[s
     assert "EARL-R001" in err
 
 
+@pytest.mark.parametrize(
+    ("value", "fragment"),
+    [("x", 'its value is "x"'), ("nan", "its value is NaN"), ("true", "its value is true"), ("1e400", "is inf")],
+)
+def test_a_param_of_the_wrong_type_is_one_error_not_one_per_use(
+    capsys: pytest.CaptureFixture[str], value: str, fragment: str
+) -> None:
+    """The spec's own `N` stands in once `--param N=…` is refused: its uses are not errors too."""
+    status, _, err = run(capsys, "check", str(EXAMPLE), "--param", f"N={value}")
+    assert status == 1
+    assert err.count("error[") == 1 and "EARL-R005" in err and fragment in err
+
+
+def test_export_refuses_a_nan_parameter_before_writing(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    spec = tmp_path / "g.earl"
+    spec.write_text(
+        "system g\nparam G: double = 1e308 * 10 - 1e308 * 10\nx/a {\n    cs {\n        period 1 ms\n    }\n}\n"
+    )
+    status, _, err = run(capsys, "export", "sysml", str(spec), "-o", str(tmp_path / "g.sysml"))
+    assert status == 1 and "its value is NaN" in err
+    assert not (tmp_path / "g.sysml").exists()
+
+
 # ---------------------------------------------------------------- --verbose and --param
 
 

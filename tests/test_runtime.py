@@ -376,10 +376,11 @@ def test_the_python_api_refuses_a_parameter_the_system_does_not_declare() -> Non
 @pytest.mark.parametrize(
     ("value", "fragment"),
     [
-        ("abc", "its value is 'abc'"),
+        ("abc", 'its value is "abc"'),
         (1.5, "its value is 1.5"),
-        (True, "its value is True"),
+        (True, "its value is true"),
         (None, "its value is None"),
+        (float("nan"), "its value is NaN"),
         (10**30, "its value (a whole number of 31 digits) does not fit it"),
     ],
 )

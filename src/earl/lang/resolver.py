@@ -179,7 +179,16 @@ class Resolver:
                     parameter.value.location or parameter.location,
                     "EARL-R005",
                 )
-                continue
+                if parameter.name not in overrides:
+                    continue
+                # a value given from outside (`--param N=x`) is wrong: the spec's own value stands in for
+                # the rest of the reading, so that every use of `N` is not reported as an error too
+                try:
+                    value = evaluate_constant(parameter.value, _values(scope))
+                except ConstantError:
+                    continue
+                if parameter_value_problem(type_name, value) is not None:
+                    continue
             if type_name in ("double", "float32", "float64"):
                 value = float(value)
             scope[parameter.name] = value

@@ -61,11 +61,27 @@ def parameter_value_problem(type_name: str, value: object) -> str | None:
         low, high = INTEGER_RANGES[type_name]
         if not low <= value <= high:
             return f"its value {_briefly(value)} does not fit it ({low}..{high})"
+    if isinstance(value, float) and value != value:
+        return "its value is NaN (not a number), which no computation or export can use"
+    if isinstance(value, str) and not value.isascii():
+        try:
+            value.encode("utf-8")
+        except UnicodeEncodeError:
+            return f"its value {_briefly(value)} is not text (it holds a lone surrogate, from undecodable bytes)"
     return None
 
 
 def _briefly(value: object) -> str:
-    if isinstance(value, int) and not isinstance(value, bool) and abs(value) >= 10**30:
+    """A value as a spec writes it (`true`, `"abc"`, `2.5`), cut short when long."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float) and value != value:
+        return "NaN"
+    if isinstance(value, str):
+        shown = value if len(value) <= 50 else f"{value[:40]}… ({len(value)} characters)"
+        shown = shown.encode("utf-8", "backslashreplace").decode("utf-8")  # a lone surrogate, shown escaped
+        return '"' + shown.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(value, int) and abs(value) >= 10**30:
         return f"{'-' if value < 0 else ''}(a whole number of {len(str(abs(value))) if abs(value) < 10**4000 else 'over 4000'} digits)"
     text = repr(value)
     return text if len(text) <= 60 else f"{text[:50]}… ({len(text)} characters)"
