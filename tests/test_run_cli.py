@@ -78,6 +78,25 @@ def test_plot_of_a_signal_the_trace_lacks_says_how_to_record_it(tmp_path: Path) 
     assert (tmp_path / "z.png").is_file()
 
 
+def test_a_plot_that_cannot_be_written_is_a_usage_error_said_before_anything_runs(tmp_path: Path) -> None:
+    trace = tmp_path / "run.mcap"
+    assert earl_cli("run", str(SPECS / "counter"), "--duration", "50ms", "--trace", str(trace)).returncode == 0
+    a_file = tmp_path / "afile"
+    a_file.write_text("x")
+    for output, fragment in [
+        (tmp_path / "x.txt", "a plot is written as .png"),
+        (tmp_path, "it is a directory"),
+        (a_file / "p.png", "is a file, not a directory"),
+    ]:
+        plot = earl_cli("plot", str(trace), "--signal", "counter/a.cs.count", "-o", str(output))
+        assert plot.returncode == 2 and fragment in plot.stderr, plot.stderr
+        assert "Traceback" not in plot.stderr
+    started = time.monotonic()
+    run = earl_cli("run", str(SPECS / "counter"), "--duration", "1000s", "--plot", str(tmp_path / "x.txt"))
+    assert run.returncode == 2 and "--plot" in run.stderr
+    assert time.monotonic() - started < 30  # refused before the run, not after it
+
+
 def test_a_trace_summary_of_something_else_is_a_clear_error(tmp_path: Path) -> None:
     junk = tmp_path / "junk.mcap"
     junk.write_bytes(b"not an mcap file at all")

@@ -95,6 +95,12 @@ def _command_named(argv: Sequence[str]) -> str | None:
 
 def main(argv: Sequence[str] | None = None) -> int:
     words = sys.argv[1:] if argv is None else list(argv)
+    for stream in (sys.stdout, sys.stderr):
+        # a file name of undecodable bytes (`spec\udcfe.earl`) is printed escaped, never a traceback
+        reconfigure = getattr(stream, "reconfigure", None)
+        if reconfigure is not None:
+            with contextlib.suppress(Exception):
+                reconfigure(errors="backslashreplace")
     # Only the command being run is imported: the others pull in the renderer, the SysML
     # exporter and more, which would add half a second to every `earl run`.
     parser = build_parser(_command_named(words))

@@ -152,6 +152,12 @@ def run(arguments: argparse.Namespace) -> int:
     signals = arguments.signal if arguments.signal is not None else settings.plot
     if arguments.plot and not signals:
         return usage_error("--plot needs signals: name them with --signal, or `plot = [...]` in run.toml")
+    if arguments.plot:
+        from earl.runtime.plot import plot_output_problem
+
+        problem = plot_output_problem(Path(arguments.plot))
+        if problem is not None:  # said now, not after a run of minutes
+            return usage_error(f"--plot {arguments.plot!r}: {problem}")
     arguments.signal = signals
     if arguments.plot and not arguments.trace:
         arguments.trace = str(Path(arguments.plot).with_suffix(".mcap"))
@@ -428,6 +434,9 @@ def _plot(arguments: argparse.Namespace, console: Console) -> None:
         plot_signals(Path(arguments.trace), arguments.signal, Path(arguments.plot))
     except TraceError as error:
         console.print(f"earl run: no plot: {error}")
+        return
+    except OSError as error:  # a read-only directory, a full disk: the run and its trace are fine
+        console.print(f"earl run: no plot: cannot write {arguments.plot}: {error.strerror or error}")
         return
     console.print(f"plot: {arguments.plot}")
 

@@ -97,16 +97,21 @@ def run_summary(arguments: argparse.Namespace) -> int:
 
 
 def run_plot(arguments: argparse.Namespace) -> int:
-    from earl.runtime.plot import plot_signals
+    from earl.runtime.plot import plot_output_problem, plot_signals
     from earl.runtime.trace_reader import TraceError
 
     path = Path(arguments.file)
     if not path.is_file():
         return usage_error(f"no such file: {arguments.file}")
+    problem = plot_output_problem(Path(arguments.output))
+    if problem is not None:
+        return usage_error(f"cannot write {arguments.output!r}: {problem}")
     try:
         plot_signals(path, arguments.signal, Path(arguments.output), arguments.title)
     except TraceError as error:
         sys.stderr.write(f"earl plot: {error}\n")
         return EXIT_FAILED
+    except OSError as error:  # a read-only directory, a full disk
+        return usage_error(f"cannot write {arguments.output}: {error.strerror or error}")
     print(f"wrote {arguments.output}")
     return EXIT_OK

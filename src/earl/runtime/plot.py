@@ -7,6 +7,25 @@ from pathlib import Path
 
 from earl.runtime.trace_reader import read_signals
 
+#: the kinds of file a plot is written as, by the suffix (what Matplotlib's Agg backend writes)
+PLOT_SUFFIXES = (".png", ".svg", ".pdf", ".jpg", ".jpeg", ".eps", ".ps")
+
+
+def plot_output_problem(output: Path) -> str | None:
+    """Why a plot cannot be written to `output`, known before anything is read or run; None when it can."""
+    if not output.name or output.is_dir():
+        return "it is a directory; name the picture, e.g. plot.png"
+    if output.suffix.lower() not in PLOT_SUFFIXES:
+        return f"a plot is written as {', '.join(PLOT_SUFFIXES)}, named by its suffix"
+    if output.exists() and not output.is_file():
+        return "it is not a regular file (a device, a pipe or a socket)"
+    for parent in output.parents:
+        if parent.exists():
+            if not parent.is_dir():
+                return f"{parent} is a file, not a directory"
+            break
+    return None
+
 
 def plot_signals(trace: Path, signals: list[str], output: Path, title: str | None = None) -> None:
     """Write a PNG (or SVG/PDF, by the suffix): one panel per element of a subsystem, its FSM states behind."""

@@ -65,8 +65,9 @@ def write_site(subject: Subject, diagnostics: Sequence[Diagnostic], directory: P
     manifest.write_text("\n".join(sorted(path.name for path in paths)) + "\n", encoding="utf-8")
     html = directory / "index.html"
     markdown = directory / "index.md"
-    html.write_text(render_html(document), encoding="utf-8")
-    markdown.write_text(render_markdown(document), encoding="utf-8")
+    # a file name of undecodable bytes is written escaped (`\udcfe`), not as a UnicodeEncodeError
+    html.write_text(render_html(document), encoding="utf-8", errors="backslashreplace")
+    markdown.write_text(render_markdown(document), encoding="utf-8", errors="backslashreplace")
     return DocumentResult(html, markdown, tuple(paths))
 
 
