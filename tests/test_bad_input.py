@@ -377,3 +377,34 @@ def test_a_named_pipe_nobody_writes_to_is_read_as_empty_not_waited_on(tmp_path: 
         [sys.executable, "-m", "earl.cli.main", "check", str(pipe)], capture_output=True, text=True, timeout=60
     )
     assert result.returncode == 1 and "EARL-S033" in result.stderr
+
+
+NESTED_FAMILIES = """\
+system big
+
+param A: int = 3
+param S: int = 3
+param B: int = 3
+
+w[I in 1..A]/a {
+    cs {
+        period 1 ms
+    }
+
+    d[J in 1..S]/ve {
+        period 1 ms
+        x[K in 1..B]/ib: int
+    }
+}
+"""
+
+
+def test_families_inside_families_that_multiply_beyond_memory_are_refused_at_once() -> None:
+    """Each family within its own limit (100,000), together 10¹⁵ elements: one error, before any expansion
+    (which used to run for a minute and die of MemoryError at 6 GB)."""
+    with pytest.raises(earl.EarlError) as refused:
+        earl.loads(NESTED_FAMILIES, "big.earl", {"A": 100_000, "S": 100_000, "B": 100_000})
+    [diagnostic] = [d for d in refused.value.diagnostics if d.code == "EARL-R017"]
+    assert "families inside families multiply" in diagnostic.message
+    assert diagnostic.location is not None and diagnostic.location.line == 12
+    earl.loads(NESTED_FAMILIES, "big.earl", {"A": 100, "S": 100, "B": 100})  # a million: allowed

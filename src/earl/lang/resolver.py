@@ -57,6 +57,9 @@ Value = bool | int | float | str
 
 #: A family larger than this is almost certainly a typo (`1..1000000`), and would exhaust memory.
 MAX_FAMILY_MEMBERS = 100_000
+#: subsystems and their elements once every family is expanded: nested families multiply (100,000
+#: agents of 100,000 subsystems each), and each element takes a few kB of memory to check or run
+MAX_EXPANDED_ELEMENTS = 4_000_000
 
 _INTEGER_TYPES = {name for name, accepted in PARAMETER_TYPES.items() if accepted == (int,)}
 
@@ -111,6 +114,9 @@ class Resolver:
         self.diagnostics: list[Diagnostic] = []
         self.types: dict[str, Any] = {}
         self.agents: dict[str, _AgentTable] = {}
+        #: elements the system will have once its families are expanded, counted as they are declared
+        self._expanded = 0
+        self._expanded_reported = False
 
     # ------------------------------------------------------------------ reporting
     def error(self, message: str, location: SourceLocation | None, code: str, hint: str | None = None) -> None:
@@ -392,6 +398,7 @@ class Resolver:
         self._parameters(agent.parameters, inner)
         table = _AgentTable(agent, family, inner)
         self.agents[agent.name] = table
+        agents = _size(family)
         for subsystem in agent.subsystems:
             key = (subsystem.name, subsystem.kind)
             if key in table.subsystems:
@@ -410,11 +417,28 @@ class Resolver:
             if subsystem.family is not None and sub_family is not None:
                 sub_scope[subsystem.family.index] = sub_family
             self._parameters(subsystem.parameters, sub_scope)
-            sub_table = self._subsystem_table(subsystem, sub_scope)
+            subsystems = agents * _size(sub_family)
+            self._count_expanded(subsystems, subsystem.location)
+            sub_table = self._subsystem_table(subsystem, sub_scope, subsystems)
             sub_table.scope = sub_scope  # type: ignore[attr-defined]
             table.subsystems[key] = (sub_table, sub_family)
 
-    def _subsystem_table(self, subsystem: Subsystem, scope: Scope) -> _SubsystemTable:
+    def _count_expanded(self, count: int, location: SourceLocation | None) -> None:
+        """EARL-R017, once, when the expanded system passes MAX_EXPANDED_ELEMENTS: each family is within
+        its own limit, but families inside families multiply."""
+        self._expanded += count
+        if self._expanded > MAX_EXPANDED_ELEMENTS and not self._expanded_reported:
+            self._expanded_reported = True
+            self.error(
+                f"expanded, the families make more than {MAX_EXPANDED_ELEMENTS:,} subsystems and elements "
+                f"({self._expanded:,} by here): families inside families multiply, and a system that large "
+                "would need more memory than a machine has",
+                location,
+                "EARL-R017",
+                "make the families smaller (their ranges, or the parameters that set them)",
+            )
+
+    def _subsystem_table(self, subsystem: Subsystem, scope: Scope, subsystems: int = 1) -> _SubsystemTable:
         table = _SubsystemTable(subsystem)
         groups: list[tuple[Kind, Sequence[Any]]] = [
             (Kind.INPUT_BUFFER, subsystem.input_buffers),
@@ -434,6 +458,7 @@ class Resolver:
                     continue
                 family = self.family_range(getattr(element, "family", None), scope)
                 names[element.name] = _Declared(element, family)
+                self._count_expanded(subsystems * _size(family), element.location)
                 if hasattr(element, "data_type"):
                     self.data_type(element.data_type, scope)
         return table
@@ -890,4 +915,9 @@ def resolve(system: System, overrides: Mapping[str, Value] | None = None) -> lis
     return Resolver(system, overrides or {}).run()
 
 
-__all__ = ["MAX_FAMILY_MEMBERS", "IndexRange", "Resolver", "resolve"]
+def _size(family: IndexRange | None) -> int:
+    """Members of a family (1 for an element declared alone)."""
+    return 1 if family is None else max(0, family.last - family.first + 1)
+
+
+__all__ = ["MAX_EXPANDED_ELEMENTS", "MAX_FAMILY_MEMBERS", "IndexRange", "Resolver", "resolve"]
