@@ -268,6 +268,15 @@ def test_sarif_names_a_relative_file_relative(
     assert uris == {"spec.earl"}
 
 
+def test_sarif_file_references_are_percent_encoded_uris() -> None:
+    from earl.check.report import artifact_uri
+
+    assert artifact_uri("my spec#1.earl") == "my%20spec%231.earl"  # a `#` would cut the name
+    assert artifact_uri("lib/types.earl") == "lib/types.earl"
+    assert artifact_uri("/tmp/x y.earl") == "file:///tmp/x%20y.earl"
+    assert artifact_uri("sp\udcfe.earl") == "sp%FE.earl"  # the byte the file name has
+
+
 def test_sarif_output_of_a_clean_spec_still_describes_the_rules(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -305,6 +314,8 @@ def test_usage_errors_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture[str])
     assert status == 2 and "directory" in err
     status, _, err = run(capsys, "check", str(EXAMPLE), "--param", "N")
     assert status == 2 and "NAME=VALUE" in err
+    status, _, err = run(capsys, "check", str(EXAMPLE), "--param", "N=3", "--param", "N=4")
+    assert status == 2 and "--param sets `N` twice" in err
     with pytest.raises(SystemExit) as exit_:
         main(["check", str(EXAMPLE), "--format", "xml"])
     assert exit_.value.code == 2
@@ -321,7 +332,14 @@ def test_an_unknown_parameter_is_an_invalid_spec(capsys: pytest.CaptureFixture[s
 
 @pytest.mark.parametrize(
     ("value", "fragment"),
-    [("x", 'its value is "x"'), ("nan", "its value is NaN"), ("true", "its value is true"), ("1e400", "is inf")],
+    [
+        ("x", 'its value is "x"'),
+        ("nan", "its value is NaN"),
+        ("true", "its value is true"),
+        ("1e400", "is inf"),
+        ("1_000", 'its value is "1_000"'),  # Python would read these as numbers; a spec cannot
+        ("٣", 'its value is "٣"'),
+    ],
 )
 def test_a_param_of_the_wrong_type_is_one_error_not_one_per_use(
     capsys: pytest.CaptureFixture[str], value: str, fragment: str

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import json
+import os
+import urllib.parse
 from collections.abc import Sequence
 from pathlib import Path, PurePath
 from typing import Any
@@ -39,7 +41,11 @@ def artifact_uri(file: str) -> str:
     """SARIF names files by URI: a relative path stays relative (code-scanning tools resolve it against
     the repository), an absolute one becomes a `file://` URI."""
     path = PurePath(file)
-    return Path(file).as_uri() if path.is_absolute() else path.as_posix()
+    if path.is_absolute():
+        return Path(file).as_uri()
+    # a relative reference: its characters percent-encoded as a URI needs them (`my spec#1.earl`
+    # would otherwise be cut at `#`); undecodable bytes of the name are encoded as the bytes they were
+    return urllib.parse.quote(os.fsencode(path.as_posix()), safe="/")
 
 
 def as_sarif(diagnostics: Sequence[Diagnostic]) -> str:

@@ -13,7 +13,7 @@ from rich.table import Table
 
 from earl.check import CheckContext, check_context, collector_paused, context_for
 from earl.check.report import as_json, as_sarif
-from earl.cli.common import UsageError, parse_parameter, spec_path, usage_error
+from earl.cli.common import UsageError, parse_parameters, spec_path, usage_error
 from earl.cli.output import print_diagnostics
 from earl.diagnostics import Diagnostic, EarlError, Severity
 from earl.lang.loader import load
@@ -108,7 +108,7 @@ def _phases(console: Console) -> Iterator[_Phases]:
 def run(arguments: argparse.Namespace) -> int:
     try:
         path = spec_path(arguments.spec)
-        parameters = dict(parse_parameter(p) for p in arguments.param)
+        parameters = parse_parameters(arguments.param)
     except UsageError as error:
         return usage_error(str(error))
     # Reading and checking a large spec allocates millions of objects that all stay alive until the

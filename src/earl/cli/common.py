@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import sys
 from pathlib import Path
 
@@ -32,15 +33,30 @@ def parse_parameter(text: str) -> tuple[str, ParameterValue]:
     value: ParameterValue
     if raw in ("true", "false"):
         value = raw == "true"
+    elif _WHOLE.fullmatch(raw):
+        value = int(raw)
+    elif _REAL.fullmatch(raw):
+        value = float(raw)
     else:
-        try:
-            value = int(raw)
-        except ValueError:
-            try:
-                value = float(raw)
-            except ValueError:
-                value = raw
+        # text, as the spec would read it: Python's int() and float() would also take `1_000` and
+        # other scripts' digits (`٣`), which no spec can write
+        value = raw
     return name.strip(), value
+
+
+def parse_parameters(texts: list[str]) -> dict[str, ParameterValue]:
+    """Every `--param NAME=VALUE`; a name given twice is a usage error (which value was meant?)."""
+    values: dict[str, ParameterValue] = {}
+    for text in texts:
+        name, value = parse_parameter(text)
+        if name in values:
+            raise UsageError(f"--param sets `{name}` twice; give it once")
+        values[name] = value
+    return values
+
+
+_WHOLE = re.compile(r"[+-]?[0-9]+")
+_REAL = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?|[+-]?(?:inf|nan)", re.IGNORECASE)
 
 
 def usage_error(message: str) -> int:

@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from earl.cli.common import UsageError, parse_parameter, refuse_to_overwrite_inputs, spec_path, usage_error
+from earl.cli.common import UsageError, parse_parameters, refuse_to_overwrite_inputs, spec_path, usage_error
 from earl.cli.output import print_diagnostics
 from earl.diagnostics import EarlError
 from earl.lang.loader import load
@@ -81,7 +81,7 @@ def output_format(arguments: argparse.Namespace) -> str:
 def run(arguments: argparse.Namespace) -> int:
     try:
         path = spec_path(arguments.spec)
-        parameters = dict(parse_parameter(p) for p in arguments.param)
+        parameters = parse_parameters(arguments.param)
         chosen = output_format(arguments)
         if chosen == "mermaid" and arguments.view not in MERMAID_VIEWS:
             raise UsageError(

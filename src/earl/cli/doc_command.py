@@ -7,7 +7,7 @@ from pathlib import Path
 from typing import Any
 
 from earl.check import check
-from earl.cli.common import UsageError, parse_parameter, spec_path, usage_error
+from earl.cli.common import UsageError, parse_parameters, spec_path, usage_error
 from earl.cli.output import print_diagnostics
 from earl.diagnostics import EarlError, Severity, SourceMap
 from earl.lang.loader import load
@@ -54,7 +54,7 @@ def register(commands: Any) -> None:
 def run(arguments: argparse.Namespace) -> int:
     try:
         path = spec_path(arguments.spec)
-        parameters = dict(parse_parameter(p) for p in arguments.param)
+        parameters = parse_parameters(arguments.param)
         output = Path(arguments.output)
         if output.exists() and not output.is_dir():
             raise UsageError(f"{arguments.output} exists and is not a directory")

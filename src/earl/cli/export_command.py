@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from earl.check import check
-from earl.cli.common import UsageError, parse_parameter, refuse_to_overwrite_inputs, spec_path, usage_error
+from earl.cli.common import UsageError, parse_parameters, refuse_to_overwrite_inputs, spec_path, usage_error
 from earl.cli.output import print_diagnostics
 from earl.diagnostics import EarlError, Severity, SourceMap
 from earl.export.sysml import LIBRARY_FILE, export_sysml, library_text
@@ -45,7 +45,7 @@ def register(commands: Any) -> None:
 def run(arguments: argparse.Namespace) -> int:
     try:
         path = spec_path(arguments.spec)
-        parameters = dict(parse_parameter(p) for p in arguments.param)
+        parameters = parse_parameters(arguments.param)
         output = None if arguments.output is None else Path(arguments.output)
         if output is not None and not output.parent.is_dir():
             raise UsageError(f"cannot write {output}: no such directory {output.parent}")

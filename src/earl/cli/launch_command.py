@@ -129,12 +129,12 @@ def run(arguments: argparse.Namespace) -> int:
 
 def _agents(spec: Path, parameters: list[str]) -> list[str]:
     """The agents of the expanded system, so that a deployment missing one fails before anything starts."""
-    from earl.cli.common import parse_parameter
+    from earl.cli.common import parse_parameters
     from earl.lang.loader import load
     from earl.model.expand import expand
     from earl.runtime.names import agent_name
 
-    values = dict(parse_parameter(p) for p in parameters)
+    values = parse_parameters(parameters)
     return [agent_name(agent) for agent in expand(load(spec, values), values).agents]
 
 

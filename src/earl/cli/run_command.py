@@ -18,7 +18,7 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 from rich.text import Text
 
-from earl.cli.common import UsageError, brief, parse_parameter, spec_path, usage_error
+from earl.cli.common import UsageError, brief, parse_parameters, spec_path, usage_error
 from earl.cli.output import print_diagnostics
 from earl.diagnostics import EarlError
 
@@ -143,7 +143,7 @@ def run(arguments: argparse.Namespace) -> int:
 
     try:
         path = spec_path(arguments.spec)
-        parameters = dict(parse_parameter(p) for p in arguments.param)
+        parameters = parse_parameters(arguments.param)
         settings = read_run_settings(path)
         duration = parse_duration(arguments.duration) if arguments.duration else (settings.duration or 10.0)
     except (UsageError, ValueError) as error:
