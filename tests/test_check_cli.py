@@ -350,6 +350,27 @@ def test_a_param_of_the_wrong_type_is_one_error_not_one_per_use(
     assert err.count("error[") == 1 and "EARL-R005" in err and fragment in err
 
 
+def test_a_problem_is_reported_once_at_the_place_it_was_written(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A link family written without its index (`link motorController[K]/ve… -> motor[K]/re…`) meets the
+    unknown `K` at each of its two ends — and used to say each twice."""
+    import shutil
+
+    copy = tmp_path / "pick"
+    shutil.copytree(EXAMPLE.parent, copy)
+    spec = copy / "system.earl"
+    text = spec.read_text()
+    line = (
+        "    link motorController[K in 1..N],motor[K]: motorController[K]/ve.motorCommand -> motor[K]/re.motorCommand"
+    )
+    assert line in text
+    spec.write_text(text.replace(line, "    link motorController[K]/ve.motorCommand -> motor[K]/re.motorCommand"))
+    status, _, err = run(capsys, "check", str(copy))
+    assert status == 1
+    assert err.count("error[EARL-R020]") == 2 and "2 errors" in err
+
+
 def test_export_refuses_a_nan_parameter_before_writing(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     spec = tmp_path / "g.earl"
     spec.write_text(

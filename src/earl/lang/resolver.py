@@ -112,6 +112,7 @@ class Resolver:
         self.system = system
         self.overrides = dict(overrides)
         self.diagnostics: list[Diagnostic] = []
+        self._said: set[tuple[str, str, SourceLocation | None]] = set()
         self.types: dict[str, Any] = {}
         self.agents: dict[str, _AgentTable] = {}
         #: elements the system will have once its families are expanded, counted as they are declared
@@ -120,6 +121,12 @@ class Resolver:
 
     # ------------------------------------------------------------------ reporting
     def error(self, message: str, location: SourceLocation | None, code: str, hint: str | None = None) -> None:
+        # An element of a family, or a link resolved from both of its ends, can meet the same problem
+        # more than once: the reader is told once, at the place it was written.
+        key = (code, message, location)
+        if key in self._said:
+            return
+        self._said.add(key)
         self.diagnostics.append(Diagnostic(Severity.ERROR, message, location, code=code, hint=hint))
 
     def duplicate(self, what: str, location: SourceLocation | None, first: SourceLocation | None) -> None:
