@@ -437,6 +437,10 @@ def test_rules_knows_reading_codes_and_refuses_unknown_ones(capsys: pytest.Captu
     status, out, err = run(capsys, "rules", "E061")
     assert status == 2 and out == ""
     assert "no rule E061" in err
+    status, _, err = run(capsys, "rules", "X999")
+    assert status == 2 and "did you mean" not in err  # no code of another family offered
+    status, _, err = run(capsys, "rules", "S19")
+    assert "did you mean `EARL-S019`?" in err
 
 
 # ---------------------------------------------------------------- safety

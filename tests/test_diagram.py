@@ -326,3 +326,9 @@ def test_diagram_and_export_never_write_over_a_file_of_the_spec(tmp_path: Path) 
     for arguments in attempts:
         assert main(arguments) == 2, arguments
     assert {path: path.read_bytes() for path in copy.glob("*.earl")} == before
+
+
+def test_the_activity_view_without_a_target_suggests_one_of_the_spec(capsys: pytest.CaptureFixture[bytes]) -> None:
+    assert main(["diagram", str(MOBILE), "--view", "activity"]) == 2
+    err = capsys.readouterr().err
+    assert "e.g. base/a.cs." in str(err) and "manip/a" not in str(err)

@@ -414,3 +414,12 @@ def test_exporting_never_imports_code_the_spec_names(tmp_path: Path, monkeypatch
     assert main(["export", "sysml", str(SMALL), "-o", str(tmp_path / "out.sysml")]) == 0
     assert not marker.exists()
     assert "conveyor" not in sys.modules
+
+
+def test_export_writes_no_model_when_the_library_cannot_be_written(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    (tmp_path / "EARL.sysml").mkdir()  # the library's place is taken by a directory
+    assert main(["export", "sysml", str(SMALL), "-o", str(tmp_path / "small.sysml")]) == 2
+    assert "cannot write" in capsys.readouterr().err
+    assert not (tmp_path / "small.sysml").exists()  # a model naming EARL::… without the library is no use

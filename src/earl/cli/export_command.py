@@ -74,15 +74,19 @@ def run(arguments: argparse.Namespace) -> int:
             refuse_to_overwrite_inputs(output.parent / LIBRARY_FILE, system.sources)
     except UsageError as error:
         return usage_error(str(error))
-    written = [output]
+    written = []
     try:
-        output.write_text(text, encoding="utf-8")
+        # the library first: a model that names `EARL::…` is of no use without it, so when it cannot be
+        # written, neither is the model, and nothing is left half done
         if not arguments.no_library:
             library = output.parent / LIBRARY_FILE
             if library.resolve() != output.resolve():
                 library.write_text(library_text(), encoding="utf-8")
                 written.append(library)
+        output.write_text(text, encoding="utf-8")
+        written.insert(0, output)
     except OSError as error:
-        return usage_error(f"cannot write {error.filename or output}: {error.strerror}")
+        done = f" ({' and '.join(str(p) for p in written)} written)" if written else ""
+        return usage_error(f"cannot write {error.filename or output}: {error.strerror}{done}")
     sys.stderr.write(f"{path}: wrote {' and '.join(str(p) for p in written)}\n")
     return 0

@@ -38,5 +38,7 @@ def run(arguments: argparse.Namespace) -> int:
     if code in READING_CODES:
         sys.stdout.write(f"{code}: {READING_CODES[code]} (found while reading the spec; see docs/rules.md)\n")
         return 0
-    hint = did_you_mean(code, [*RULES, *READING_CODES])
+    # a suggestion of the same family of codes only (`EARL-X999` is no misspelt `EARL-S019`)
+    family = code[: len("EARL-") + 1]
+    hint = did_you_mean(code, [c for c in [*RULES, *READING_CODES] if c.startswith(family)])
     return usage_error(f"no rule {arguments.code}" + (f"; {hint}" if hint else "; `earl rules` lists them"))

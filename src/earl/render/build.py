@@ -84,9 +84,12 @@ def diagram_of(subject: Subject, view: str, target: str | None) -> Diagram:
         if target is None:
             behaviours = [(a, s, b) for a, s in all_subsystems(system) for b in s.basic_behaviours]
             if len(behaviours) != 1:
-                raise TargetError(
-                    "the activity view needs --target naming a basic behaviour, e.g. manip/a.cs.jointMove/bb"
+                example = (
+                    f"{qualified_subsystem_name(behaviours[0][0], behaviours[0][1])}.{behaviours[0][2].name}/bb"
+                    if behaviours
+                    else "manip/a.cs.jointMove/bb"
                 )
+                raise TargetError(f"the activity view needs --target naming a basic behaviour, e.g. {example}")
             agent, subsystem, behaviour = behaviours[0]
         else:
             agent, subsystem, behaviour = find_behaviour(system, target)
