@@ -507,3 +507,16 @@ def test_on_a_terminal_a_spinner_names_the_phase_and_elsewhere_nothing_is_added(
     for phase in ("reading the specification", "expanding the indexed families", "applying the rules to 17 subsystems"):
         assert phase in terminal.stderr
     assert plain.stdout.strip().endswith(terminal.stdout.strip()[-60:])  # the verdict itself is the same
+
+
+def test_a_refused_family_range_is_not_followed_by_index_errors_against_it(tmp_path: Path) -> None:
+    spec = tmp_path / "rng.earl"
+    spec.write_text(
+        "system rng\n\nx/a {\n    cs {\n        period 1 ms\n        v[J in 3..2]/m: int = 0\n"
+        "        p/pp = v[1]/mi > 0\n    }\n}\n"
+    )
+    import earl
+
+    with pytest.raises(earl.EarlError) as refused:
+        earl.load(spec)
+    assert [d.code for d in refused.value.diagnostics] == ["EARL-R016"]  # no R027 against the empty range

@@ -659,7 +659,8 @@ class Resolver:
         if values is None:
             return
         outside = sorted({v for v in values if v < family.first or v > family.last})
-        if outside:
+        # an empty range is one already refused (R016, R017): every index would be "outside" it
+        if outside and family.last >= family.first:
             self.error(
                 f"`{reference_text(reference)}` reaches index {outside[0]}, outside the family's {family.first}..{family.last}",
                 index.location or reference.location,
