@@ -20,13 +20,12 @@ import subprocess
 import sys
 import threading
 import time
-from collections.abc import Iterator
 from pathlib import Path
 from typing import IO, Any
 
 from earl.cli.common import UsageError, spec_path, usage_error
 from earl.cli.output import print_diagnostics
-from earl.cli.run_command import STOP_SIGNALS
+from earl.cli.run_command import handling_stop_signals
 from earl.diagnostics import EarlError
 
 EXIT_OK, EXIT_FAILED, EXIT_INTERRUPTED = 0, 1, 130
@@ -159,17 +158,11 @@ class _Supervisor:
     def stop_requested(self) -> bool:
         return self.signals > 0 or self.output_closed
 
-    @contextlib.contextmanager
-    def stopping_on_signals(self) -> Iterator[None]:
+    def stopping_on_signals(self) -> contextlib.AbstractContextManager[None]:
         def note(*_: object) -> None:
             self.signals += 1
 
-        previous = {number: signal.signal(number, note) for number in STOP_SIGNALS}
-        try:
-            yield
-        finally:
-            for number, handler in previous.items():
-                signal.signal(number, handler)
+        return handling_stop_signals(note)
 
     def start(self, label: str, command: list[str]) -> None:
         # Rich draws the children's tables for a pipe 80 columns wide unless told otherwise

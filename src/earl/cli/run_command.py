@@ -9,7 +9,7 @@ import signal
 import statistics
 import sys
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -253,6 +253,17 @@ class _StopRequest:
 
 
 @contextlib.contextmanager
+def handling_stop_signals(handler: Callable[..., None]) -> Iterator[None]:
+    """`handler` for every one of STOP_SIGNALS meanwhile; the previous handlers afterwards."""
+    previous = {number: signal.signal(number, handler) for number in STOP_SIGNALS}
+    try:
+        yield
+    finally:
+        for number, before in previous.items():
+            signal.signal(number, before)
+
+
+@contextlib.contextmanager
 def _stopped_like_ctrl_c() -> Iterator[_StopRequest]:
     """Ctrl-C, SIGTERM and SIGHUP raise KeyboardInterrupt meanwhile, so that the run ends in order (exit 130)."""
     request = _StopRequest()
@@ -261,12 +272,8 @@ def _stopped_like_ctrl_c() -> Iterator[_StopRequest]:
         request.requested = True
         raise KeyboardInterrupt
 
-    previous = {number: signal.signal(number, stop) for number in STOP_SIGNALS}
-    try:
+    with handling_stop_signals(stop):
         yield request
-    finally:
-        for number, handler in previous.items():
-            signal.signal(number, handler)
 
 
 def _close(transport: Any) -> None:

@@ -63,11 +63,20 @@ def parameter_value_problem(type_name: str, value: object) -> str | None:
             return f"its value {_briefly(value)} does not fit it ({low}..{high})"
     if isinstance(value, float) and value != value:
         return "its value is NaN (not a number), which no computation or export can use"
-    if isinstance(value, str) and not value.isascii():
-        try:
-            value.encode("utf-8")
-        except UnicodeEncodeError:
-            return f"its value {_briefly(value)} is not text (it holds a lone surrogate, from undecodable bytes)"
+    if isinstance(value, str) and lone_surrogate(value) is not None:
+        return f"its value {_briefly(value)} is not text (it holds a lone surrogate, from undecodable bytes)"
+    return None
+
+
+def lone_surrogate(text: str) -> int | None:
+    """Where `text` holds half of a surrogate pair, which no UTF-8 file, trace or peer can carry (what
+    undecodable bytes become with errors="surrogateescape"); None for text."""
+    if text.isascii():
+        return None
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError as error:
+        return error.start
     return None
 
 

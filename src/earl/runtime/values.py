@@ -30,6 +30,7 @@ from earl.model.types import (
     StructType,
     TypeAlias,
     TypeReference,
+    lone_surrogate,
     type_text,
 )
 from earl.runtime.codegen import compiled
@@ -55,21 +56,19 @@ class Reals(tuple[float, ...]):
 
     def __new__(cls, values: Iterable[Any] = ()) -> Reals:
         # What the spec's code makes with `type(value)(…)` is checked like any value: only the runtime,
-        # which has checked the elements itself, makes one unchecked (`trusted_reals`).
-        items = tuple(values)
-        for index, item in enumerate(items):
-            _coerce_primitive(item, "double", f"element [{index}] of an array of reals")
-        return tuple.__new__(cls, (float(item) for item in items))
+        # which has checked the elements itself, makes one unchecked (`new_tuple(Reals, …)`).
+        return new_tuple(
+            cls,
+            [
+                _coerce_primitive(item, "double", f"element [{index}] of an array of reals")
+                for index, item in enumerate(values)
+            ],
+        )
 
 
 #: `new_tuple(Reals, values)`: a Reals of elements the caller has checked (floats, none of them NaN),
 #: without `Reals.__new__`'s checks; a third faster than through functools.partial
 new_tuple = tuple.__new__
-
-
-def trusted_reals(values: Iterable[float]) -> Reals:
-    """A Reals of elements the caller has checked (the runtime's own paths that are not hot)."""
-    return new_tuple(Reals, values)
 
 
 #: what the lines of `QuickTest.lines` use, for the namespace they are compiled in
@@ -213,7 +212,7 @@ class TypeSystem:
             size = _fixed_size(resolved)
             value = () if size is None else tuple(self.default(resolved.element) for _ in range(size))
             if self._holds_reals(resolved):
-                value = trusted_reals(value)
+                value = new_tuple(Reals, value)
         else:
             record = self.record_class(resolved.name, [f.name for f in resolved.fields])
             value = record({f.name: (None if f.optional else self.default(f.data_type)) for f in resolved.fields})
@@ -234,7 +233,7 @@ class TypeSystem:
             if size is not None and len(items) != size:
                 raise ValueTypeError(f"{where} must have {size} elements ({type_text(data_type)}), not {len(items)}")
             items = [self.coerce(item, resolved.element, f"{where}[{i}]") for i, item in enumerate(items)]
-            return trusted_reals(items) if self._holds_reals(resolved) else tuple(items)
+            return new_tuple(Reals, items) if self._holds_reals(resolved) else tuple(items)
         if not isinstance(value, Mapping):
             _mismatch(value, data_type, where)
         fields = {f.name: f for f in resolved.fields}
@@ -442,14 +441,12 @@ def _coerce_primitive(value: Any, name: str, where: str) -> Value:
         return value
     if name == "string":
         if isinstance(value, str):
-            if not value.isascii():
-                try:
-                    value.encode("utf-8")
-                except UnicodeEncodeError as error:  # a lone surrogate, from bytes decoded with "surrogateescape"
-                    raise ValueTypeError(
-                        f"{where} is not text: it holds the lone surrogate U+{ord(value[error.start]):04X} at index "
-                        f"{error.start}, which no trace or peer can carry (decode bytes with errors='replace')"
-                    ) from None
+            at = lone_surrogate(value)
+            if at is not None:
+                raise ValueTypeError(
+                    f"{where} is not text: it holds the lone surrogate U+{ord(value[at]):04X} at index "
+                    f"{at}, which no trace or peer can carry (decode bytes with errors='replace')"
+                )
             return value
         raise ValueTypeError(f"{where} must be a string, not {_describe(value)}")
     if name == "bytes":
