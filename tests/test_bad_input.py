@@ -130,6 +130,26 @@ def test_an_import_of_a_loop_of_symbolic_links_points_at_the_import(tmp_path: Pa
     assert "cannot read" in error.message and "one.earl" in error.message
 
 
+@pytest.mark.parametrize("linked", ["the root file", "an imported file"])
+def test_imports_are_looked_up_where_a_symbolic_link_points(linked: str, tmp_path: Path) -> None:
+    """One rule for every file: its imports are next to the file itself, not next to a link to it."""
+    library, project = tmp_path / "library", tmp_path / "project"
+    library.mkdir()
+    project.mkdir()
+    (library / "units.earl").write_text("struct Pose {\n    x: double\n}\n", encoding="utf-8")
+    (project / "units.earl").write_text("struct Other {\n    y: double\n}\n", encoding="utf-8")
+    agent = "a/a {\n    cs {\n        p/m: Pose\n    }\n}\n"
+    if linked == "the root file":
+        (library / "system.earl").write_text(f'system s\nimport "units.earl"\n\n{agent}', encoding="utf-8")
+        (project / "system.earl").symlink_to(library / "system.earl")
+    else:
+        (library / "types.earl").write_text('import "units.earl"\n', encoding="utf-8")
+        (project / "types.earl").symlink_to(library / "types.earl")
+        (project / "system.earl").write_text(f'system s\nimport "types.earl"\n\n{agent}', encoding="utf-8")
+    system = earl.load(project / "system.earl")
+    assert [t.name for t in system.types] == ["Pose"]
+
+
 DEEP = 10_000
 
 

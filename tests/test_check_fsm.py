@@ -1,6 +1,7 @@
 """The FSM analysis against brute force: on random FSMs, the BDDs find exactly what trying every
 assignment of the primitive predicates finds, and every assignment they show really does what the
-message says."""
+message says.  As `fsm.selectState()` runs: the transitions leaving a state are tried only when its
+behaviour stops, in priority order."""
 
 from __future__ import annotations
 
@@ -14,7 +15,7 @@ import pytest
 import earl
 from earl.check import check, context_for
 from earl.diagnostics import Diagnostic
-from earl.model.elements import FSM, Subsystem
+from earl.model.elements import FSM, Subsystem, Transition
 from earl.model.expressions import BooleanOperation, Expression, Literal, Not, Read
 from earl.model.kinds import Kind
 
@@ -82,13 +83,25 @@ def brute_force(subsystem: Subsystem, fsm: FSM) -> dict[str, set[str]]:
             found["EARL-I063"].add(state.name)
             continue
         leaving = [t for t in fsm.transitions if t.source == state.name]
+        stopping = [a for a in allowed if stops(a)]  # transitions are tried only when the behaviour stops
+
+        def distinct(first: Transition, second: Transition) -> bool:
+            return (first.priority is not None or second.priority is not None) and first.priority != second.priority
+
+        def rank(t: Transition) -> tuple[bool, int]:
+            return (t.priority is None, t.priority or 0)
+
         for t in leaving:
-            if not any(value(t.condition.expression, a) for a in allowed):
+            before = [u for u in leaving if distinct(u, t) and rank(u) < rank(t)]
+            taken = any(
+                value(t.condition.expression, a) and not any(value(u.condition.expression, a) for u in before)
+                for a in stopping
+            )
+            if not taken:
                 found["EARL-W062"].add(t.name)
         for first, second in itertools.combinations(leaving, 2):
-            distinct = (first.priority is not None or second.priority is not None) and first.priority != second.priority
-            both = any(value(first.condition.expression, a) and value(second.condition.expression, a) for a in allowed)
-            if not distinct and both:
+            both = any(value(first.condition.expression, a) and value(second.condition.expression, a) for a in stopping)
+            if not distinct(first, second) and both:
                 found["EARL-E060"].add(f"{first.name}|{second.name}")
         if any(stops(a) and not any(value(t.condition.expression, a) for t in leaving) for a in allowed):
             found["EARL-W061"].add(state.name)
@@ -140,6 +153,9 @@ def test_the_bdd_analysis_finds_what_brute_force_finds(seed: int) -> None:
             assignment = witness(diagnostic.message)
             assert all(value(a.expression, assignment) for a in assumptions)
             assert all(value(transitions[name].condition.expression, assignment) for name in match.groups())
+            source = subsystem.fsm.state_named(transitions[match.group(1)].source)
+            stopping = subsystem.basic_behaviour(source.behaviour) if source else None
+            assert stopping is not None and value(stopping.terminal_condition.expression, assignment)
         if diagnostic.code == "EARL-W061":
             match = PATTERNS["EARL-W061"].search(diagnostic.message)
             assert match is not None
@@ -173,3 +189,177 @@ def test_equal_priorities_still_overlap() -> None:
     assert "e.g. when p1/pp = true" in overlaps[0].message
     apart = both.replace("s1 -> s3 when p1/pp priority 1", "s1 -> s3 when p1/pp priority 2")
     assert not [d for d in check(earl.loads(apart, "random.earl")) if d.code == "EARL-E060" and "`s1," in d.message]
+
+
+PROBE = """\
+system probe
+
+struct S {
+    a: double
+    b: boolean
+    mode: string
+    opt: double?
+}
+
+r/r { x/a }
+
+x/a {
+    cs {
+        period 10 ms
+        v/ib: double
+        s/ib: S
+        m/m: double = 0.0
+        go/pp = newData(v/ib)
+        hot/pp = v/ib > 3.0
+        cold/pp = not hot/pp
+        false/pp = false
+        work/pf(v/ib, s/ib -> m/mo)
+        run/bb {
+            tf = {work/pf}
+            tc = TC
+        }
+        sink/bb {
+            tf = {work/pf}
+            tc = false/pp
+        }
+        fsm {
+            initial run
+            state run: run/bb
+            state a: sink/bb
+            state b: sink/bb
+            run -> a when FIRST
+            run -> b when SECOND
+        }
+    }
+}
+"""
+
+
+def probe(first: str, second: str, stop: str = "go/pp") -> dict[str, list[str]]:
+    """The FSM findings for `run -> a when FIRST` and `run -> b when SECOND`, the behaviour stopping on `stop`."""
+    text = PROBE.replace("TC", stop).replace("FIRST", first).replace("SECOND", second)
+    found: dict[str, list[str]] = {}
+    for diagnostic in check(earl.loads(text, "probe.earl")):
+        if diagnostic.code in ("EARL-E060", "EARL-W061", "EARL-W062", "EARL-I063", "EARL-E064"):
+            found.setdefault(diagnostic.code, []).append(diagnostic.message)
+    found.pop("EARL-I063")  # the sinks
+    return found
+
+
+@pytest.mark.parametrize(
+    ("first", "second"),
+    [
+        ("v/ib > 5.0", "v/ib < 3.0"),
+        ("v/ib > 3.0", "v/ib <= 3.0"),
+        ("v/ib >= 3.0", "3.0 > v/ib"),
+        ("v/ib == 2.0", "v/ib != 2.0"),
+        ('s/ib.mode == "stop"', 's/ib.mode == "go"'),
+        ("hot/pp", "cold/pp"),
+        ("s/ib.b", "s/ib.b == false"),
+        ("s/ib.b", "s/ib.b != true"),
+        ("newData(s/ib.opt)", "not newData(s/ib)"),
+        ("newData(v/ib)", "timeout(v/ib)"),
+    ],
+)
+def test_conditions_that_exclude_each_other_through_what_they_compare_do_not_overlap(first: str, second: str) -> None:
+    assert "EARL-E060" not in probe(first, second, stop="true")
+
+
+@pytest.mark.parametrize(
+    ("first", "second", "example"),
+    [
+        ("v/ib > 3.0 and v/ib < 5.0", "v/ib > 4.0", "v/ib < 5.0 = true, v/ib > 3.0 = true, v/ib > 4.0 = true"),
+        ('s/ib.mode == "stop"', 's/ib.mode != "go"', 's/ib.mode != "go" = true, s/ib.mode == "stop" = true'),
+        ("hot/pp", "v/ib > 4.0", "hot/pp = true, v/ib > 4.0 = true"),
+    ],
+)
+def test_conditions_that_can_hold_together_still_overlap_with_an_example_in_the_spec_s_words(
+    first: str, second: str, example: str
+) -> None:
+    [message] = probe(first, second, stop="true")["EARL-E060"]
+    assert message.endswith(f"e.g. when {example}"), message
+
+
+def test_transitions_are_tried_only_when_the_behaviour_stops() -> None:
+    # `not go/pp` and `hot/pp` overlap, but never when `run/bb` stops (on go/pp)
+    found = probe("hot/pp", "not go/pp")
+    assert "EARL-E060" not in found
+    assert found["EARL-W062"] == [
+        "transition `run,b/t` of x/a.cs can never be taken: its condition never holds when `run/bb` stops"
+    ]
+    # a terminal condition that cannot hold: the behaviour never ends, and nothing else is said
+    assert probe("hot/pp", "go/pp", stop="v/ib > 5.0 and v/ib < 3.0") == {}
+
+
+def test_a_transition_always_preceded_by_one_of_higher_priority_is_never_taken() -> None:
+    found = probe("go/pp priority 1", "go/pp and hot/pp priority 2")
+    assert found == {
+        "EARL-W062": [
+            "transition `run,b/t` of x/a.cs can never be taken: whenever its condition holds, `run,a/t` holds "
+            "too and is tried first"
+        ]
+    }
+
+
+def test_assumptions_that_contradict_each_other_are_an_error_not_a_silence() -> None:
+    text = PROBE.replace("TC", "go/pp").replace("FIRST", "go/pp").replace("SECOND", "go/pp")
+    text = text.replace(
+        "            run -> b when go/pp\n", "            run -> b when go/pp\n            assume go/pp and not go/pp\n"
+    )
+    codes = [d.code for d in check(earl.loads(text, "probe.earl")) if d.code.startswith("EARL-E")]
+    assert codes == ["EARL-E064"]
+
+
+FAMILY = """\
+system fam
+
+r/r { w[1]/a  w[2]/a  boss/a }
+
+w[K in 1..2]/a {
+    cs {
+        period 10 ms
+        in/ib: double
+        m/m: double = 0.0
+        go/pp = newData(in/ib)
+        first/pp = K == 1
+        false/pp = false
+        work/pf(in/ib -> m/mo)
+        run/bb {
+            tf = {work/pf}
+            tc = go/pp
+        }
+        sink/bb {
+            tf = {work/pf}
+            tc = false/pp
+        }
+        fsm {
+            initial run
+            state run: run/bb
+            state a: sink/bb
+            state b: sink/bb
+            run -> a when go/pp
+            run -> b when go/pp and not first/pp
+        }
+    }
+}
+
+boss/a {
+    cs {
+        period 10 ms
+        out[K in 1..2]/ob: double
+    }
+}
+
+link boss,w[K in 1..2]: boss/a.cs.out[K] -> w[K]/a.cs.in
+"""
+
+
+def test_a_member_of_a_family_is_analysed_with_its_own_index() -> None:
+    found = {d.code: d.message for d in check(earl.loads(FAMILY, "fam.earl")) if d.code in ("EARL-E060", "EARL-W062")}
+    assert found == {
+        "EARL-E060": "transitions `run,a/t` and `run,b/t` of w[2]/a.cs can both hold, e.g. when go/pp = true",
+        "EARL-W062": "transition `run,b/t` of w[1]/a.cs can never be taken: its condition never holds",
+    }
+    same = FAMILY.replace("first/pp = K == 1", "first/pp = in/ib > 1.0")
+    [overlap] = [d.message for d in check(earl.loads(same, "fam.earl")) if d.code == "EARL-E060"]
+    assert "of w[1..2]/a.cs can both hold" in overlap  # one analysis, said once for both members

@@ -494,7 +494,41 @@ CASES: list[Case] = [
         19,
         13,
         "transition `run,other/t` of a1/a.cs can never be taken: its condition never holds",
+        edit(TWO_STATES, ("run -> other when go/pp\n", "run -> other when go/pp and x/mi > 2.0 priority 1\n")),
+    ),
+    Case(
+        "EARL-W062",
         edit(TWO_STATES, ("run -> other when go/pp\n", "run -> other when go/pp priority 1\n")),
+        18,
+        13,
+        "transition `run,run/t` of a1/a.cs can never be taken: whenever its condition holds, `run,other/t` "
+        "holds too and is tried first",
+        edit(TWO_STATES, ("run -> other when go/pp\n", "run -> other when go/pp and x/mi > 2.0 priority 1\n")),
+    ),
+    Case(
+        "EARL-W062",
+        edit(TWO_STATES, ("run -> other when go/pp\n", "run -> other when not go/pp\n")),
+        19,
+        13,
+        "transition `run,other/t` of a1/a.cs can never be taken: its condition never holds when `run/bb` stops",
+        edit(TWO_STATES, ("run -> other when go/pp\n", "run -> other when x/mi > 2.0 priority 1\n")),
+    ),
+    Case(
+        "EARL-E064",
+        edit(
+            TWO_STATES,
+            (
+                "other -> run when go/pp\n",
+                "other -> run when go/pp\n            assume go/pp\n            assume not go/pp\n",
+            ),
+        ),
+        21,
+        13,
+        "the `assume` formulas of a1/a.cs can never hold",
+        edit(
+            TWO_STATES,
+            ("other -> run when go/pp\n", "other -> run when go/pp\n            assume not (go/pp and x/mi < 1.0)\n"),
+        ),
     ),
 ]
 
@@ -1014,3 +1048,40 @@ def test_a_subsystem_declared_twice_is_reported_once_not_again_by_each_link_to_i
     with pytest.raises(EarlError) as raised:
         earl.loads(twice, "spec.earl")
     assert [d.code for d in raised.value.diagnostics] == ["EARL-R002"]
+
+
+def test_a_problem_every_member_of_a_link_family_shares_is_said_once_with_the_indices_as_a_range() -> None:
+    declared = "    link motor[K in 1..N],motorController[K]: motor[K]/re.encoderReading -> motorController[K]/ve.encoderReading\n"
+    wrong = "    link motor[K in 1..N],cs: motor[K]/re.encoderReading -> cs.motorControllerState[K]\n"
+    text = EXAMPLE.read_text(encoding="utf-8")
+    assert declared in text
+    system = earl.loads(text.replace(declared, wrong), str(EXAMPLE))
+    found = [d for d in check(system) if d.code == "EARL-E012"]
+    assert [d.message for d in found] == [
+        "a link from a Real Effector to a Control Subsystem is not permitted inside an agent (link `motor[1..6],cs`)"
+    ]
+    fed_twice = [d.message for d in check(system) if d.code == "EARL-E011"]
+    assert fed_twice == [
+        "`manip/a.cs.motorControllerState[1..6]/ib` is fed by link `motor[1..6],cs` and by link "
+        "`motorController[1..6],cs`"
+    ]
+
+
+def test_merging_keeps_apart_other_places_and_writes_scattered_indices_as_a_list() -> None:
+    from earl.check.merging import Said, merge_family_members
+    from earl.model.location import SourceLocation
+
+    here, there = SourceLocation("s.earl", 3, 5, 3, 9), SourceLocation("s.earl", 4, 5, 4, 9)
+    found = [
+        Said("EARL-E010", "`m[1]/ve` is wrong", here, "fix it"),
+        Said("EARL-E010", "`m[3]/ve` is wrong", here, "fix it"),
+        Said("EARL-E010", "`m[3]/ve` is wrong", here, "fix it"),
+        Said("EARL-E010", "`m[4]/ve` is wrong", here, "fix it"),
+        Said("EARL-E010", "`m[2]/ve` is wrong", there, "fix it"),
+        Said("EARL-E011", "`m[5]/ve` is wrong", here, None),
+    ]
+    assert [(s.code, s.message, s.location) for s in merge_family_members(found)] == [
+        ("EARL-E010", "`m[1, 3, 4]/ve` is wrong", here),
+        ("EARL-E010", "`m[2]/ve` is wrong", there),
+        ("EARL-E011", "`m[5]/ve` is wrong", here),
+    ]

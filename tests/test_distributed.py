@@ -300,13 +300,14 @@ def test_a_peer_that_finishes_its_run_is_no_fault_but_one_killed_is(tmp_path: Pa
     receiver = run(
         processes,
         tmp_path / "receiver.log",
-        [*common, "--agents", "receiver/a", "--duration", "6s", "--trace", str(tmp_path / "r.mcap")],
+        # long enough for the second sender to start, be seen and be killed on a busy machine
+        [*common, "--agents", "receiver/a", "--duration", "12s", "--trace", str(tmp_path / "r.mcap")],
     )
     sender = run(processes, tmp_path / "sender.log", [*common, "--agents", "sender/a", "--duration", "2s"])
     assert sender.finish(60) == 0, sender.output
-    receiver.wait_for("sender/a finished its run: ", 30)
+    finished = receiver.wait_for("sender/a finished its run: ", 30)
     again = run(processes, tmp_path / "again.log", [*common, "--agents", "sender/a", "--duration", "60s"])
-    back = receiver.wait_for("sender/a is alive: receiver/a.cs ", 30)
+    back = receiver.wait_for("sender/a is alive: receiver/a.cs ", 30, after=finished)
     time.sleep(0.5)
     os.kill(again.child.pid, signal.SIGKILL)
     receiver.wait_for("sender/a disappeared", 30, after=back)
@@ -473,6 +474,21 @@ def test_launch_checks_the_duration_and_names_processes_of_other_hosts_before_st
         check=False,
     )
     assert "[sender/a  ] runs on host `locahost`, not started here" in result.stdout, result.stdout
+
+
+def test_launch_refuses_to_split_the_robots_effectors_from_their_environment(tmp_path: Path) -> None:
+    """manip/a and grip/a drive MuJoCo's actuators: in two processes each would simulate a world of its own."""
+    deploy = deployment(tmp_path, [(["task/a"], False), (["manip/a"], True), (["grip/a"], False)])
+    result = subprocess.run(
+        [sys.executable, "-m", "earl.cli.main", "launch", str(PICK_AND_PLACE), "--deployment", str(deploy)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=False,
+    )
+    assert result.returncode == 1, result.stderr
+    assert "process 3 runs `grip/a`, whose Real Effectors or Receptors act on the environment" in result.stderr
+    assert "started" not in result.stdout and "Traceback" not in result.stderr
 
 
 def test_pick_and_place_split_over_two_processes_survives_a_killed_task_agent_and_completes(

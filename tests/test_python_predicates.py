@@ -6,6 +6,7 @@ The spec below is also tests/runtime_specs/thresholds/system.earl, so the other 
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import pytest
@@ -124,3 +125,33 @@ def test_a_predicate_that_raises_is_a_fault_and_counts_as_false(tmp_path: Path) 
     assert sim.state_of("counter/a.cs").state == "count"
     assert sim.faults and sim.faults[0].kind == "predicate"
     assert "does not declare that it reads `y`" in sim.faults[0].message
+
+
+def test_a_predicate_is_asked_once_per_decision_however_many_conditions_name_it(tmp_path: Path) -> None:
+    """`big/pp` is the terminal condition and the transition's condition: one call per iteration, and a
+    predicate with state (a debounce, a random draw) decides as it answered."""
+    code = CODE.replace(
+        'def big(inputs, context):\n    return inputs.x >= context.parameters["LIMIT"]\n',
+        "CALLS = []\n\n\ndef big(inputs, context):\n    CALLS.append(context.time)\n"
+        "    return len(CALLS) == 3  # true once, on its third call\n",
+    )
+    sim = earl.simulate(earl.load(write(tmp_path, code)))
+    try:
+        sim.advance_to(0.0045)
+        import limits  # type: ignore[import-not-found]
+
+        assert limits.CALLS == [0.0, 0.001, 0.002]  # each iteration once; after the third, state `done`
+        assert sim.state_of("counter/a.cs").state == "done"
+    finally:
+        sim.close()
+        sys.modules.pop("limits", None)
+
+
+def test_a_predicate_that_raises_is_one_fault_per_decision(tmp_path: Path) -> None:
+    spec = write(tmp_path, CODE.replace("return inputs.x >=", "return inputs.y >="))
+    sim = earl.simulate(earl.load(spec))
+    try:
+        sim.advance_to(0.0005)  # one iteration
+        assert [f.kind for f in sim.faults] == ["predicate"]
+    finally:
+        sim.close()

@@ -578,6 +578,21 @@ def test_a_run_toml_setting_of_the_wrong_kind_is_a_usage_error(
     assert "Traceback" not in error
 
 
+def test_run_toml_is_read_next_to_the_spec_a_symbolic_link_points_to(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """As the spec's imports and Python modules: next to the file itself."""
+    from earl.cli.main import main
+
+    spec = counter_copy(tmp_path)
+    (spec.parent / "run.toml").write_text("colour = 1\n")
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    (elsewhere / "system.earl").symlink_to(spec)
+    assert main(["run", str(elsewhere / "system.earl"), "--duration", "10ms", "--no-progress"]) == 2
+    assert "unknown setting `colour`" in capsys.readouterr().err
+
+
 @pytest.mark.parametrize("seed", ["-1", "x", "1.5"])
 def test_a_seed_that_is_not_a_whole_number_from_zero_is_a_usage_error(seed: str) -> None:
     result = earl_cli("run", str(SPECS / "counter"), f"--seed={seed}", "--duration", "10ms")

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import re
 import shutil
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -329,6 +330,86 @@ def lone_waiter(tmp_path: Path, spec: str) -> tuple[Simulation, Events]:
     return earl.simulate(earl.load(tmp_path / "system.earl"), recorders=[events], check=False), events
 
 
+EVERY_THIRD = """\
+system everyThird
+
+a/a {
+    cs {
+        period 10 ms
+        count/m: int = 0
+        val/ob: int
+        false/pp = false
+        inc/pf(count/mi -> count/mo) = python "third:inc"
+        send/pf(count/mi -> val/ob) = python "third:send"
+        run/bb {
+            tf = {inc/pf} then {send/pf}
+            tc = false/pp
+        }
+        fsm {
+            initial run
+            state run: run/bb
+        }
+    }
+}
+
+b/a {
+    cs {
+        val/ib: int
+        got/m: int = 0
+        false/pp = false
+        take/pf(val/ib -> got/mo) = python "third:take"
+        run/bb {
+            tf = {take/pf}
+            tc = false/pp
+        }
+        fsm {
+            initial run
+            state run: run/bb { obligatory val/ib  timeout 1 s }
+        }
+    }
+}
+
+link a,b: a/a.cs.val -> b/a.cs.val
+
+r/r {
+    a/a
+    b/a
+}
+"""
+
+
+class _Still:
+    """An environment that does nothing: with one, every event goes through the scheduler's queue."""
+
+    def advance(self, seconds: float) -> None:
+        pass
+
+
+def test_a_subsystem_woken_by_a_sender_running_alone_takes_each_message_when_it_arrives(tmp_path: Path) -> None:
+    """The sender runs in the scheduler's tight loop (`_run_alone`); the receiver it wakes must run at
+    once, in the sender's instant, and not after the sender has run on to the end of `advance_to`."""
+    (tmp_path / "system.earl").write_text(EVERY_THIRD)
+    (tmp_path / "third.py").write_text(
+        "TAKEN = []\n"
+        "def inc(i, o, c):\n    o.count = i.count + 1\n"
+        "def send(i, o, c):\n    if i.count % 3 == 1:\n        o.val = i.count\n"
+        "def take(i, o, c):\n    o.got = i.val\n    TAKEN.append((round(c.time, 6), i.val))\n"
+    )
+    runs = []
+    for environment, chunks in ((None, [0.2]), (_Still(), [0.2]), (None, [0.05, 0.1, 0.15, 0.2])):
+        sim = earl.simulate(earl.load(tmp_path / "system.earl"), environment=environment)
+        try:
+            taken = sys.modules["third"].TAKEN
+            taken.clear()
+            for until in chunks:
+                sim.advance_to(until)
+            runs.append(list(taken))
+        finally:
+            sim.close()
+    wanted = [(0.0, 0), (0.0, 1), (0.03, 4), (0.06, 7), (0.09, 10), (0.12, 13), (0.15, 16), (0.18, 19)]
+    assert runs == [wanted, wanted, wanted]
+
+
 def test_a_lone_subsystem_that_waits_for_a_buffer_times_out_on_time(tmp_path: Path) -> None:
     # One engine alone runs in the scheduler's tight loop (`_run_alone`); a wait must leave it
     # for the timeout event exactly as the general loop does: start, wait 3 ms, start again.
@@ -363,14 +444,30 @@ def test_stale_reads_the_set_of_buffers_whose_remote_sender_is_gone(tmp_path: Pa
         sim.close()
 
 
-def test_the_python_api_refuses_a_parameter_the_system_does_not_declare() -> None:
-    """As `earl run --param` does (EARL-R001): a misspelt name must not leave the default in place."""
+@pytest.mark.parametrize("check", [True, False])
+def test_the_python_api_refuses_a_parameter_the_system_does_not_declare(check: bool) -> None:
+    """As `earl run --param` does (EARL-R001): a misspelt name must not leave the default in place,
+    with the checker switched off too."""
     system = earl.load(SPECS / "counter")
     with pytest.raises(earl.EarlError) as refused:
-        earl.simulate(system, parameters={"LIMTI": 3})
+        earl.simulate(system, parameters={"LIMTI": 3}, check=check)
     [diagnostic] = refused.value.diagnostics
     assert diagnostic.code == "EARL-R001" and "`LIMTI`" in diagnostic.message
     assert diagnostic.hint == "did you mean `LIMIT`?"
+
+
+def test_parameters_given_to_load_are_the_system_s_own() -> None:
+    """`earl.load(path, {"N": 3})`, as the README shows it: the model, its run and its text have N = 3."""
+    example = Path(__file__).parent.parent / "examples" / "pick_and_place"
+    system = earl.load(example, {"N": 3})
+    assert "param N: int = 3" in system.to_earl()
+    sim = earl.simulate(system, environment=None)
+    try:
+        assert [name for name in sim.subsystems if "/a.motorController[" in name] == [
+            f"manip/a.motorController[{k}]/ve" for k in (1, 2, 3)
+        ]
+    finally:
+        sim.close()
 
 
 @pytest.mark.parametrize(

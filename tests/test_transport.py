@@ -136,6 +136,60 @@ def test_the_examples_deployment_puts_every_agent_in_one_process() -> None:
     assert deployment.connect_for(robot) == [deployment.group_of(["task/a"]).listen]
 
 
+def _placed(tmp_path: Path, processes: list[tuple[list[str], str]], acting: list[str]) -> list[bool | None]:
+    """Where the environment runs for a deployment of `processes` (agents, extra lines of the table)."""
+    lines = []
+    for number, (agents, extra) in enumerate(processes):
+        names = ", ".join(f'"{a}"' for a in agents)
+        lines += ["[[process]]", f"agents = [{names}]", f'listen = "tcp/127.0.0.1:{7500 + number}"', extra, ""]
+    (tmp_path / "deploy.toml").write_text("\n".join(lines))
+    placed = read_deployment(tmp_path / "deploy.toml").place_environment(acting)
+    return [process.environment for process in placed.processes]
+
+
+ROBOT, TASK = ["manip/a", "grip/a"], ["task/a"]
+
+
+def test_the_environment_goes_to_the_process_whose_agents_act_on_it_unless_the_file_says(tmp_path: Path) -> None:
+    assert _placed(tmp_path, [(TASK, ""), (ROBOT, "")], ROBOT) == [False, True]
+    assert _placed(tmp_path, [(TASK, "environment = false"), (ROBOT, "environment = true")], ROBOT) == [False, True]
+    assert _placed(tmp_path, [(TASK, "environment = false"), (ROBOT, "")], ROBOT) == [False, True]
+    assert _placed(tmp_path, [(TASK, ""), (["b/a"], "")], []) == [True, False]  # nobody acts: the first
+    # the robot's process keeps its effectors away from any environment: nobody gets one
+    assert _placed(tmp_path, [(TASK, ""), (ROBOT, "environment = false")], ROBOT) == [False, False]
+    # a process that names its own environment in `args` is left to the user
+    args = 'args = ["--environment", "hardware:open"]'
+    assert _placed(tmp_path, [(["manip/a"], args), (["grip/a"], "")], ROBOT) == [None, True]
+
+
+@pytest.mark.parametrize(
+    ("processes", "fragment"),
+    [
+        (
+            [(TASK, ""), (["manip/a"], ""), (["grip/a"], "")],
+            "the environment would run in process 2 (manip/a) and in process 3 (grip/a), each simulating a "
+            "world of its own",
+        ),
+        (
+            [(TASK, "environment = true"), (ROBOT, "")],
+            "process 2 runs `manip/a`, whose Real Effectors or Receptors act on the environment, but the "
+            "environment lives in process 1 (task/a); run `manip/a` in process 1",
+        ),
+        (
+            [(["manip/a"], "environment = true"), (["grip/a", "task/a"], "")],
+            "process 2 runs `grip/a`, whose Real Effectors or Receptors act on the environment, but the "
+            "environment lives in process 1 (manip/a)",
+        ),
+    ],
+)
+def test_an_environment_that_would_run_twice_or_apart_from_its_effectors_is_refused(
+    tmp_path: Path, processes: list[tuple[list[str], str]], fragment: str
+) -> None:
+    with pytest.raises(DeploymentError) as raised:
+        _placed(tmp_path, processes, ROBOT)
+    assert fragment in str(raised.value)
+
+
 @pytest.mark.parametrize(
     ("text", "fragment"),
     [

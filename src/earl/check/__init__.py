@@ -12,6 +12,7 @@ from collections.abc import Mapping
 
 from earl.check import fsm_analysis, rules_behaviour, rules_communication, rules_structure
 from earl.check.context import CheckContext
+from earl.check.merging import Said, merge_family_members
 from earl.check.registry import RULES, Finding, Rule
 from earl.collector import paused as collector_paused
 from earl.diagnostics import Diagnostic, Severity, did_you_mean
@@ -77,17 +78,15 @@ def wrong_parameter_values(system: System, parameters: Mapping[str, object]) -> 
 def check_context(context: CheckContext) -> list[Diagnostic]:
     """Every finding of every rule over an already expanded system (`context_for`)."""
     with collector_paused():
-        diagnostics: list[Diagnostic] = []
-        seen: set[tuple[str, object, str]] = set()
-        for rule in RULES.values():
-            for finding in rule.check(context):
-                key = (rule.code, finding.location, finding.message)
-                if key in seen:
-                    continue
-                seen.add(key)
-                diagnostics.append(
-                    Diagnostic(rule.severity, finding.message, finding.location, rule.code, finding.hint)
-                )
+        found = [
+            Said(rule.code, finding.message, finding.location, finding.hint)
+            for rule in RULES.values()
+            for finding in rule.check(context)
+        ]
+    diagnostics = [
+        Diagnostic(RULES[said.code].severity, said.message, said.location, said.code, said.hint)
+        for said in merge_family_members(found)
+    ]
     root = context.declared.source_file
     diagnostics.sort(
         key=lambda d: (

@@ -1,17 +1,29 @@
 """FSM analysis: overlapping, dead and missing transition conditions, decided with binary decision diagrams.
 
-Each primitive predicate is a free Boolean variable (a predicate defined by a
-constant, like the manual's `false/pp`, is that constant); any other Boolean
-sub-formula that is not built from `and`, `or`, `not` (a comparison, a call of
-`newData`) is a variable of its own.  The `assume` formulas of the FSM constrain
-the variables.  With these, for every state of every FSM:
+A transition condition is a Boolean formula over *atoms*: each comparison, each call of
+`newData`/`timeout`/`stale`, each Boolean value read from a buffer or memory is a variable;
+`and`, `or`, `not` and `==`/`!=` between Booleans are the BDD's own operations, and a
+sub-formula of constants (`2 == 1` in member 2 of a family) is folded to its value.  A
+primitive predicate is a variable of its own, tied to its definition, so a message can say
+`hot/pp = true` while the analysis knows that `hot/pp` *is* `v/ib > 3.0`.  What the atoms
+mean adds constraints, conjoined with the FSM's `assume` formulas:
 
-- two leaving transitions whose conditions can hold together, without distinct
-  priorities, make the FSM nondeterministic (error, with one assignment);
-- a behaviour that can stop (`tc or ec`) while no leaving transition holds is stuck
-  (warning, with one assignment);
-- a condition that can never hold is a dead transition (warning);
-- a behaviour whose `tc` and `ec` can never hold never ends (note: fine for a sink state).
+- comparisons of one value with constants (`v/ib > 5.0`, `v/ib < 3.0`, `mode/ib == "stop"`) are
+  decided over the real numbers (or the distinct strings): `v/ib > 5.0 and v/ib < 3.0` never holds.
+  An `int` value is treated as a real, so `n/ib > 3 and n/ib < 4` is thought possible;
+- `newData(x/ib.field)` holds only when `newData(x/ib)` does, and `timeout(x/ib)` and
+  `stale(x/ib)` only when it does not (docs/semantics.md).
+
+The transitions leaving a state are evaluated only when its behaviour stops (`tc or ec`, step 5
+of docs/semantics.md), in priority order.  With these, for every state of every FSM:
+
+- two leaving transitions whose conditions can hold together when the behaviour stops, without
+  distinct priorities, make the FSM nondeterministic (error, with one assignment);
+- a behaviour that can stop while no leaving transition holds is stuck (warning, with one assignment);
+- a transition that can never be taken — its condition never holds when the behaviour stops, or
+  a transition of higher priority always holds then too — is dead (warning);
+- a behaviour whose `tc` and `ec` can never hold never ends (note: fine for a sink state);
+- `assume` formulas that can never hold together would switch every check off (error).
 
 The BDDs come from `dd` (a maintained BDD package; its pure-Python backend needs no
 compiler), not from a hand-made solver.
@@ -20,6 +32,7 @@ compiler), not from a hand-made solver.
 from __future__ import annotations
 
 import importlib
+import itertools
 import sys
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -27,10 +40,23 @@ from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
 from earl.check.context import CheckContext, subsystem_name
+from earl.check.expression_types import BOOLEAN, ExpressionTyper
 from earl.check.registry import Finding, rule
 from earl.diagnostics import Severity
-from earl.model.elements import FSM, Subsystem, Transition
-from earl.model.expressions import BooleanOperation, Expression, Literal, Not, Read, evaluate_constant, walk
+from earl.model.elements import FSM, Agent, Subsystem, Transition
+from earl.model.expressions import (
+    Arithmetic,
+    BooleanOperation,
+    Call,
+    Comparison,
+    ConstantError,
+    Expression,
+    Literal,
+    Negate,
+    Not,
+    Read,
+    evaluate_constant,
+)
 from earl.model.kinds import Kind
 from earl.model.text import expression_text
 
@@ -67,21 +93,71 @@ class Analysis:
     findings: dict[str, list[Finding]]
 
 
+Constant = bool | int | float | str
+
+_ORDERINGS = {
+    "<": lambda a, b: a < b,
+    "<=": lambda a, b: a <= b,
+    ">": lambda a, b: a > b,
+    ">=": lambda a, b: a >= b,
+    "==": lambda a, b: a == b,
+    "!=": lambda a, b: a != b,
+}
+#: `c < x` is `x > c`
+_MIRRORED = {"<": ">", "<=": ">=", ">": "<", ">=": "<=", "==": "==", "!=": "!="}
+
+
+def _constant(expression: Expression) -> Constant | None:
+    """The value of a sub-formula of constants (the expansion put family indices and parameters in)."""
+    if isinstance(expression, (Literal, Negate, Arithmetic)):
+        try:
+            return evaluate_constant(expression, {})
+        except ConstantError:
+            return None
+    if isinstance(expression, Not):
+        operand = _constant(expression.operand)
+        return (not operand) if isinstance(operand, bool) else None
+    if isinstance(expression, BooleanOperation):
+        values = [_constant(operand) for operand in expression.operands]
+        if not all(isinstance(value, bool) for value in values):
+            return None
+        return all(values) if expression.operator == "and" else any(values)
+    if isinstance(expression, Comparison):
+        left, right = _constant(expression.left), _constant(expression.right)
+        if left is None or right is None or isinstance(left, bool) != isinstance(right, bool):
+            return None
+        if isinstance(left, str) != isinstance(right, str):
+            return None
+        if expression.operator not in ("==", "!=") and (isinstance(left, (str, bool))):
+            return None
+        return bool(_ORDERINGS[expression.operator](left, right))
+    return None
+
+
+def _is_number(value: object) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
 class _Encoder:
-    def __init__(self, subsystem: Subsystem) -> None:
+    """Formulas of one subsystem as BDDs, and the constraints that say what their atoms mean."""
+
+    def __init__(self, context: CheckContext, subsystem: Subsystem) -> None:
         self.bdd = BDD()
         self.subsystem = subsystem
+        self.typer = ExpressionTyper(context, subsystem)
         self.names: dict[str, str] = {}  # BDD variable → the text a person reads
         self.by_text: dict[str, str] = {}
-        self.constants: dict[str, bool] = {}
-        for predicate in subsystem.primitive_predicates:
-            if not any(isinstance(node, Read) for node in walk(predicate.expression)):
-                try:
-                    value = evaluate_constant(predicate.expression, {})
-                except ValueError:
-                    continue
-                if isinstance(value, bool):
-                    self.constants[predicate.name] = value
+        #: the variables a condition names itself; examples show these, not what predicates stand for
+        self.surface: set[str] = set()
+        self._depth = 0  # > 0 while encoding a predicate's definition
+        self.definitions: dict[str, Expression] = {p.name: p.expression for p in subsystem.primitive_predicates}
+        self._defining: set[str] = set()
+        self._constants: dict[str, Function] = {}  # predicates whose definitions are constants
+        self.meaning = self.bdd.true  # what the atoms mean: definitions, comparisons, newData
+        #: per compared value (its text): the comparisons with a constant, as (operator, constant, variable)
+        self.comparisons: dict[str, list[tuple[str, Constant, Function]]] = {}
+        self.calls: dict[tuple[str, str], Function] = {}  # (function, argument text) → variable
+        self.call_arguments: dict[str, Read] = {}
 
     def variable(self, text: str) -> Function:
         name = self.by_text.get(text)
@@ -89,11 +165,14 @@ class _Encoder:
             name = self.by_text[text] = f"v{len(self.by_text)}"
             self.names[name] = text
             self.bdd.declare(name)
+        if self._depth == 0:
+            self.surface.add(name)
         return self.bdd.var(name)
 
     def encode(self, expression: Expression) -> Function:
-        if isinstance(expression, Literal) and isinstance(expression.value, bool):
-            return self.bdd.true if expression.value else self.bdd.false
+        folded = _constant(expression)
+        if isinstance(folded, bool):
+            return self.bdd.true if folded else self.bdd.false
         if isinstance(expression, Not):
             return ~self.encode(expression.operand)
         if isinstance(expression, BooleanOperation):
@@ -103,13 +182,101 @@ class _Encoder:
                 result = (result & operand) if expression.operator == "and" else (result | operand)
             return result
         if isinstance(expression, Read) and expression.target.kind is Kind.PRIMITIVE_PREDICATE and not expression.path:
-            constant = self.constants.get(expression.target.name)
-            if constant is not None:
-                return self.bdd.true if constant else self.bdd.false
+            return self._predicate(expression)
+        if isinstance(expression, Comparison):
+            return self._comparison(expression)
+        if isinstance(expression, Call) and len(expression.arguments) == 1:
+            argument = expression.arguments[0]
+            variable = self.variable(expression_text(expression))
+            if isinstance(argument, Read):
+                self.calls[(expression.function, expression_text(argument))] = variable
+                self.call_arguments[expression_text(argument)] = argument
+            return variable
         return self.variable(expression_text(expression))
 
+    def _predicate(self, read: Read) -> Function:
+        text = expression_text(read)
+        name = read.target.name
+        definition = self.definitions.get(name)
+        if definition is not None and name not in self._defining and text not in self.by_text:
+            self._defining.add(name)  # each once; a predicate defined through itself stays free
+            self._depth += 1
+            try:
+                meaning = self.encode(definition)
+            finally:
+                self._depth -= 1
+            if meaning in (self.bdd.true, self.bdd.false):
+                self._constants[name] = meaning  # the manual's `false/pp`: the constant itself
+            else:
+                self.meaning &= self.variable(text).equiv(meaning)
+        constant = self._constants.get(name)
+        return constant if constant is not None else self.variable(text)
+
+    def _comparison(self, comparison: Comparison) -> Function:
+        text = expression_text(comparison)
+        left, right = _constant(comparison.left), _constant(comparison.right)
+        operator = comparison.operator
+        if left is not None and right is None:
+            left, right, operator = right, left, _MIRRORED[operator]
+            value_side = comparison.right
+        else:
+            value_side = comparison.left
+        if right is not None and left is None:
+            if isinstance(right, bool) and operator in ("==", "!="):
+                # `s/ib.b == false` is `not s/ib.b`: the Boolean itself, not an atom of its own
+                value = self.encode(value_side)
+                return value if (operator == "==") == right else ~value
+            variable = self.variable(text)
+            self.comparisons.setdefault(expression_text(value_side), []).append((operator, right, variable))
+            return variable
+        if operator in ("==", "!=") and BOOLEAN == self.typer.type_of(comparison.left) == self.typer.type_of(
+            comparison.right
+        ):
+            same = self.encode(comparison.left).equiv(self.encode(comparison.right))
+            return same if operator == "==" else ~same
+        return self.variable(text)
+
+    def constraints(self) -> Function:
+        """What the atoms mean (call once every formula is encoded)."""
+        meaning = self.meaning
+        for atoms in self.comparisons.values():
+            meaning &= self._regions(atoms)
+        for (function, argument), variable in self.calls.items():
+            read = self.call_arguments[argument]
+            whole = self.calls.get(("newData", expression_text(Read(read.target))))
+            if function == "newData" and read.path and whole is not None:
+                meaning &= variable.implies(whole)
+            elif function in ("timeout", "stale") and not read.path:
+                arrived = self.calls.get(("newData", argument))
+                if arrived is not None:
+                    meaning &= variable.implies(~arrived)
+        return meaning
+
+    def _regions(self, atoms: list[tuple[str, Constant, Function]]) -> Function:
+        """One value compared with constants lies in one region of the line (or is one of the strings):
+        the atoms hold together only as in one of the regions."""
+        constants = [constant for _, constant, _ in atoms]
+        if all(_is_number(c) for c in constants):
+            points = sorted({float(c) for c in constants})  # type: ignore[arg-type]
+            samples: list[Constant] = [points[0] - 1.0, points[-1] + 1.0]
+            samples += points
+            samples += [(low + high) / 2 for low, high in itertools.pairwise(points)]
+        elif all(isinstance(c, str) for c in constants) and all(op in ("==", "!=") for op, _, _ in atoms):
+            samples = [*dict.fromkeys(constants), object()]  # type: ignore[list-item]  # the strings, and any other
+        else:
+            return self.bdd.true
+        regions = self.bdd.false
+        for sample in samples:
+            region = self.bdd.true
+            for operator, constant, variable in atoms:
+                region &= variable if _ORDERINGS[operator](sample, constant) else ~variable
+            regions |= region
+        return regions
+
     def example(self, formula: Function) -> str:
-        assignment: dict[str, Any] = self.bdd.pick(formula) or {}
+        hidden = [name for name in self.names if name not in self.surface]
+        shown = self.bdd.exist(hidden, formula) if hidden else formula
+        assignment: dict[str, Any] = self.bdd.pick(shown) or {}
         if not assignment:
             return "always"
         parts = [
@@ -125,28 +292,50 @@ def _distinct_priorities(first: Transition, second: Transition) -> bool:
     return first.priority != second.priority
 
 
-def analyse(subsystem: Subsystem, fsm: FSM, owner: str) -> Analysis:
-    encoder = _Encoder(subsystem)
+def _evaluation_order(transitions: list[Transition]) -> list[Transition]:
+    """As `fsm.selectState()` tries them: `priority 1` first, those without a priority last."""
+    return sorted(transitions, key=lambda t: (t.priority is None, t.priority or 0))
+
+
+def analyse(context: CheckContext, subsystem: Subsystem, fsm: FSM, owner: str) -> Analysis:
+    encoder = _Encoder(context, subsystem)
     bdd = encoder.bdd
     findings: dict[str, list[Finding]] = {
-        code: [] for code in ("EARL-E060", "EARL-W061", "EARL-W062", "EARL-I063", "EARL-W021", "EARL-W020")
+        code: [] for code in ("EARL-E064", "EARL-E060", "EARL-W061", "EARL-W062", "EARL-I063", "EARL-W021", "EARL-W020")
     }
     assumed = bdd.true
     for assumption in fsm.assumptions:
         assumed &= encoder.encode(assumption.expression)
     conditions = {id(t): encoder.encode(t.condition.expression) for t in fsm.transitions}
-    ending: dict[str, bool] = {}
+    stops: dict[str, Function] = {}
+    for state in fsm.states:
+        behaviour = subsystem.basic_behaviour(state.behaviour)
+        if behaviour is not None:
+            stop = encoder.encode(behaviour.terminal_condition.expression)
+            if behaviour.error_condition is not None:
+                stop |= encoder.encode(behaviour.error_condition.expression)
+            stops[state.name] = stop
+    meaning = encoder.constraints()
+    if fsm.assumptions and (assumed & meaning) == bdd.false:
+        findings["EARL-E064"].append(
+            Finding(
+                f"the `assume` formulas of {owner} can never hold, so they would hide every overlap of its transitions",
+                fsm.assumptions[0].location,
+                "an assumption states what always holds of the inputs; correct the one that contradicts the others",
+            )
+        )
+        return Analysis(findings)
+    assumed &= meaning
+    #: per transition: when `fsm.selectState()` takes it (its behaviour stopped, nothing before it held)
+    taken: dict[int, Function] = {}
+    dead: dict[int, Finding] = {}  # transitions of states that can stop which are never taken, and why
     for state in fsm.states:
         behaviour = subsystem.basic_behaviour(state.behaviour)
         if behaviour is None:
             continue
-        stop = encoder.encode(behaviour.terminal_condition.expression)
-        if behaviour.error_condition is not None:
-            stop |= encoder.encode(behaviour.error_condition.expression)
-        can_stop = (stop & assumed) != bdd.false
-        ending[state.name] = can_stop
+        stop = stops[state.name] & assumed
         leaving = [t for t in fsm.transitions if t.source == state.name]
-        if not can_stop:
+        if stop == bdd.false:
             findings["EARL-I063"].append(
                 Finding(
                     f"`{behaviour.name}/bb` never ends: its terminal and error conditions can never hold, so state `{state.name}` of {owner} is never left",
@@ -164,20 +353,38 @@ def analyse(subsystem: Subsystem, fsm: FSM, owner: str) -> Analysis:
                 )
             )
             continue
-        for transition in leaving:
-            if (conditions[id(transition)] & assumed) == bdd.false:
-                findings["EARL-W062"].append(
-                    Finding(
-                        f"transition `{transition.name}/t` of {owner} can never be taken: its condition never holds",
-                        transition.location,
-                        "check the condition and the `assume` formulas",
-                    )
+        ordered = _evaluation_order(leaving)
+        for position, transition in enumerate(ordered):
+            holds = conditions[id(transition)] & stop
+            before = [t for t in ordered[:position] if _distinct_priorities(t, transition)]
+            first_to_hold = holds
+            for earlier in before:
+                first_to_hold &= ~conditions[id(earlier)]
+            taken[id(transition)] = first_to_hold
+            if holds == bdd.false:
+                never = (
+                    "its condition never holds"
+                    if (conditions[id(transition)] & assumed) == bdd.false
+                    else f"its condition never holds when `{behaviour.name}/bb` stops"
+                )
+                dead[id(transition)] = Finding(
+                    f"transition `{transition.name}/t` of {owner} can never be taken: {never}",
+                    transition.location,
+                    "check the condition, the behaviour's terminal condition and the `assume` formulas",
+                )
+            elif first_to_hold == bdd.false:
+                winner = next(t for t in before if (holds & conditions[id(t)]) != bdd.false)
+                dead[id(transition)] = Finding(
+                    f"transition `{transition.name}/t` of {owner} can never be taken: whenever its condition "
+                    f"holds, `{winner.name}/t` holds too and is tried first",
+                    transition.location,
+                    "narrow the condition of the transition tried first, or change the priorities",
                 )
         for position, first in enumerate(leaving):
             for second in leaving[position + 1 :]:
                 if _distinct_priorities(first, second):
                     continue
-                both = conditions[id(first)] & conditions[id(second)] & assumed
+                both = conditions[id(first)] & conditions[id(second)] & stop
                 if both != bdd.false:
                     findings["EARL-E060"].append(
                         Finding(
@@ -189,24 +396,38 @@ def analyse(subsystem: Subsystem, fsm: FSM, owner: str) -> Analysis:
         none_holds = bdd.true
         for transition in leaving:
             none_holds &= ~conditions[id(transition)]
-        stuck = stop & none_holds & assumed
+        stuck = stop & none_holds
         if stuck != bdd.false:
             findings["EARL-W061"].append(
                 Finding(
                     f"`{behaviour.name}/bb` can stop while no transition out of `{state.name}` holds ({owner}), e.g. when {encoder.example(stuck)}",
                     state.location,
-                    "add a transition for this case, or narrow the terminal condition",
+                    "add a transition for this case, narrow the terminal condition, or declare an `assume` that rules it out",
                 )
             )
-    # Reachability through transitions that can be taken from behaviours that can end.
+    # `* -> recover` stands for one transition from every other state: dead only when none is ever taken.
+    declared: dict[object, list[Transition]] = {}
+    for transition in fsm.transitions:
+        declared.setdefault(transition.location or id(transition), []).append(transition)
+    for group in declared.values():
+        if len(group) == 1:
+            if id(group[0]) in dead:
+                findings["EARL-W062"].append(dead[id(group[0])])
+        elif all(taken.get(id(t), bdd.false) == bdd.false for t in group):
+            findings["EARL-W062"].append(
+                Finding(
+                    f"transition `*,{group[0].destination}/t` of {owner} can never be taken from any state",
+                    group[0].location,
+                    "check the condition, the behaviours' terminal conditions and the `assume` formulas",
+                )
+            )
+    # Reachability through transitions that can be taken.
     reachable = {fsm.initial}
     frontier = [fsm.initial]
     while frontier:
         source = frontier.pop()
-        if not ending.get(source, False):
-            continue
         for transition in fsm.transitions:
-            possible = transition.source == source and (conditions[id(transition)] & assumed) != bdd.false
+            possible = transition.source == source and taken.get(id(transition), bdd.false) != bdd.false
             if possible and transition.destination not in reachable:
                 reachable.add(transition.destination)
                 frontier.append(transition.destination)
@@ -222,54 +443,40 @@ def analyse(subsystem: Subsystem, fsm: FSM, owner: str) -> Analysis:
     return Analysis(findings)
 
 
-def _fsm_key(subsystem: Subsystem) -> tuple[object, ...]:
-    """Family members usually have identical FSMs: analyse each distinct one once."""
-    fsm = subsystem.fsm
-    assert fsm is not None
-    parts: list[object] = [id(subsystem.location), fsm.initial]
-    parts += [(p.name, expression_text(p.expression)) for p in subsystem.primitive_predicates]
-    parts += [(s.name, s.behaviour) for s in fsm.states]
-    parts += [(t.source, t.destination, t.priority, expression_text(t.condition.expression)) for t in fsm.transitions]
-    parts += [expression_text(a.expression) for a in fsm.assumptions]
-    for behaviour in subsystem.basic_behaviours:
-        parts.append(expression_text(behaviour.terminal_condition.expression))
-        parts.append(
-            None if behaviour.error_condition is None else expression_text(behaviour.error_condition.expression)
-        )
-    return tuple(parts)
+#: stands for the subsystem in the messages of an analysis shared by the members of a family
+_OWNER = "\x00owner\x00"
 
 
 def analyses(context: CheckContext) -> dict[str, list[Finding]]:
-    """Every FSM of the system analysed once; cached on the context for the rules below."""
+    """Every FSM of the system analysed once per distinct content; cached on the context for the rules below.
+
+    Members of a family whose bodies are the same (`context.content_key`) are analysed once, and each
+    member's findings named after it, so that the check says them once with the indices as a range
+    (`w[1..4]/a.cs`); a member whose predicates depend on its index is analysed on its own."""
     cached = getattr(context, "_fsm_analyses", None)
     if cached is not None:
         return cached  # type: ignore[no-any-return]
     result: dict[str, list[Finding]] = {}
-    seen: set[tuple[object, ...]] = set()
-    for agent, subsystem in context.distinct_subsystems():
-        if subsystem.fsm is None:
-            continue
-        key = _fsm_key(subsystem)
-        if key in seen:
-            continue
-        seen.add(key)
-        owner = subsystem_name(agent, subsystem)
-        if subsystem.family is not None or agent.family is not None:
-            owner = f"{owner} (and the other members of its family)"
-        for code, found in analyse(subsystem, subsystem.fsm, owner).findings.items():
-            result.setdefault(code, []).extend(found)
+    groups: dict[object, list[tuple[Agent, Subsystem]]] = {}
+    for agent, subsystem in context.subsystems():
+        if subsystem.fsm is not None:
+            groups.setdefault(context.content_key(agent, subsystem), []).append((agent, subsystem))
+    for members in groups.values():
+        _, subsystem = members[0]
+        assert subsystem.fsm is not None
+        for code, found in analyse(context, subsystem, subsystem.fsm, _OWNER).findings.items():
+            named = result.setdefault(code, [])
+            for finding in found:
+                for member_agent, member in members:
+                    message = finding.message.replace(_OWNER, subsystem_name(member_agent, member))
+                    named.append(Finding(message, finding.location, finding.hint))
     context._fsm_analyses = result  # type: ignore[attr-defined]
     return result
 
 
 def _from_analysis(code: str) -> Any:
     def check(context: CheckContext) -> Iterator[Finding]:
-        seen: set[object] = set()
-        for finding in analyses(context).get(code, []):
-            key = (finding.location, finding.message.split(" of ")[0])
-            if key not in seen:
-                seen.add(key)
-                yield finding
+        yield from analyses(context).get(code, [])
 
     return check
 
@@ -288,9 +495,20 @@ _register(
     "transitions leaving a state do not overlap",
     "§2.2, Figure 5a, Table 5",
     "`fsm.selectState()` must pick one next state. Two transitions leaving one state whose initial conditions "
-    "can hold at once (under the FSM's `assume` formulas) need distinct priorities, or an assumption that "
-    "excludes the overlap. The manual's own Table 5 overlaps: `jointMove,jointMove/t` and `jointMove,idle/t` "
+    "can hold at once when its behaviour stops (under the FSM's `assume` formulas) need distinct priorities, "
+    "or an assumption that excludes the overlap. Comparisons of one value with constants are decided over "
+    "the numbers (`v/ib > 5.0` and `v/ib < 3.0` never hold together), a primitive predicate stands for its "
+    "definition. The manual's own Table 5 overlaps: `jointMove,jointMove/t` and `jointMove,idle/t` "
     "both hold when a new joint position arrives without an emergency stop.",
+)
+_register(
+    "EARL-E064",
+    Severity.ERROR,
+    "the assumptions of an FSM can hold",
+    "§2.2, Table 5",
+    "An `assume` formula states what always holds of a subsystem's inputs, and the FSM analysis considers "
+    "only situations in which every assumption holds. Assumptions that contradict each other leave no "
+    "situation at all: every overlap and every missing transition would pass unseen.",
 )
 _register(
     "EARL-W061",
@@ -305,7 +523,9 @@ _register(
     Severity.WARNING,
     "every transition can be taken",
     "§2.2, Table 5",
-    "A transition whose initial condition can never hold (under the assumptions) is dead specification.",
+    "A transition whose initial condition never holds when its state's behaviour stops (under the "
+    "assumptions), or whenever it holds a transition tried before it (a higher priority) holds too, is dead "
+    "specification. A `* -> x` transition is dead when it can be taken from no state.",
 )
 _register(
     "EARL-I063",

@@ -69,6 +69,7 @@ def register(commands: Any) -> None:
 
 
 def run(arguments: argparse.Namespace) -> int:
+    from earl.runtime.simulation import read_run_settings
     from earl.transport.deployment import DeploymentError, read_deployment
     from earl.transport.process import DEPLOYMENT_FILE
 
@@ -83,10 +84,17 @@ def run(arguments: argparse.Namespace) -> int:
         return usage_error(f"no deployment file {deployment_path}; name one with --deployment (docs/distributed.md)")
     try:
         deployment = read_deployment(deployment_path)
-        deployment.check_agents(_agents(path, arguments.param))
+        known, acting = _agents(path, arguments.param)
+        deployment.check_agents(known)
+        environment = read_run_settings(path).environment
+        if environment not in (None, "none"):
+            # each `earl run` places it by the same rule; said here, before anything starts
+            deployment = deployment.place_environment(acting)
     except DeploymentError as error:
         print(f"earl launch: {error}", file=sys.stderr)
         return EXIT_FAILED
+    except ValueError as error:  # a run.toml that cannot be used
+        return usage_error(str(error))
     except UsageError as error:
         return usage_error(str(error))
     except EarlError as error:
@@ -118,23 +126,25 @@ def run(arguments: argparse.Namespace) -> int:
         for process in local:
             if supervisor.stop_requested:
                 break
+            # whether the environment runs there, each process reads from the deployment file as checked above
             command = [sys.executable, "-m", "earl.cli.main", "run", *common, "--agents", process.label]
-            if not process.environment:
-                command += ["--environment", "none"]
             command += list(process.args)
             supervisor.start(process.label, command)
         return supervisor.wait()
 
 
-def _agents(spec: Path, parameters: list[str]) -> list[str]:
-    """The agents of the expanded system, so that a deployment missing one fails before anything starts."""
+def _agents(spec: Path, parameters: list[str]) -> tuple[list[str], list[str]]:
+    """The agents of the expanded system, and those with Real Effectors or Receptors, so that a
+    deployment missing one, or keeping one apart from the environment, fails before anything starts."""
     from earl.cli.common import parse_parameters
     from earl.lang.loader import load
     from earl.model.expand import expand
     from earl.runtime.names import agent_name
+    from earl.transport.process import acting_agents
 
     values = parse_parameters(parameters)
-    return [agent_name(agent) for agent in expand(load(spec, values), values).agents]
+    expanded = expand(load(spec, values), values)
+    return [agent_name(agent) for agent in expanded.agents], acting_agents(expanded)
 
 
 class _Supervisor:

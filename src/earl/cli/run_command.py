@@ -189,7 +189,13 @@ def run(arguments: argparse.Namespace) -> int:
         if arguments.transport == "zenoh":
             from earl.transport.process import open_transport
 
-            agents, transport = open_transport(system, parameters, path, agents or [], arguments)
+            # run.toml's environment lives where the deployment file puts it; --environment is the user's
+            from_settings = environment if arguments.environment is None else None
+            agents, transport, environment_here = open_transport(
+                system, parameters, path, agents or [], arguments, from_settings
+            )
+            if from_settings is not None and not environment_here:
+                environment = None
         elif agents:
             from earl.transport.process import agents_of
 

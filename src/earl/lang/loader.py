@@ -16,8 +16,9 @@ from earl.diagnostics import Diagnostic, EarlError, Severity, SourceMap
 from earl.lang.parser import MAX_FILE_BYTES, decode, parse_text, too_large
 from earl.lang.transformer import ParsedFile
 from earl.model.elements import Agent, Import, Link, Parameter, Robot, System
+from earl.model.expressions import Literal
 from earl.model.location import SourceLocation
-from earl.model.types import StructType, TypeAlias
+from earl.model.types import REAL_TYPES, StructType, TypeAlias
 
 ParameterValue = bool | int | float | str
 
@@ -144,7 +145,9 @@ def load_files(path: Path, sources: SourceMap) -> tuple[ParsedFile, list[ParsedF
             visit(child, target, [*chain, target])
             imported.append(child)
 
-    visit(root, path, [_resolved(path)])
+    # A file's imports are looked up next to the file itself, where a symbolic link to it points,
+    # for the root as for every imported file: a library linked into a project finds its own imports.
+    visit(root, _resolved(path), [_resolved(path)])
     return root, imported
 
 
@@ -206,7 +209,20 @@ def load(path: str | Path, parameters: Mapping[str, ParameterValue] | None = Non
     if errors:
         raise EarlError(errors, sources)
     system.sources = sources
+    set_parameters(system, parameters or {})
     return system
+
+
+def set_parameters(system: System, parameters: Mapping[str, ParameterValue]) -> None:
+    """The system's parameters take the values given (checked by `resolve` already), so that what is
+    checked, run, drawn and printed from the returned model is the system with them: `load(path,
+    {"N": 3})` is the spec with `param N: int = 3`."""
+    for parameter in system.parameters:
+        if parameter.name in parameters:
+            value = parameters[parameter.name]
+            if getattr(parameter.data_type, "name", "") in REAL_TYPES and type(value) is int:
+                value = float(value)  # `N = 3` for a double: the value the runtime would compute
+            parameter.value = Literal(value, parameter.value.location)
 
 
 def parse_file(path: str | Path) -> System:
@@ -276,7 +292,7 @@ def _loads(text: str, path: str, parameters: Mapping[str, ParameterValue] | None
 
     root = parse_text(text, path, sources)
     if any(isinstance(d, Import) for d in root.declarations):
-        base = Path(path).parent if path != "<text>" else Path.cwd()
+        base = _resolved(Path(path)).parent if path != "<text>" else Path.cwd()
         imported: list[ParsedFile] = []
         for declaration in root.declarations:
             if isinstance(declaration, Import):
@@ -290,4 +306,5 @@ def _loads(text: str, path: str, parameters: Mapping[str, ParameterValue] | None
     if errors:
         raise EarlError(errors, sources)
     system.sources = sources
+    set_parameters(system, parameters or {})
     return system

@@ -66,7 +66,7 @@ from earl.model.expressions import (
 )
 from earl.model.kinds import Kind
 from earl.model.location import SourceLocation
-from earl.model.types import ArrayType, DataType, StructType, TypeAlias
+from earl.model.types import REAL_TYPES, ArrayType, DataType, StructType, TypeAlias
 
 Value = bool | int | float | str
 Environment = dict[str, Value]
@@ -93,7 +93,7 @@ def parameter_values(
     result = dict(environment)
     for parameter in parameters:
         value = overrides[parameter.name] if parameter.name in overrides else evaluate_constant(parameter.value, result)
-        if getattr(parameter.data_type, "name", "") in ("double", "float32", "float64") and isinstance(value, int):
+        if getattr(parameter.data_type, "name", "") in REAL_TYPES and isinstance(value, int):
             value = float(value)
         result[parameter.name] = value
     return result

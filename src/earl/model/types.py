@@ -40,6 +40,9 @@ INTEGER_RANGES: dict[str, tuple[int, int]] = {
     "uint64": (0, 2**64 - 1),
 }
 
+#: The primitive types of real numbers: a whole number given for one is that real (`3` is `3.0`).
+REAL_TYPES: frozenset[str] = frozenset({"double", "float32", "float64"})
+
 #: The types a `param` may have, and the Python values each accepts (a boolean is no number here).
 PARAMETER_TYPES: dict[str, tuple[type, ...]] = {
     "boolean": (bool,),

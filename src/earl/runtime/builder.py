@@ -229,6 +229,7 @@ def _behaviour(
         if predicate.implementation is not None:
             try:
                 engine.predicates[predicate.name] = _python_predicate(engine, predicate)
+                engine.has_python_predicates = True
             except BindingProblem as problem:
                 problems.append(problem.diagnostic)
     functions: dict[str, FunctionRuntime] = {}
@@ -341,10 +342,25 @@ def _python_predicate(engine: SubsystemEngine, predicate: PrimitivePredicate) ->
     inputs = build_inputs(f"{predicate.name}/pp", predicate.reads, engine.inputs, engine.memory)
     refresh = inputs._earl_refresh
     context = engine.context
+    values = engine.python_predicate_values
+    name = predicate.name
 
     def evaluate(*_: object) -> bool:
-        refresh()
-        return bool(function(inputs, context))
+        # once per decision: a predicate that keeps state or draws random numbers must not be
+        # asked again by the terminal condition's second reading or by a transition naming it too
+        known = values.get(name)
+        if known is None:
+            refresh()
+            try:
+                known = values[name] = bool(function(inputs, context))
+            except (KeyboardInterrupt, SystemExit):
+                raise
+            except BaseException as raised:
+                values[name] = raised
+                raise
+        if isinstance(known, BaseException):
+            raise known
+        return known
 
     return evaluate
 

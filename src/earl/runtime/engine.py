@@ -128,6 +128,10 @@ class SubsystemEngine:
         self.memory: dict[str, Any] = {}
         self.destinations: dict[str, list[Destination]] = {}
         self.predicates: dict[str, CompiledPredicate] = {}
+        #: what each predicate computed by Python returned (or raised) since the input buffers last took
+        #: what arrived: one call per predicate per decision, however many conditions name it
+        self.python_predicate_values: dict[str, bool | BaseException] = {}
+        self.has_python_predicates = False
         self.states: dict[str, StateRuntime] = {}
         self.state: StateRuntime | None = None
         self.iteration = 0
@@ -230,6 +234,7 @@ class SubsystemEngine:
         """`tf.pf.ib.receive()`: every input buffer takes what arrived; obligatory ones not filled time out."""
         state = self.state
         assert state is not None
+        self.python_predicate_values.clear()
         inputs = self.inputs
         new_data = self.new_data
         for key, channel in self.channels.items():

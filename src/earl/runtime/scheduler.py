@@ -159,7 +159,7 @@ class Scheduler:
                 if advance is None and not realtime:
                     # The engine alone is due before anything else: run it on without the queue
                     # (same order as through the queue, only cheaper).
-                    alone = self._run_alone(engine, following, min(until, queue[0][0] - 1) if queue else until)
+                    alone = self._run_alone(engine, following, until)
                     if alone is None:
                         continue
                     following = alone
@@ -332,21 +332,24 @@ class Scheduler:
             self._push(time + state.timeout, engine, _TIMEOUT, token)
         return None
 
-    def _run_alone(self, engine: SubsystemEngine, following: int, last: int) -> int | None:
-        """Iterations of one engine due at `following`, … up to `last` (ns) while nothing else is due.
+    def _run_alone(self, engine: SubsystemEngine, following: int, until: int) -> int | None:
+        """Iterations of one engine due at `following`, … up to `until` (ns) while nothing else is due.
 
         The loop of a system with one subsystem (and of a fast one among slow ones), so it is
         `_start` written out for the common case: a period, no memory to record after each
-        iteration.
+        iteration.  What is due next is looked at after every iteration: a message the engine sent
+        may have woken a subsystem waiting for it (`_delivered` queues it at that instant), and
+        that one runs before the engine's next iteration.
         """
+        queue = self._queue
         period = engine.period
         if period is None or period <= 0 or (self.record_memory and engine.name in self.record_memory):
             next_start: int | None = following
-            while next_start is not None and next_start <= last:
+            while next_start is not None and next_start <= until and not (queue and queue[0][0] <= next_start):
                 self.now = next_start
                 next_start = self._start(engine, next_start)
             return next_start
-        while following <= last:
+        while following <= until and not (queue and queue[0][0] <= following):
             self.now = following
             # looked up each time: the engine's `iterate` changes with its state
             if not engine.iterate(following):

@@ -99,6 +99,8 @@ class Simulation:
             raise ValueError("a run over a transport between processes runs in real time only (realtime=True)")
         if check:
             _check(system, parameters)
+        else:
+            _check_parameters(system, parameters)
         self.system = system
         self.expanded = expand(system, parameters)
         self.seed = seed
@@ -270,6 +272,15 @@ def _check(system: System, parameters: Mapping[str, ParameterValue]) -> None:
         raise EarlError(errors, system.sources)  # type: ignore[arg-type]
 
 
+def _check_parameters(system: System, parameters: Mapping[str, ParameterValue]) -> None:
+    """Without the checker, still no misspelt or mistyped parameter: it would run with the default."""
+    from earl.check import unknown_parameters, wrong_parameter_values
+
+    errors = unknown_parameters(system, parameters) + wrong_parameter_values(system, parameters)
+    if errors:
+        raise EarlError(errors, system.sources)  # type: ignore[arg-type]
+
+
 def _code_directories(system: System) -> list[Path]:
     return [Path(system.source_file).resolve().parent] if system.source_file else []
 
@@ -358,7 +369,7 @@ class RunSettings:
 
 
 def read_run_settings(spec: Path) -> RunSettings:
-    path = spec.parent / "run.toml"
+    path = spec.resolve().parent / "run.toml"  # next to the file itself, as its modules and imports
     if not path.is_file():
         return RunSettings()
     try:

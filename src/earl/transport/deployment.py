@@ -4,7 +4,7 @@
     [[process]]
     agents = ["manip/a", "grip/a"]       # run together in one OS process
     listen = "tcp/127.0.0.1:7451"        # its Zenoh endpoint; every other process connects to it
-    environment = true                   # the run.toml environment (physics) lives here (default true)
+    environment = true                   # the run.toml environment (physics) lives here (see below)
 
     [[process]]
     agents = ["task/a"]
@@ -14,13 +14,19 @@
     args = ["--trace", "task.mcap"]      # more `earl run` options for this process
 
 Every agent of the system must be in exactly one process (docs/distributed.md).
+
+The environment (run.toml's simulated world) exists once: the Real Effectors and Receptors that act
+on it must all run in the one process that holds it, or each process would simulate a world of its
+own and the gripper would close in another world than the arm's.  Unwritten, `environment` is true
+for the process whose agents have Real Effectors or Receptors (the first process when no agent has).
 """
 
 from __future__ import annotations
 
 import socket
 import tomllib
-from dataclasses import dataclass, field
+from collections.abc import Collection
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 LOCAL_HOSTS = frozenset({"localhost", "127.0.0.1", "::1"})
@@ -36,13 +42,19 @@ class ProcessGroup:
 
     agents: tuple[str, ...]
     listen: str
-    environment: bool = True
+    #: whether run.toml's environment lives here; None when the file does not say (`place_environment`)
+    environment: bool | None = None
     host: str = "localhost"
     args: tuple[str, ...] = ()
 
     @property
     def label(self) -> str:
         return ",".join(self.agents)
+
+    @property
+    def names_its_environment(self) -> bool:
+        """Its `args` choose its environment (`--environment hardware:open`): the user's, not checked."""
+        return any(arg == "--environment" or arg.startswith("--environment=") for arg in self.args)
 
     @property
     def is_local(self) -> bool:
@@ -85,6 +97,53 @@ class Deployment:
             raise DeploymentError(
                 f"{self.path}: the agent `{missing[0]}` runs in no process; add it to a process's `agents`"
             )
+
+    def place_environment(self, acting: Collection[str]) -> Deployment:
+        """This deployment with every process's `environment` decided, for a system whose agents
+        `acting` have Real Effectors or Receptors; `DeploymentError` when the environment would run
+        twice, or apart from an agent that acts on it.
+
+        A process that does not say gets the environment when it runs an agent that acts on it and
+        no process claims it with `environment = true`; in a system with no such agent, the first
+        process that does not say gets it."""
+        checked = [process for process in self.processes if not process.names_its_environment]
+        claimed = any(process.environment for process in checked)
+        acting = set(acting)
+        anyone_acts = any(not acting.isdisjoint(process.agents) for process in self.processes)
+        first_silent = next((process for process in checked if process.environment is None), None)
+
+        def decided(process: ProcessGroup) -> bool | None:
+            if process.environment is not None or process.names_its_environment:
+                return process.environment
+            if claimed:
+                return False
+            return not acting.isdisjoint(process.agents) if anyone_acts else process is first_silent
+
+        placed = replace(self, processes=tuple(replace(p, environment=decided(p)) for p in self.processes))
+        placed._check_environment(acting)
+        return placed
+
+    def _check_environment(self, acting: Collection[str]) -> None:
+        numbered = [(n, p) for n, p in enumerate(self.processes, start=1) if not p.names_its_environment]
+        holders = [(n, p) for n, p in numbered if p.environment]
+        if len(holders) > 1:
+            (first, one), (second, other) = holders[0], holders[1]
+            raise DeploymentError(
+                f"{self.path}: the environment would run in process {first} ({one.label}) and in process "
+                f"{second} ({other.label}), each simulating a world of its own; give it to one process "
+                "(`environment = false` in the others) and run every agent with Real Effectors or Receptors there"
+            )
+        if not holders:
+            return  # no process holds it: the Real Effectors and Receptors are bound to something else
+        number, holder = holders[0]
+        for other_number, process in numbered:
+            away = [agent for agent in process.agents if agent in acting]
+            if process is not holder and away:
+                raise DeploymentError(
+                    f"{self.path}: process {other_number} runs `{away[0]}`, whose Real Effectors or Receptors "
+                    f"act on the environment, but the environment lives in process {number} ({holder.label}); "
+                    f"run `{away[0]}` in process {number}"
+                )
 
 
 def normalise_agent(name: str) -> str:
@@ -174,10 +233,10 @@ def read_deployment(path: Path) -> Deployment:
                 f"{where}: `{listen}` is the same endpoint as process {seen_endpoints[key]}'s; give each its own port"
             )
         seen_endpoints[key] = number
-        environment = table.get("environment", True)
+        environment = table.get("environment")
         host = table.get("host", "localhost")
         args = table.get("args", [])
-        if not isinstance(environment, bool):
+        if environment is not None and not isinstance(environment, bool):
             raise DeploymentError(f"{where}: `environment` must be true or false")
         if not isinstance(host, str) or not host:
             raise DeploymentError(f"{where}: `host` must be a host name")

@@ -15,6 +15,7 @@ from typing import Any
 
 from earl.model.elements import System
 from earl.model.expand import expand
+from earl.model.kinds import Kind
 from earl.runtime.names import agent_name
 from earl.transport.deployment import DeploymentError, normalise_agent, read_deployment
 from earl.transport.zenoh_transport import TransportError, ZenohTransport, config_from_file, default_config
@@ -31,11 +32,28 @@ def log(line: str) -> None:
         print(line, file=sys.stderr, flush=True)
 
 
+def acting_agents(expanded: System) -> list[str]:
+    """The agents with a Real Effector or Receptor: those that act on the environment."""
+    real = (Kind.REAL_EFFECTOR, Kind.REAL_RECEPTOR)
+    return [agent_name(agent) for agent in expanded.agents if any(s.kind in real for s in agent.subsystems)]
+
+
 def open_transport(
-    system: System, parameters: Mapping[str, Any], spec: Path, agents: list[str], arguments: argparse.Namespace
-) -> tuple[list[str], ZenohTransport]:
-    """The agents this process runs (normalised) and its open transport; `ValueError` for bad options."""
-    known = [agent_name(agent) for agent in expand(system, dict(parameters)).agents]
+    system: System,
+    parameters: Mapping[str, Any],
+    spec: Path,
+    agents: list[str],
+    arguments: argparse.Namespace,
+    environment: str | None = None,
+) -> tuple[list[str], ZenohTransport, bool]:
+    """The agents this process runs (normalised), its open transport, and whether `environment` (the one
+    run.toml or --environment names, if any) runs here; `ValueError` for bad options.
+
+    The deployment file says where the environment lives (`Deployment.place_environment`); with
+    the user's own --zenoh-config there is none, and the environment runs wherever it is named."""
+    expanded = expand(system, dict(parameters))
+    known = [agent_name(agent) for agent in expanded.agents]
+    environment_here = environment is not None
     names = agents_of(system, parameters, agents)
     if arguments.zenoh_config:
         config_path = Path(arguments.zenoh_config)
@@ -57,7 +75,11 @@ def open_transport(
         try:
             deployment = read_deployment(path)
             deployment.check_agents(known)
+            if environment is not None:
+                deployment = deployment.place_environment(acting_agents(expanded))
             group = deployment.group_of(names)
+            if environment is not None and not group.names_its_environment:
+                environment_here = bool(group.environment)
         except DeploymentError as error:
             raise ValueError(str(error)) from None
         connect = deployment.connect_for(group)
@@ -73,7 +95,7 @@ def open_transport(
             raise ValueError(f"{error} (with {where})") from None
         raise TransportError(f"{error} ({where}, as {path} says)") from None
     log(f"earl run: {', '.join(names)} over Zenoh ({where})")
-    return names, transport
+    return names, transport, environment_here
 
 
 def agents_of(system: System, parameters: Mapping[str, Any], agents: list[str]) -> list[str]:
