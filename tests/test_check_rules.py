@@ -514,6 +514,50 @@ CASES: list[Case] = [
         edit(TWO_STATES, ("run -> other when go/pp\n", "run -> other when x/mi > 2.0 priority 1\n")),
     ),
     Case(
+        "EARL-E043",
+        edit(("        x/m: double = 0.0\n", '        x/m: double = "zero"\n')),
+        6,
+        23,
+        "the initial value of `x/m` must be a number (double), not the string",
+        BASE,
+    ),
+    Case(
+        "EARL-E043",
+        edit(("        x/m: double = 0.0\n", "        x/m: double = 0.0\n        v/m: double[3] = [1.0, 2.0]\n")),
+        7,
+        26,
+        "the initial value of `v/m` must have 3 elements (double[3]), not 2",
+        edit(("        x/m: double = 0.0\n", "        x/m: double = 0.0\n        v/m: double[3] = [1.0, 2.0, 3]\n")),
+    ),
+    Case(
+        "EARL-W011",
+        edit(("        inp/ib: double\n", "        inp/ib: double\n        spare/ib: double\n")),
+        25,
+        9,
+        "`a2/a.cs.spare/ib` is fed by no link: it never receives a message",
+        BASE,
+    ),
+    Case(
+        "EARL-E016",
+        edit(
+            ("        inp/ib: double\n", "        inp/ib: double\n        spare/ib: double\n"),
+            (
+                "            state run: run/bb\n            run -> run when got/pp",
+                "            state run: run/bb { obligatory spare/ib }\n            run -> run when got/pp",
+            ),
+        ),
+        35,
+        44,
+        "state `run` of a2/a.cs waits for ever: `spare/ib` is obligatory, no link feeds it, and the state has no `timeout`",
+        edit(
+            ("        inp/ib: double\n", "        inp/ib: double\n        spare/ib: double\n"),
+            (
+                "            state run: run/bb\n            run -> run when got/pp",
+                "            state run: run/bb { obligatory spare/ib  timeout 5 ms }\n            run -> run when got/pp",
+            ),
+        ),
+    ),
+    Case(
         "EARL-E064",
         edit(
             TWO_STATES,

@@ -531,3 +531,17 @@ def test_advance_to_takes_a_finite_number_of_seconds(time: Any, error: type[Exce
     sim.advance_to(0.01)  # the run is intact
     assert sim.time == pytest.approx(0.01)
     sim.close()
+
+
+def test_a_memory_whose_initial_value_does_not_fit_is_said_at_its_line(tmp_path: Path) -> None:
+    """`earl check` refuses it (EARL-E043); unchecked, the run names the memory's line, not the subsystem's."""
+    spec = tmp_path / "counter"
+    shutil.copytree(SPECS / "counter", spec)
+    text = (spec / "system.earl").read_text()
+    (spec / "system.earl").write_text(text.replace("count/m: int = 0", "count/m: int = true", 1))
+    line = 1 + text[: text.index("count/m: int = 0")].count("\n")
+    with pytest.raises(earl.EarlError) as refused:
+        earl.simulate(earl.load(spec), check=False)
+    [diagnostic] = refused.value.diagnostics
+    assert diagnostic.code == "EARL-X010" and "the initial value of count/m must be" in diagnostic.message
+    assert diagnostic.location is not None and diagnostic.location.line == line

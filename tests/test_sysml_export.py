@@ -365,9 +365,16 @@ def test_the_command_writes_the_export_and_the_library(tmp_path: Path, capsys: p
     assert "wrote" in capsys.readouterr().err
 
 
-def test_the_command_prints_to_standard_output(capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["export", "sysml", str(SMALL), "--param", "N=3"]) == 0
+def test_the_command_prints_to_standard_output(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # with N = 3 the spec's two initial setpoints no longer fit `double[N]` (EARL-E043): zero ones do
+    three = tmp_path / "small.earl"
+    three.write_text(
+        SMALL.read_text(encoding="utf-8").replace("setpoints/m: Speeds = [0.0, 0.0]", "setpoints/m: Speeds")
+    )
+    assert main(["export", "sysml", str(three), "--param", "N=3"]) == 0
     assert "belt3_ve" in capsys.readouterr().out
+    assert main(["export", "sysml", str(SMALL), "--param", "N=3"]) == 1
+    assert "EARL-E043" in capsys.readouterr().err
 
 
 def test_the_command_refuses_an_invalid_spec(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

@@ -355,6 +355,29 @@ def _early_function_reads(
             return
 
 
+@rule("EARL-E043", Severity.ERROR, "a memory's initial value is of its data type", "§2.2, Table 3")
+def memory_initial_values(context: CheckContext) -> Iterator[Finding]:
+    """Internal Memory starts with the value written after `=`; it must be a value of the memory's data
+    type (`moving/m: boolean = 3` is not), or the subsystem cannot start. The check is the runtime's own,
+    made before anything runs."""
+    from earl.runtime.values import TypeSystem, ValueTypeError  # values only: no user code is imported
+
+    types = TypeSystem(context.system)
+    for _, subsystem in context.distinct_subsystems():
+        for memory in subsystem.memories:
+            if memory.initial_value is None:
+                continue
+            key = instance_name(memory.name, memory.index)
+            try:
+                types.constant(memory.initial_value, memory.data_type, f"the initial value of `{key}/m`")
+            except ValueTypeError as wrong:
+                yield Finding(
+                    str(wrong),
+                    memory.initial_value.location or memory.location,
+                    "write a constant of the memory's type, or leave out `= …` for the type's zero value",
+                )
+
+
 @rule("EARL-W042", Severity.WARNING, "every partial transition function is used", "§2.2, Table 6")
 def unused_functions(context: CheckContext) -> Iterator[Finding]:
     """A partial transition function that no behaviour's transition function composes never runs."""

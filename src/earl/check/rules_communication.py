@@ -162,3 +162,47 @@ def link_names(context: CheckContext) -> Iterator[Finding]:
                 link.link.location,
                 None,
             )
+
+
+@rule("EARL-E016", Severity.ERROR, "a subsystem never waits for ever", "§2.2, Figure 5b")
+def waits_for_nothing_for_ever(context: CheckContext) -> Iterator[Finding]:
+    """A state's obligatory Input Buffers are received by waiting until each has a new message, at most
+    for the state's `timeout`. An obligatory buffer that no link feeds never gets one: in a state without
+    a timeout the subsystem would wait there for ever, silently."""
+    for agent, subsystem in context.distinct_subsystems():
+        if subsystem.fsm is None:
+            continue
+        fed = {
+            instance_name(buffer.name, buffer.index)
+            for buffer in subsystem.input_buffers
+            if context.links_into.get(id(buffer))
+        }
+        for state in subsystem.fsm.states:
+            if state.timeout is not None:
+                continue
+            for reference in state.obligatory:
+                buffer = context.input_buffer(subsystem, reference)
+                if buffer is None or instance_name(buffer.name, buffer.index) in fed:
+                    continue
+                yield Finding(
+                    f"state `{state.name}` of {subsystem_name(agent, subsystem)} waits for ever: "
+                    f"`{instance_name(buffer.name, buffer.index)}/ib` is obligatory, no link feeds it, "
+                    "and the state has no `timeout`",
+                    reference.location or state.location,
+                    "link an Output Buffer to it, give the state's buffer group a `timeout`, or make it optional",
+                )
+
+
+@rule("EARL-W011", Severity.WARNING, "every Input Buffer is fed by a link", "§2.2, §2.3")
+def unfed_input_buffers(context: CheckContext) -> Iterator[Finding]:
+    """An Input Buffer receives messages only over a link (§2.3); one that no link feeds keeps its type's
+    zero value for ever, and `newData()` of it is never true."""
+    for agent, subsystem in context.distinct_subsystems():
+        for buffer in subsystem.input_buffers:
+            if not context.links_into.get(id(buffer)):
+                yield Finding(
+                    f"`{subsystem_name(agent, subsystem)}.{instance_name(buffer.name, buffer.index)}/ib` is fed by "
+                    "no link: it never receives a message",
+                    buffer.location,
+                    "link an Output Buffer to it, or remove it",
+                )

@@ -121,7 +121,7 @@ def build_network(
                         Diagnostic(
                             Severity.ERROR,
                             f"{subsystem_name(agent, subsystem)} cannot run: {error}",
-                            subsystem.location,
+                            getattr(error, "location", None) or subsystem.location,
                             code="EARL-X010",
                         )
                     )
@@ -196,7 +196,13 @@ def _engine(
         if memory.initial_value is None:
             engine.memory[key] = types.default(memory.data_type)
         else:
-            engine.memory[key] = types.constant(memory.initial_value, memory.data_type, f"the initial value of {key}/m")
+            try:
+                engine.memory[key] = types.constant(
+                    memory.initial_value, memory.data_type, f"the initial value of {key}/m"
+                )
+            except ValueTypeError as wrong:
+                wrong.location = memory.initial_value.location or memory.location  # said at the memory's line
+                raise
     for predicate in subsystem.primitive_predicates:
         if predicate.implementation is None:  # Python ones are bound with the functions
             engine.predicates[predicate.name] = compile_predicate(

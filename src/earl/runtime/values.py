@@ -21,7 +21,8 @@ from operator import itemgetter
 from typing import Any, NoReturn
 
 from earl.model.elements import System
-from earl.model.expressions import ListLiteral, Literal, Negate
+from earl.model.expressions import Arithmetic, ConstantError, ListLiteral, Literal, Negate, evaluate_constant
+from earl.model.location import SourceLocation
 from earl.model.types import (
     INTEGER_RANGES,
     ArrayType,
@@ -174,6 +175,9 @@ class Record(dict[str, Any]):
 
 class ValueTypeError(TypeError):
     """A value does not fit the declared data type; the message says where and why."""
+
+    #: where the spec wrote the value, when it is a constant of the spec (a memory's initial value)
+    location: SourceLocation | None = None
 
 
 class TypeSystem:
@@ -360,6 +364,11 @@ def _constant(expression: Any) -> Any:
         return [_constant(item) for item in expression.items]
     if isinstance(expression, Negate):
         return -_constant(expression.operand)
+    if isinstance(expression, Arithmetic):  # `2 * QUEUE + 0.5`: the expansion put the parameter's value in
+        try:
+            return evaluate_constant(expression, {})
+        except ConstantError as error:
+            raise ValueTypeError(f"an initial value must be a constant: {error}") from None
     raise ValueTypeError("an initial value must be a constant")
 
 
