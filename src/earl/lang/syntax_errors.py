@@ -248,8 +248,14 @@ def _unexpected_token(
 
     if token.type == "$END" or not token.line:
         location = after_previous()
-    elif end is not None and token.line > end[0] and token.type not in ("NUMBER", "INT", "STRING"):
-        # What is missing belongs at the end of the line before, not before the next statement.
+    elif (
+        end is not None
+        and token.line > end[0]
+        and token.type not in ("NUMBER", "INT", "STRING")
+        and _last_character(text, end) not in ("{", "}")
+    ):
+        # What is missing belongs at the end of the line before, not before the next statement. After
+        # `{` or `}` the line before is complete: the statement found is the one in the wrong place.
         location = after_previous()
     else:
         column = token.column or 1
@@ -270,6 +276,13 @@ def _unexpected_token(
         if diagnostic is not None:
             return diagnostic
     return _expected_message(token, context, location)
+
+
+def _last_character(text: str, end: tuple[int, int]) -> str:
+    """The character that ends what was read (`end` is just after it: line and column from 1)."""
+    lines = text.split("\n")
+    line = lines[end[0] - 1] if 0 < end[0] <= len(lines) else ""
+    return line[end[1] - 2] if 2 <= end[1] <= len(line) + 1 else ""
 
 
 def _token_location(path: str, token: Token) -> SourceLocation:
@@ -459,6 +472,10 @@ def _bad_kind(token: Token, context: _Context, location: SourceLocation, path: s
         return None
     kinds = context.describe(context.expected)
     hint = next((HINTS[t] for t in context.expected if t in HINTS), None)
+    if str(token) == Kind.MEMORY.value and "MI" in context.expected:
+        name = context.value(2)
+        named = f"{name}" if isinstance(name, Token) and name.type == "NAME" else "x"
+        hint = f"memory is declared `{named}/m`, read as `{named}/mi` and written as `{named}/mo`; here, read it: `{named}/mi`"
     if str(token) in (Kind.AGENT.value, Kind.ROBOT.value) and context.open_brackets():
         title = KIND_TITLES[Kind(str(token))]
         hint = f"an {title} is declared at the top level; " + (_unclosed_hint(context.open_brackets()) or "")
@@ -523,6 +540,9 @@ def _expected_message(token: Token, context: _Context, location: SourceLocation)
             )
     if hint is None:
         hint = _after_keyword_hint(context)
+    if token.type == "SLASH" and any(t in expected for t in ("STAR", "PLUS", "MINUS")):
+        # `v/ib / 2`: after a value, where an operator may follow, a slash can only mean division
+        hint = "there is no division (the slash introduces a kind): write `0.5 * x` for `x / 2`"
     if hint is None and token.type in ("NUMBER", "INT") and "NAME" in expected and "NUMBER" not in expected:
         hint = "names start with a letter or `_`"
     if hint is None and token.type == "NAME" and str(token) in _TOP_LEVEL_ONLY:
