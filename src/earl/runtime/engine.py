@@ -162,6 +162,15 @@ class SubsystemEngine:
         self.recorder.state_changed(time, self.name, None, initial, f"*,{initial}")
         self.recorder.behaviour_started(time, self.name, initial, self.state.behaviour.name)
 
+    def prepare(self) -> None:
+        """Generate every state's code now rather than at its first iteration: a real-time run does it
+        before its clock starts, so that no first iteration starts late by the time it took."""
+        for state in self.states.values():
+            if state.iterate is None:
+                state.iterate = compile_iteration(self, state)
+            if state.complete is None and state.obligatory:
+                state.complete = compile_completion(self, state)
+
     # ------------------------------------------------------------------ Figure 5b, steps 1-5
     def _iteration_of(self, state: StateRuntime) -> Iterate:
         """`iterate(time)` while in `state`: one whole iteration (steps 1-5), compiled at its first use.

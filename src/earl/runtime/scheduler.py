@@ -91,6 +91,9 @@ class Scheduler:
         self._advance: Callable[[float], Any] | None = getattr(environment, "advance", None)
         self._environment_time = -1
         self._wall_start = 0
+        #: whether the wall clock runs yet: it starts once the first instant (t = 0) has run, whose
+        #: one-time costs (the first call of every function, the environment's first step) are no lateness
+        self._clock_running = False
         self.lateness: dict[str, Lateness] = {}
         self.started = False
         #: messages from other processes; only real-time runs have one
@@ -113,6 +116,8 @@ class Scheduler:
             initial = self.network.initial_states.get(engine.name)
             if initial is None or initial not in engine.states:
                 continue
+            if self.realtime:
+                engine.prepare()  # before the wall clock starts: see `SubsystemEngine.prepare`
             engine.start(initial, 0)
             self._push(0, engine, _START)
         self._wall_start = self.clock()
@@ -146,6 +151,8 @@ class Scheduler:
                 self._environment_time = time
                 advance(time * 1e-9)
             if realtime:
+                if time > 0 and not self._clock_running:
+                    self._start_clock()
                 self._wait_until(time, engine, kind)
             if kind == _START:
                 # `_start` and `_push` written out: this is the path of nearly every event
@@ -204,6 +211,8 @@ class Scheduler:
                     self.now = max(self.now, min(clock() - self._wall_start, until))
                     inbox.drain(self.now)
                 due = queue[0][0] if queue and queue[0][0] <= until else until
+                if due > 0 and not self._clock_running:
+                    self._start_clock()
                 if clock() - self._wall_start < due:
                     self._sleep_until(due, inbox)
                     continue
@@ -395,7 +404,14 @@ class Scheduler:
         if kind == _START:
             self._record_lateness(time, engine)
 
+    def _start_clock(self) -> None:
+        """Run time 0 is now on the wall clock: the first instant has run (`_clock_running`)."""
+        self._wall_start = self.clock()
+        self._clock_running = True
+
     def _record_lateness(self, time: int, engine: SubsystemEngine) -> None:
+        if not self._clock_running:
+            return  # the first instant, run before the clock starts
         late = self.clock() - (self._wall_start + time)
         record = self.lateness.get(engine.name)
         if record is None:
