@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -598,3 +599,34 @@ def test_a_seed_that_is_not_a_whole_number_from_zero_is_a_usage_error(seed: str)
     result = earl_cli("run", str(SPECS / "counter"), f"--seed={seed}", "--duration", "10ms")
     assert result.returncode == 2
     assert "argument --seed" in result.stderr and "Traceback" not in result.stderr
+
+
+def test_a_stop_signal_ends_the_run_between_two_instants(tmp_path: Path) -> None:
+    """Every function takes 2 ms, so a signal most likely comes inside an instant: the run still ends
+    after it, every subsystem having run the same instants (all three run every 10 ms)."""
+    from earl.runtime.trace_reader import _messages
+
+    spec = counter_copy(tmp_path)
+    for module in ("cs", "relay", "display"):
+        functions = spec.parent / "counting" / f"{module}.py"
+        text = functions.read_text()
+        text = re.sub(r"(def \w+\(inputs, outputs, context\):\n)", r"\1    time.sleep(0.002)\n", text)
+        functions.write_text("import time\n\n" + text)
+    trace = tmp_path / "run.mcap"
+    process = subprocess.Popen(
+        [*EARL, "run", str(spec), "--duration", "600s", "--trace", str(trace)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        time.sleep(3.0)
+        process.send_signal(signal.SIGINT)
+        _, stderr = process.communicate(timeout=30)
+    finally:
+        process.kill()
+    assert process.returncode == 130, stderr
+    assert "stopping after this instant" in stderr and "interrupted at" in stderr
+    [end] = [data for topic, _, _, data in _messages(trace, ["/earl/run"]) if "iterations" in data]
+    counts = set(end["iterations"].values())
+    assert len(counts) == 1 and counts != {0}, end["iterations"]

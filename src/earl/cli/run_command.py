@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import gc
+import os
 import signal
 import statistics
 import sys
@@ -282,6 +283,24 @@ def _stopped_like_ctrl_c() -> Iterator[_StopRequest]:
         yield request
 
 
+@contextlib.contextmanager
+def _stopped_between_instants() -> Iterator[_StopRequest]:
+    """Ctrl-C, SIGTERM and SIGHUP ask the run to stop once the instant running has run to its end, so
+    that every subsystem has run the same instants; a second one stops it at once, inside the instant
+    (a function that never returns)."""
+    request = _StopRequest()
+
+    def stop(*_: object) -> None:
+        if request.requested:
+            raise KeyboardInterrupt
+        request.requested = True
+        with contextlib.suppress(OSError):  # said from a signal handler: one write, no Rich
+            os.write(2, b"earl run: stopping after this instant (once more to stop at once)\n")
+
+    with handling_stop_signals(stop):
+        yield request
+
+
 def _close(transport: Any) -> None:
     if transport is not None:
         transport.close()
@@ -317,7 +336,7 @@ def _execute(simulation: Any, duration: float, arguments: argparse.Namespace, re
         gc.freeze()
     started = time.perf_counter()
     try:
-        with _stopped_like_ctrl_c() as stop:
+        with _stopped_between_instants() as stop:
             _advance(simulation, duration, arguments, console, started, stop)
     except KeyboardInterrupt:
         interrupted = True
@@ -376,8 +395,8 @@ def _advance(
     progress: Progress | None = None
     try:
         for step in range(1, steps + 1):
-            simulation.advance_to(duration * step / steps)
-            if stop.requested:  # the spec's code swallowed the KeyboardInterrupt
+            simulation.advance_to(duration * step / steps, should_stop=lambda: stop.requested)
+            if stop.requested:  # between two instants: the run ends as interrupted (exit 130)
                 raise KeyboardInterrupt
             elapsed = time.perf_counter() - started
             if progress is None and elapsed > 1.0 and not arguments.no_progress and console.is_terminal:

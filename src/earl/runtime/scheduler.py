@@ -143,7 +143,8 @@ class Scheduler:
         tokens = self._tokens
         record_memory = self.record_memory
         while queue and queue[0][0] <= until:
-            if should_stop is not None and should_stop():
+            # a stop is made between two instants, never inside one (docs/semantics.md)
+            if should_stop is not None and queue[0][0] > self.now and should_stop():
                 return
             time, _, _, kind, engine, token = pop(queue)
             self.now = time
@@ -166,7 +167,7 @@ class Scheduler:
                 if advance is None and not realtime:
                     # The engine alone is due before anything else: run it on without the queue
                     # (same order as through the queue, only cheaper).
-                    alone = self._run_alone(engine, following, until)
+                    alone = self._run_alone(engine, following, until, should_stop)
                     if alone is None:
                         continue
                     following = alone
@@ -204,8 +205,8 @@ class Scheduler:
                 if self._failure is not None:
                     failure, self._failure = self._failure, None
                     raise failure
-                if should_stop is not None and should_stop():
-                    return
+                if should_stop is not None and not (queue and queue[0][0] <= self.now) and should_stop():
+                    return  # between two instants
                 if inbox.pending:
                     # a message arriving now is handled at the wall-clock instant it was received
                     self.now = max(self.now, min(clock() - self._wall_start, until))
@@ -263,9 +264,8 @@ class Scheduler:
             if inbox.pending:
                 inbox.drain(time)  # what came before, first
             action(time, value)
-            should_stop = self._should_stop
             queue = self._queue
-            while queue and queue[0][0] <= time and (should_stop is None or not should_stop()):
+            while queue and queue[0][0] <= time:  # the whole instant: a stop is made between instants
                 event_time, _, _, kind, engine, token = heapq.heappop(queue)
                 if kind == _RESUME and engine.waiting and not (queue and queue[0][0] <= time):
                     # the subsystem this message woke, with nothing else due: its receive and decide, and
@@ -341,7 +341,9 @@ class Scheduler:
             self._push(time + state.timeout, engine, _TIMEOUT, token)
         return None
 
-    def _run_alone(self, engine: SubsystemEngine, following: int, until: int) -> int | None:
+    def _run_alone(
+        self, engine: SubsystemEngine, following: int, until: int, should_stop: Callable[[], bool] | None = None
+    ) -> int | None:
         """Iterations of one engine due at `following`, … up to `until` (ns) while nothing else is due.
 
         The loop of a system with one subsystem (and of a fast one among slow ones), so it is
@@ -355,10 +357,14 @@ class Scheduler:
         if period is None or period <= 0 or (self.record_memory and engine.name in self.record_memory):
             next_start: int | None = following
             while next_start is not None and next_start <= until and not (queue and queue[0][0] <= next_start):
+                if should_stop is not None and should_stop():
+                    break
                 self.now = next_start
                 next_start = self._start(engine, next_start)
             return next_start
         while following <= until and not (queue and queue[0][0] <= following):
+            if should_stop is not None and should_stop():
+                break  # the next iteration goes back to the queue, where the stop is made
             self.now = following
             # looked up each time: the engine's `iterate` changes with its state
             if not engine.iterate(following):
