@@ -437,8 +437,12 @@ def test_rules_knows_reading_codes_and_refuses_unknown_ones(capsys: pytest.Captu
     status, out, err = run(capsys, "rules", "E061")
     assert status == 2 and out == ""
     assert "no rule E061" in err
+    status, out, _ = run(capsys, "rules", "X003")
+    assert status == 0 and out.startswith("EARL-X003: importing the module raised an error")
     status, _, err = run(capsys, "rules", "X999")
-    assert status == 2 and "did you mean" not in err  # no code of another family offered
+    assert status == 2 and "EARL-S" not in err and "EARL-E" not in err  # no code of another family offered
+    status, _, err = run(capsys, "rules", "X030")
+    assert status == 2 and "did you mean `EARL-X020`?" in err
     status, _, err = run(capsys, "rules", "S19")
     assert "did you mean `EARL-S019`?" in err
 

@@ -1129,3 +1129,19 @@ def test_merging_keeps_apart_other_places_and_writes_scattered_indices_as_a_list
         ("EARL-E010", "`m[2]/ve` is wrong", there),
         ("EARL-E011", "`m[5]/ve` is wrong", here),
     ]
+
+
+def test_equality_of_structs_and_arrays_needs_one_type_and_names_them() -> None:
+    types = "struct S {\n    a: double\n    arr: double[3]\n}\n\nstruct T {\n    a: double\n}\n\n"
+    text = BASE.replace("system base\n\n", "system base\n\n" + types).replace(
+        "        inp/ib: double\n", "        inp/ib: double\n        s/ib: S\n        t/ib: T\n        u/ib: S\n"
+    )
+
+    def said(condition: str) -> list[str]:
+        spec = text.replace("got/pp = newData(inp/ib)", f"got/pp = newData(inp/ib) and {condition}")
+        return [d.message for d in findings(spec, "EARL-E030")]
+
+    assert said("s/ib == t/ib") == ["`s/ib == t/ib` compares a struct `S` with a struct `T`"]
+    assert said("s/ib.arr != t/ib") == ["`s/ib.arr != t/ib` compares an array `double[3]` with a struct `T`"]
+    assert said("s/ib == 3.0") == ["`s/ib == 3.0` compares a struct `S` with a number"]
+    assert said("s/ib == u/ib") == []

@@ -24,7 +24,7 @@ from earl.model.expressions import (
 from earl.model.kinds import Kind
 from earl.model.location import SourceLocation
 from earl.model.text import expression_text
-from earl.model.types import ArrayType, PrimitiveType, StructType
+from earl.model.types import ArrayType, PrimitiveType, StructType, type_text
 
 BOOLEAN = "boolean"
 NUMBER = "number"
@@ -96,18 +96,16 @@ class ExpressionTyper:
         if isinstance(expression, Comparison):
             left, right = self.type_of(expression.left), self.type_of(expression.right)
             if UNKNOWN not in (left, right):
+                described = f"{self._what(expression.left, left)} with {self._what(expression.right, right)}"
                 if expression.operator in ("==", "!="):
-                    if left != right:
+                    if left != right or (left == OTHER and not self._same_structure(expression.left, expression.right)):
                         self.problems.append(
-                            TypeProblem(
-                                f"`{expression_text(expression)}` compares a {left} with a {right}",
-                                expression.location,
-                            )
+                            TypeProblem(f"`{expression_text(expression)}` compares {described}", expression.location)
                         )
                 elif left != NUMBER or right != NUMBER:
                     self.problems.append(
                         TypeProblem(
-                            f"`{expression.operator}` orders numbers, but `{expression_text(expression)}` compares a {left} with a {right}",
+                            f"`{expression.operator}` orders numbers, but `{expression_text(expression)}` compares {described}",
                             expression.location,
                         )
                     )
@@ -123,6 +121,52 @@ class ExpressionTyper:
                     expression.location,
                 )
             )
+
+    def _what(self, expression: Expression, category: str) -> str:
+        """`a number`, `a struct `Goal``, `an array `double[3]``: what a side of a comparison is."""
+        if category != OTHER:
+            return f"a {category}"
+        structure = self._structure(expression) if isinstance(expression, Read) else None
+        if isinstance(structure, StructType):
+            return f"a struct `{structure.name}`"
+        if isinstance(structure, ArrayType):
+            return f"an array `{type_text(structure)}`"
+        if isinstance(structure, PrimitiveType):
+            return f"a `{structure.name}` value"
+        return "a list" if isinstance(expression, ListLiteral) else "a struct or an array"
+
+    def _same_structure(self, left: Expression, right: Expression) -> bool:
+        """Two structs, arrays or bytes values of one type (or whose types are not known here)."""
+        first = self._structure(left) if isinstance(left, Read) else None
+        second = self._structure(right) if isinstance(right, Read) else None
+        if first is None or second is None:
+            return True
+        return self.context.same_type(first, second)  # type: ignore[arg-type]
+
+    def _structure(self, read: Read) -> PrimitiveType | ArrayType | StructType | None:
+        """The type a read of a buffer or memory yields, aliases followed; None when not known."""
+        target = read.target
+        element: InputBuffer | Memory | None
+        if target.kind is Kind.INPUT_BUFFER:
+            element = self.context.input_buffer(self.subsystem, target)
+        elif target.kind in (Kind.MEMORY_INPUT, Kind.MEMORY):
+            element = self.context.memory(self.subsystem, target)
+        else:
+            return None
+        if element is None:
+            return None
+        current = self.context.structural(element.data_type)
+        for accessor in read.path:
+            if isinstance(accessor, FieldAccess) and isinstance(current, StructType):
+                field = current.field_named(accessor.name)
+                if field is None:
+                    return None
+                current = self.context.structural(field.data_type)
+            elif not isinstance(accessor, FieldAccess) and isinstance(current, ArrayType):
+                current = self.context.structural(current.element)
+            else:
+                return None
+        return current  # type: ignore[return-value]
 
     def _read(self, read: Read) -> str:
         target = read.target

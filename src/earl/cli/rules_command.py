@@ -10,6 +10,7 @@ from earl.check.registry import RULES, rules_by_code
 from earl.cli.common import usage_error
 from earl.diagnostics import did_you_mean
 from earl.lang.codes import READING_CODES
+from earl.runtime.codes import RUNNING_CODES
 
 
 def register(commands: Any) -> None:
@@ -38,7 +39,12 @@ def run(arguments: argparse.Namespace) -> int:
     if code in READING_CODES:
         sys.stdout.write(f"{code}: {READING_CODES[code]} (found while reading the spec; see docs/rules.md)\n")
         return 0
+    if code in RUNNING_CODES:
+        sys.stdout.write(
+            f"{code}: {RUNNING_CODES[code]} (found when `earl run` binds the spec to its code; see docs/runtime.md)\n"
+        )
+        return 0
     # a suggestion of the same family of codes only (`EARL-X999` is no misspelt `EARL-S019`)
     family = code[: len("EARL-") + 1]
-    hint = did_you_mean(code, [c for c in [*RULES, *READING_CODES] if c.startswith(family)])
+    hint = did_you_mean(code, [c for c in [*RULES, *READING_CODES, *RUNNING_CODES] if c.startswith(family)])
     return usage_error(f"no rule {arguments.code}" + (f"; {hint}" if hint else "; `earl rules` lists them"))

@@ -1,0 +1,22 @@
+"""The codes of problems found when `earl run` (or `earl.simulate`) binds a spec to its code and data.
+
+`EARL-X…` problems stop a run before its first iteration; each is reported at the spec line that
+names the code or the data. docs/runtime.md lists them, and `earl rules X003` explains one; a test
+checks that every code the source uses is here and in the page.
+"""
+
+from __future__ import annotations
+
+RUNNING_CODES: dict[str, str] = {
+    "EARL-X000": 'a partial transition function has no `= python "…"` implementation',
+    "EARL-X001": "the implementation is not `module:function`",
+    "EARL-X002": "the module cannot be found (modules are looked up next to the spec first)",
+    "EARL-X003": "importing the module raised an error, called `sys.exit()`, or imports a module that cannot be found",
+    "EARL-X004": "the module has no such function, or it is not callable",
+    "EARL-X005": "the function cannot be called with `(inputs, outputs, context)`, or is no plain function",
+    "EARL-X010": "a subsystem's data cannot be set up (e.g. an initial value that does not fit its type)",
+    "EARL-X011": "a subsystem has no `fsm`",
+    "EARL-X012": "a subsystem has no `period` and a state that waits for nothing",
+    "EARL-X013": "a link ends at an input buffer its subsystem does not have",
+    "EARL-X020": "the environment factory failed, or the environment's `advance` is no method",
+}
