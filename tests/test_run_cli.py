@@ -71,12 +71,32 @@ def test_plot_of_a_signal_the_trace_lacks_says_how_to_record_it(tmp_path: Path) 
     assert earl_cli("run", str(SPECS / "counter"), "--duration", "50ms", "--trace", str(trace)).returncode == 0
     result = earl_cli("plot", str(trace), "--signal", "counter/a.cs.sent", "-o", str(tmp_path / "x.png"))
     assert result.returncode == 1
-    assert "--record-memory counter/a.cs" in result.stderr
+    assert "if it is memory, record it with `--record-memory counter/a.cs`" in result.stderr
     assert "Traceback" not in result.stderr
     # what an output buffer sent is in the trace without recording memory
     sent = earl_cli("plot", str(trace), "--signal", "counter/a.relay/ve.back", "-o", str(tmp_path / "z.png"))
     assert sent.returncode == 0, sent.stderr
     assert (tmp_path / "z.png").is_file()
+
+
+def test_run_plot_records_the_memory_it_draws_and_refuses_a_signal_the_system_lacks(tmp_path: Path) -> None:
+    png = tmp_path / "sent.png"
+    # `sent` is memory: recorded for the plot without --record-memory
+    result = earl_cli(
+        "run", str(SPECS / "counter"), "--duration", "50ms", "--plot", str(png), "--signal", "counter/a.cs.sent"
+    )
+    assert result.returncode == 0, result.stderr
+    assert png.read_bytes().startswith(b"\x89PNG")
+    started = time.monotonic()
+    wrong = earl_cli(
+        "run", str(SPECS / "counter"), "--duration", "1000s", "--plot", str(png), "--signal", "counter/a.cs.snet"
+    )
+    assert wrong.returncode == 2
+    assert "--signal `counter/a.cs.snet`: `counter/a.cs` has no memory or output buffer `snet`" in wrong.stderr
+    assert "did you mean `sent`?" in wrong.stderr
+    assert time.monotonic() - started < 30  # before the run
+    nowhere = earl_cli("run", str(SPECS / "counter"), "--plot", str(png), "--signal", "counter/a.cz.count")
+    assert nowhere.returncode == 2 and "does not start with a subsystem of this system" in nowhere.stderr
 
 
 def test_a_plot_that_cannot_be_written_is_a_usage_error_said_before_anything_runs(tmp_path: Path) -> None:
@@ -630,3 +650,69 @@ def test_a_stop_signal_ends_the_run_between_two_instants(tmp_path: Path) -> None
     [end] = [data for topic, _, _, data in _messages(trace, ["/earl/run"]) if "iterations" in data]
     counts = set(end["iterations"].values())
     assert len(counts) == 1 and counts != {0}, end["iterations"]
+
+
+ARRAY_SENDER = """\
+system arrays
+
+a/a {
+    cs {
+        period 10 ms
+        v/ob: double[2]
+        t/m: double = 0.0
+        false/pp = false
+        tick/pf(t/mi -> t/mo) = python "arrays:tick"
+        emit/pf(t/mi -> v/ob) = python "arrays:emit"
+        run/bb {
+            tf = {tick/pf} then {emit/pf}
+            tc = false/pp
+        }
+        fsm {
+            initial run
+            state run: run/bb
+        }
+    }
+}
+
+b/a {
+    cs {
+        period 10 ms
+        v/ib: double[2]
+        x/m: double = 0.0
+        false/pp = false
+        take/pf(v/ib -> x/mo) = python "arrays:take"
+        run/bb {
+            tf = {take/pf}
+            tc = false/pp
+        }
+        fsm {
+            initial run
+            state run: run/bb
+        }
+    }
+}
+
+link a,b: a/a.cs.v -> b/a.cs.v
+
+r/r {
+    a/a
+    b/a
+    link a,b
+}
+"""
+
+
+def test_an_element_of_an_array_output_buffer_is_plotted_by_its_index(tmp_path: Path) -> None:
+    (tmp_path / "system.earl").write_text(ARRAY_SENDER)
+    (tmp_path / "arrays.py").write_text(
+        "def tick(inputs, outputs, context):\n    outputs.t = inputs.t + 1.0\n\n\n"
+        "def emit(inputs, outputs, context):\n    outputs.v = (inputs.t, 2.0)\n\n\n"
+        "def take(inputs, outputs, context):\n    outputs.x = inputs.v[0]\n"
+    )
+    trace = tmp_path / "run.mcap"
+    ran = earl_cli("run", str(tmp_path), "--duration", "50ms", "--trace", str(trace))
+    assert ran.returncode == 0, ran.stderr
+    plot = earl_cli("plot", str(trace), "--signal", "a/a.cs.v[0]", "-o", str(tmp_path / "v.png"))
+    assert plot.returncode == 0, plot.stderr
+    wrong = earl_cli("plot", str(trace), "--signal", "a/a.cs.v.value[0]", "-o", str(tmp_path / "w.png"))
+    assert wrong.returncode == 1 and "the trace has `v[0]`, `v[1]`" in wrong.stderr, wrong.stderr

@@ -201,6 +201,19 @@ def run(arguments: argparse.Namespace) -> int:
             from earl.transport.process import agents_of
 
             agents = agents_of(system, parameters, agents)
+        if arguments.plot:
+            # what the plot draws is recorded, and a signal the system does not have is said now
+            from earl.model.expand import expand
+            from earl.runtime.plot import memory_to_record
+
+            try:
+                plotted = memory_to_record(expand(system, parameters), list(signals or []))
+            except ValueError as error:
+                _close(transport)
+                return usage_error(f"--signal {error}")
+            if agents:
+                plotted = [name for name in plotted if name.split(".", 1)[0] in agents]
+            record_memory = sorted({*(record_memory or []), *plotted})
         simulation = Simulation(
             system,
             parameters=parameters,

@@ -5,7 +5,10 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from earl.runtime.trace_reader import read_signals
+from earl.diagnostics import did_you_mean
+from earl.model.elements import System
+from earl.runtime.names import subsystem_name
+from earl.runtime.trace_reader import read_signals, signal_element
 
 #: the kinds of file a plot is written as, by the suffix (what Matplotlib's Agg backend writes)
 PLOT_SUFFIXES = (".png", ".svg", ".pdf", ".jpg", ".jpeg", ".eps", ".ps")
@@ -25,6 +28,35 @@ def plot_output_problem(output: Path) -> str | None:
                 return f"{parent} is a file, not a directory"
             break
     return None
+
+
+def memory_to_record(expanded: System, signals: list[str]) -> list[str]:
+    """The subsystems whose memory `signals` name, which a run that plots them must record; a
+    `ValueError` saying why for a signal that names no memory or output buffer of the system, found
+    before the run rather than after it (`earl run --plot`)."""
+    subsystems = {subsystem_name(a, s): s for a in expanded.agents for s in a.subsystems}
+    longest_first = sorted(subsystems, key=len, reverse=True)
+    record: list[str] = []
+    for signal in signals:
+        owner = next((name for name in longest_first if signal.startswith(name + ".")), None)
+        if owner is None:
+            prefix = signal.rsplit(".", 1)[0]
+            suggestion = did_you_mean(prefix, list(subsystems)) or f"a subsystem such as `{next(iter(subsystems), '')}`"
+            raise ValueError(f"`{signal}` does not start with a subsystem of this system; {suggestion}")
+        subsystem = subsystems[owner]
+        element = signal_element(signal[len(owner) + 1 :])
+        memories = sorted({m.name for m in subsystem.memories})
+        outputs = sorted({o.name for o in subsystem.output_buffers})
+        if element in memories:
+            record.append(owner)
+        elif element not in outputs:  # an output buffer's values are the messages on its links
+            hint = did_you_mean(element, [*memories, *outputs])
+            known = ", ".join(f"`{name}`" for name in dict.fromkeys([*memories, *outputs])) or "none"
+            raise ValueError(
+                f"`{signal}`: `{owner}` has no memory or output buffer `{element}`"
+                + (f"; {hint}" if hint else f" (it has {known})")
+            )
+    return sorted(set(record))
 
 
 def plot_signals(trace: Path, signals: list[str], output: Path, title: str | None = None) -> None:

@@ -216,7 +216,11 @@ def read_signals(path: Path, names: list[str]) -> Signals:
                 continue
             for leaf, value in iter_leaves(data):
                 if buffer:
-                    leaf = buffer if leaf == "value" else f"{buffer}.{leaf}"
+                    # a message that is not a struct is recorded as `{"value": …}`: `raw[0]`, not `raw.value[0]`
+                    if leaf == "value" or leaf.startswith("value["):
+                        leaf = buffer + leaf[len("value") :]
+                    else:
+                        leaf = f"{buffer}.{leaf}"
                 found = leaves.get((subsystem, leaf))
                 if found is None:
                     found = leaves[(subsystem, leaf)] = ([], [])
@@ -233,11 +237,17 @@ def read_signals(path: Path, names: list[str]) -> Signals:
             if owner == subsystem and pattern.match(leaf)
         ]
         if not matched:
-            hint = (
-                f"record its memory with `--record-memory {subsystem}`"
-                if f"{subsystem}/memory" not in available
-                else "check the name against the spec"
-            )
+            element = _element(inner)
+            same = sorted({leaf for (owner, leaf) in leaves if owner == subsystem and _element(leaf) == element})
+            if same:
+                hint = f"the trace has {', '.join(f'`{leaf}`' for leaf in same[:6])}{' …' if len(same) > 6 else ''}"
+            elif f"{subsystem}/memory" not in available:
+                hint = (
+                    f"if it is memory, record it with `--record-memory {subsystem}`; an output buffer is in the "
+                    "trace when a link leaves it (and `--record-links` keeps that link)"
+                )
+            else:
+                hint = "check the name against the spec"
             raise TraceError(f"the trace has no values for `{name}`; {hint}")
         series.extend(sorted(matched, key=lambda item: _natural(item.name)))
     bands = {
@@ -250,9 +260,12 @@ def read_signals(path: Path, names: list[str]) -> Signals:
     return Signals(series, bands, end)
 
 
-def _element(name: str) -> str:
+def signal_element(name: str) -> str:
     """The element a signal or buffer name starts with: `motorControllerCommand` of `motorControllerCommand[2].x`."""
     return re.split(r"[.\[]", name, maxsplit=1)[0]
+
+
+_element = signal_element
 
 
 def _natural(name: str) -> list[object]:
