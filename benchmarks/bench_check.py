@@ -46,7 +46,7 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
 import earl  # noqa: E402
-from earl.check import check_context, collector_paused, context_for  # noqa: E402
+from earl.check import CheckContext, check_context, collector_paused, context_for  # noqa: E402
 from earl.check.fsm_analysis import analyse  # noqa: E402
 from earl.diagnostics import Severity  # noqa: E402
 from earl.model.elements import FSM, Subsystem  # noqa: E402
@@ -283,37 +283,44 @@ def enumerate_findings(subsystem: Subsystem, fsm: FSM) -> dict[str, set[str]]:
         assumed &= tables.table(assumption.expression)
     condition = {id(t): tables.table(t.condition.expression) & assumed for t in fsm.transitions}
     found: dict[str, set[str]] = {"overlap": set(), "dead": set(), "stuck": set(), "endless": set(), "lost": set()}
-    ending = {}
+    taken: dict[int, int] = {}  # as fsm.selectState() runs: tried only when the behaviour stops, by priority
+
+    def distinct(first: Any, second: Any) -> bool:
+        return (first.priority is not None or second.priority is not None) and first.priority != second.priority
+
+    def rank(transition: Any) -> tuple[bool, int]:
+        return (transition.priority is None, transition.priority or 0)
+
     for state in fsm.states:
         behaviour = subsystem.basic_behaviour(state.behaviour)
         assert behaviour is not None
         stop = tables.table(behaviour.terminal_condition.expression) & assumed
-        ending[state.name] = stop != 0
         if not stop:
             found["endless"].add(state.name)
             continue
         leaving = [t for t in fsm.transitions if t.source == state.name]
         none_holds = stop
         for position, first in enumerate(leaving):
-            if not condition[id(first)]:
+            first_to_hold = condition[id(first)] & stop
+            for before in leaving:
+                if distinct(before, first) and rank(before) < rank(first):
+                    first_to_hold &= tables.all ^ condition[id(before)]
+            taken[id(first)] = first_to_hold
+            if not first_to_hold:
                 found["dead"].add(first.name)
             none_holds &= tables.all ^ condition[id(first)]
             for second in leaving[position + 1 :]:
-                distinct = (first.priority is not None or second.priority is not None) and (
-                    first.priority != second.priority
-                )
-                if not distinct and condition[id(first)] & condition[id(second)]:
+                if not distinct(first, second) and condition[id(first)] & condition[id(second)] & stop:
                     found["overlap"].add(f"{first.name}|{second.name}")
         if none_holds:
             found["stuck"].add(state.name)
     reachable, frontier = {fsm.initial}, [fsm.initial]
     while frontier:
         source = frontier.pop()
-        if ending.get(source):
-            for t in fsm.transitions:
-                if t.source == source and condition[id(t)] and t.destination not in reachable:
-                    reachable.add(t.destination)
-                    frontier.append(t.destination)
+        for t in fsm.transitions:
+            if t.source == source and taken.get(id(t)) and t.destination not in reachable:
+                reachable.add(t.destination)
+                frontier.append(t.destination)
     found["lost"] = {s.name for s in fsm.states} - reachable
     return found
 
@@ -327,9 +334,9 @@ _PATTERNS = {
 }
 
 
-def bdd_findings(subsystem: Subsystem, fsm: FSM) -> dict[str, set[str]]:
+def bdd_findings(context: CheckContext, subsystem: Subsystem, fsm: FSM) -> dict[str, set[str]]:
     found: dict[str, set[str]] = {kind: set() for kind, _ in _PATTERNS.values()}
-    for code, findings in analyse(subsystem, fsm, "a/a.cs").findings.items():
+    for code, findings in analyse(context, subsystem, fsm, "a/a.cs").findings.items():
         if code not in _PATTERNS:
             continue
         kind, pattern = _PATTERNS[code]
@@ -342,13 +349,14 @@ def bdd_findings(subsystem: Subsystem, fsm: FSM) -> dict[str, set[str]]:
 
 def bench_fsm(predicates: int, transitions: int, runs: int, peer: bool) -> dict[str, Any]:
     system = earl.loads(fsm_spec(predicates, transitions), "fsm.earl")
-    subsystem = next(s for _, s in context_for(system).subsystems())
+    context = context_for(system)
+    subsystem = next(s for _, s in context.subsystems())
     fsm = subsystem.fsm
     assert fsm is not None and len(fsm.transitions) == transitions
     assert len(subsystem.primitive_predicates) == predicates
     bdd: list[Timing] = []
     for _ in range(runs):
-        found, timing = timed(lambda: bdd_findings(subsystem, fsm))
+        found, timing = timed(lambda: bdd_findings(context, subsystem, fsm))
         bdd.append(timing)
     row: dict[str, Any] = {
         "predicates": predicates,

@@ -558,6 +558,46 @@ CASES: list[Case] = [
         ),
     ),
     Case(
+        "EARL-W022",
+        edit(
+            ("        inp/ib: double\n", "        inp/ib: double\n        spare/ib: double\n"),
+            (
+                "            state run: run/bb\n            run -> run when got/pp",
+                "            state run: run/bb { obligatory inp/ib  optional inp/ib }\n            run -> run when got/pp",
+            ),
+        ),
+        35,
+        61,
+        "state `run` of a2/a.cs lists `inp/ib` as obligatory and as optional",
+        edit(
+            (
+                "            state run: run/bb\n            run -> run when got/pp",
+                "            state run: run/bb { obligatory inp/ib  timeout 5 ms }\n            run -> run when got/pp",
+            ),
+        ),
+    ),
+    Case(
+        "EARL-W022",
+        edit(
+            (
+                "            state run: run/bb\n            run -> run when got/pp",
+                "            state run: run/bb { optional inp/ib  timeout 5 ms }\n            run -> run when got/pp",
+            ),
+        ),
+        34,
+        13,
+        "state `run` of a2/a.cs has a `timeout` but no obligatory buffer to wait for",
+        BASE,
+    ),
+    Case(
+        "EARL-E044",
+        edit(("        take/pf(inp/ib -> y/mo)\n", '        take/pf(inp/ib -> y/mo) = python "take"\n')),
+        27,
+        9,
+        'the implementation of `take/pf`, `python "take"`, does not name a function',
+        edit(("        take/pf(inp/ib -> y/mo)\n", '        take/pf(inp/ib -> y/mo) = python "robot.relay:take"\n')),
+    ),
+    Case(
         "EARL-E064",
         edit(
             TWO_STATES,

@@ -544,6 +544,20 @@ def test_advance_to_takes_a_finite_number_of_seconds(time: Any, error: type[Exce
     sim.close()
 
 
+def test_advance_to_a_time_reached_does_nothing_and_a_negative_one_is_refused() -> None:
+    sim = earl.simulate(earl.load(SPECS / "counter"), seed=1)
+    try:
+        sim.advance_to(0.03)
+        with pytest.raises(ValueError, match=r"advance_to takes a run time from 0 on, not -1\.0"):
+            sim.advance_to(-1.0)
+        sim.advance_to(0.01)  # reached already: nothing to do
+        assert sim.time == pytest.approx(0.03)
+        sim.advance_to(0.05)
+        assert sim.time == pytest.approx(0.05)
+    finally:
+        sim.close()
+
+
 def test_a_memory_whose_initial_value_does_not_fit_is_said_at_its_line(tmp_path: Path) -> None:
     """`earl check` refuses it (EARL-E043); unchecked, the run names the memory's line, not the subsystem's."""
     spec = tmp_path / "counter"

@@ -85,6 +85,9 @@ def write(inputs, outputs, context):
         inputs.sent = 100  # inputs are read-only: the call fails, and writes nothing
     elif mode == 8:
         inputs.current[1] = 2.0  # a member of a family read, likewise
+    elif mode == 9:
+        outputs["current[1]"] = 3.0  # a member by its name, as `inputs["x[2]"]` reads one
+        LOG.append(outputs["current[1]"])
 """
 
 
@@ -264,6 +267,31 @@ def test_a_memory_and_an_output_buffer_of_one_name_are_written_by_attribute_and_
         assert sim.state_of("twin/a.echo/ve").inputs["level"] == 40.0
     finally:
         sim.close()
+
+
+def test_a_member_of_a_family_is_written_and_read_back_by_its_name(tmp_path: Path) -> None:
+    sim, log = run(tmp_path, 9)
+    assert sim.faults == []
+    assert sim.state_of("viewer/a.cs").memory["current[1]"] == 3.0
+    assert log[-1] == 3.0
+
+
+def test_an_output_buffer_read_back_before_it_is_written_is_a_fault_not_none(tmp_path: Path) -> None:
+    (tmp_path / "system.earl").write_text(SHARED_NAMES_SPEC)
+    (tmp_path / "sharing.py").write_text(
+        SHARED_NAMES_CODE.replace("    outputs.level = inputs.level\n", "    outputs.level = outputs['level'] or 1.0\n")
+    )
+    sim = earl.simulate(earl.load(tmp_path / "system.earl"), check=False)
+    try:
+        sim.advance_to(0.0005)
+        fault = next(f for f in sim.faults if f.subsystem == "twin/a.echo/ve")
+        assert fault.kind == "undeclared-read", sim.faults
+        assert "reads back the output buffer `level` before writing it" in fault.message
+    finally:
+        sim.close()
+        import sys
+
+        sys.modules.pop("sharing", None)
 
 
 def test_a_checked_array_of_reals_passes_again_at_once_but_only_at_its_size() -> None:

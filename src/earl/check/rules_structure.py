@@ -4,10 +4,11 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 
-from earl.check.context import CheckContext, instance_name
+from earl.check.context import CheckContext, instance_name, subsystem_name
 from earl.check.registry import Finding, rule
 from earl.diagnostics import Severity
 from earl.model.kinds import KIND_TITLES, Kind
+from earl.model.text import reference_text
 
 
 @rule("EARL-E001", Severity.ERROR, "a System contains at least one Robot", "§2.1, Figure 2")
@@ -148,3 +149,48 @@ def zombie_agent(context: CheckContext) -> Iterator[Finding]:
                 agent.location,
                 "link it to another agent's control subsystem, or give it effectors or receptors",
             )
+
+
+@rule("EARL-W022", Severity.WARNING, "a state's buffer group says each thing once", "§2.2, Figure 5b")
+def buffer_groups(context: CheckContext) -> Iterator[Finding]:
+    """A state lists an Input Buffer as obligatory (waited for) or as optional (taken when new), not
+    both; its `timeout` bounds the wait for the obligatory buffers, so it needs one to bound."""
+    for agent, subsystem in context.distinct_subsystems():
+        if subsystem.fsm is None:
+            continue
+        for state in subsystem.fsm.states:
+            obligatory = {reference_text(r) for r in state.obligatory}
+            for reference in state.optional:
+                if reference_text(reference) in obligatory:
+                    yield Finding(
+                        f"state `{state.name}` of {subsystem_name(agent, subsystem)} lists "
+                        f"`{reference_text(reference)}` as obligatory and as optional",
+                        reference.location or state.location,
+                        "name it once: obligatory to wait for it, optional to take it only when it is there",
+                    )
+            if state.timeout is not None and not state.obligatory:
+                yield Finding(
+                    f"state `{state.name}` of {subsystem_name(agent, subsystem)} has a `timeout` but no "
+                    "obligatory buffer to wait for",
+                    state.location,
+                    "make a buffer obligatory, or remove the timeout",
+                )
+
+
+@rule("EARL-E044", Severity.ERROR, "an implementation names a module and a function", "§2.2, Figure 6")
+def implementations_name_a_function(context: CheckContext) -> Iterator[Finding]:
+    """`= python "module:function"` tells `earl run` which function computes a Partial Transition
+    Function or a Primitive Predicate; without both parts there is nothing to import (`earl run`
+    refuses it, EARL-X001). Nothing is imported to check this."""
+    for _, subsystem in context.distinct_subsystems():
+        named = [(f"`{f.name}/pf`", f.implementation, f.location) for f in subsystem.partial_transition_functions]
+        named += [(f"`{p.name}/pp`", p.implementation, p.location) for p in subsystem.primitive_predicates]
+        for what, implementation, location in named:
+            if implementation is None:
+                continue
+            if not implementation.module.strip() or not implementation.function.strip():
+                yield Finding(
+                    f'the implementation of {what}, `python "{implementation.path}"`, does not name a function',
+                    location,
+                    'write `python "module:function"`, e.g. `python "robot.arm:move"`',
+                )

@@ -176,6 +176,9 @@ class Simulation:
             raise ValueError(
                 f"advance_to takes a finite run time of at most {Duration.MAX_SECONDS:g} s, not {seconds!r}"
             )
+        if seconds < 0:
+            # a run time starts at 0: a slip between advance_to and advance_by, most likely
+            raise ValueError(f"advance_to takes a run time from 0 on, not {seconds!r} (advance_by takes a duration)")
         if self._stopped_inside is not None:
             raise RuntimeError(
                 f"this simulation stopped inside an instant ({self._stopped_inside}), so a subsystem may be "

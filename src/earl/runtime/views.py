@@ -286,7 +286,12 @@ class Outputs:
             return self.__dict__[target.attribute]
         if target.key in target.store:
             return target.store[target.key]
-        return self._earl_memory.get(target.key) if target.is_memory else None
+        if target.is_memory:
+            return self._earl_memory.get(target.key)
+        # an output buffer holds nothing before the call writes it: read back, it is no `None` to go on with
+        raise UndeclaredAccess(
+            f"`{self._earl_function}` reads back the output buffer `{target.key}` before writing it", write=False
+        )
 
     def __setitem__(self, name: str, value: Any) -> None:
         target = self._earl_targets.get(name)
@@ -423,6 +428,7 @@ def build_outputs(
             targets[attribute] = target
         if index is not None:
             families.setdefault(reference.name, {})[index] = target
+            targets.setdefault(key, target)  # `outputs["wheelSpeed[1]"]`, as `inputs["x[2]"]` reads a member
     for name, members in families.items():
         family = outputs._earl_families[name] = FamilyOutputs(name, outputs, dict(sorted(members.items())))
         setattr(type(outputs), name, family)
