@@ -9,6 +9,7 @@ import itertools
 import random
 import re
 from collections.abc import Mapping
+from pathlib import Path
 
 import pytest
 
@@ -363,3 +364,11 @@ def test_a_member_of_a_family_is_analysed_with_its_own_index() -> None:
     same = FAMILY.replace("first/pp = K == 1", "first/pp = in/ib > 1.0")
     [overlap] = [d.message for d in check(earl.loads(same, "fam.earl")) if d.code == "EARL-E060"]
     assert "of w[1..2]/a.cs can both hold" in overlap  # one analysis, said once for both members
+
+
+def test_a_condition_over_a_large_family_is_one_boolean_to_the_analysis() -> None:
+    """`any(K in 1..N: …)` with N = 1,000 joints: 1,001 atoms in one `or` would make a BDD as deep as N
+    (dd's operations recurse once per variable: N = 2,500 exceeded Python's recursion limit)."""
+    example = Path(__file__).parent.parent / "examples" / "pick_and_place"
+    diagnostics = check(earl.load(example, {"N": 1000}))
+    assert [d for d in diagnostics if d.severity.value == "error"] == []

@@ -1185,3 +1185,21 @@ def test_equality_of_structs_and_arrays_needs_one_type_and_names_them() -> None:
     assert said("s/ib.arr != t/ib") == ["`s/ib.arr != t/ib` compares an array `double[3]` with a struct `T`"]
     assert said("s/ib == 3.0") == ["`s/ib == 3.0` compares a struct `S` with a number"]
     assert said("s/ib == u/ib") == []
+
+
+def test_the_hint_for_outputs_in_an_early_stage_says_what_fits_the_function() -> None:
+    # `emit/pf` reads only memory: it is a second-stage function already
+    [finding] = findings(edit(("tf = {compute/pf} then {emit/pf}", "tf = {compute/pf, emit/pf}")), "EARL-E040")
+    assert finding.hint == "`emit/pf` reads only memory: make it the second stage, `tf = {compute/pf} then {emit/pf}`"
+    # a family of output buffers is named as the spec writes it, not member by member
+    text = EXAMPLE.read_text(encoding="utf-8")
+    before = "tf = {calculatePosition/pf, jointMove/pf} then {outputManipState/pf, outputMotorCon/pf}"
+    assert before in text
+    wrong = text.replace(
+        before, "tf = {calculatePosition/pf, jointMove/pf, outputMotorCon/pf} then {outputManipState/pf}"
+    )
+    said = [d for d in check(earl.loads(wrong, str(EXAMPLE))) if d.code == "EARL-E040"]
+    assert [d.message.split(" in stage")[0] for d in said] == [
+        "`outputMotorCon/pf` writes `motorControllerCommand[*]/ob`"
+    ]
+    assert said[0].hint == "`outputMotorCon/pf` reads only memory: move it into the last stage (stage 2)"

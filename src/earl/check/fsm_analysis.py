@@ -134,6 +134,14 @@ def _constant(expression: Expression) -> Constant | None:
     return None
 
 
+#: the most operands of one `and`/`or`, and comparisons of one value, the analysis looks into
+_MOST_OPERANDS = 64
+
+
+def _shortened(text: str) -> str:
+    return text if len(text) <= 80 else text[:77] + "…"
+
+
 def _is_number(value: object) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool)
 
@@ -176,6 +184,10 @@ class _Encoder:
         if isinstance(expression, Not):
             return ~self.encode(expression.operand)
         if isinstance(expression, BooleanOperation):
+            if len(expression.operands) > _MOST_OPERANDS:
+                # `any(K in 1..N: …)` unrolled for a large N: one Boolean of its own, so that no
+                # BDD grows with N (dd's operations recurse once per variable)
+                return self.variable(_shortened(expression_text(expression)))
             operands = [self.encode(o) for o in expression.operands]
             result = operands[0]
             for operand in operands[1:]:
@@ -255,6 +267,8 @@ class _Encoder:
     def _regions(self, atoms: list[tuple[str, Constant, Function]]) -> Function:
         """One value compared with constants lies in one region of the line (or is one of the strings):
         the atoms hold together only as in one of the regions."""
+        if len(atoms) > _MOST_OPERANDS:
+            return self.bdd.true  # regions × atoms grows as the square: such comparisons stay unrelated
         constants = [constant for _, constant, _ in atoms]
         if all(_is_number(c) for c in constants):
             points = sorted({float(c) for c in constants})  # type: ignore[arg-type]
@@ -443,6 +457,25 @@ def analyse(context: CheckContext, subsystem: Subsystem, fsm: FSM, owner: str) -
     return Analysis(findings)
 
 
+def _fsm_key(subsystem: Subsystem) -> tuple[object, ...]:
+    """Equal for two members of a family whose FSM, conditions and predicates read the same once
+    expanded: one analysis serves them all. A member whose index reaches its conditions (`K == 1`
+    is `2 == 1` in member 2) reads differently and is analysed on its own."""
+    fsm = subsystem.fsm
+    assert fsm is not None
+    parts: list[object] = [id(subsystem.location), fsm.initial]
+    parts += [(p.name, expression_text(p.expression)) for p in subsystem.primitive_predicates]
+    parts += [(s.name, s.behaviour) for s in fsm.states]
+    parts += [(t.source, t.destination, t.priority, expression_text(t.condition.expression)) for t in fsm.transitions]
+    parts += [expression_text(a.expression) for a in fsm.assumptions]
+    for behaviour in subsystem.basic_behaviours:
+        parts.append(expression_text(behaviour.terminal_condition.expression))
+        parts.append(
+            None if behaviour.error_condition is None else expression_text(behaviour.error_condition.expression)
+        )
+    return tuple(parts)
+
+
 #: stands for the subsystem in the messages of an analysis shared by the members of a family
 _OWNER = "\x00owner\x00"
 
@@ -450,9 +483,9 @@ _OWNER = "\x00owner\x00"
 def analyses(context: CheckContext) -> dict[str, list[Finding]]:
     """Every FSM of the system analysed once per distinct content; cached on the context for the rules below.
 
-    Members of a family whose bodies are the same (`context.content_key`) are analysed once, and each
-    member's findings named after it, so that the check says them once with the indices as a range
-    (`w[1..4]/a.cs`); a member whose predicates depend on its index is analysed on its own."""
+    Members of a family whose FSMs read the same (`_fsm_key`) are analysed once, and each member's
+    findings named after it, so that the check says them once with the indices as a range
+    (`w[1..4]/a.cs`); a member whose conditions depend on its index is analysed on its own."""
     cached = getattr(context, "_fsm_analyses", None)
     if cached is not None:
         return cached  # type: ignore[no-any-return]
@@ -460,7 +493,7 @@ def analyses(context: CheckContext) -> dict[str, list[Finding]]:
     groups: dict[object, list[tuple[Agent, Subsystem]]] = {}
     for agent, subsystem in context.subsystems():
         if subsystem.fsm is not None:
-            groups.setdefault(context.content_key(agent, subsystem), []).append((agent, subsystem))
+            groups.setdefault(_fsm_key(subsystem), []).append((agent, subsystem))
     for members in groups.values():
         _, subsystem = members[0]
         assert subsystem.fsm is not None

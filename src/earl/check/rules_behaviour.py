@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterable, Iterator
 
 from earl.check.context import CheckContext, instance_name, reference_key, subsystem_name
@@ -106,20 +107,31 @@ def _writes(
     return stages
 
 
-def _stage_fix(function: str, outputs: list[str], stages: int, number: int) -> str:
-    """How to move output-buffer writes out of an early stage: the hint of EARL-E040."""
+def _families(names: list[str]) -> list[str]:
+    """`x[1]/ob, x[2]/ob` as the spec writes them: `x[*]/ob` (an expanded function lists every member)."""
+    bases = [re.sub(r"\[\d+\]", "[*]", name) for name in names]
+    return [base if bases.count(base) > 1 else name for name, base in dict(zip(bases, names, strict=True)).items()]
+
+
+def _stage_fix(function: str, outputs: list[str], stages: int, number: int, sender: bool, others: list[str]) -> str:
+    """How to move output-buffer writes out of an early stage: the hint of EARL-E040. `sender`: the
+    function reads only memory and writes only output buffers, a last-stage function already;
+    `others`: the other functions of its stage."""
+    outputs = _families(outputs)
     memory = ", ".join(f"{name.removesuffix('/ob')}/mo" for name in outputs)
     sends = ", ".join(outputs)
+    if sender and stages == 1 and others:
+        first = ", ".join(f"{name}/pf" for name in others)
+        return f"`{function}/pf` reads only memory: make it the second stage, `tf = {{{first}}} then {{{function}/pf}}`"
     if stages == 1:
         return (
             f"a one-stage `tf` has no stage for outputs (Eq. 4–6): let `{function}/pf` write memory instead "
             f"(`-> {memory}`, declared as `/m`) and add a second stage that sends it, "
             f"`tf = {{{function}/pf}} then {{send/pf}}` with `send/pf(… /mi -> {sends})`"
         )
-    return (
-        f"move `{function}/pf` into the last stage (stage {stages}) if it reads only memory, or let it write "
-        f"memory (`-> {memory}`) that a last-stage function sends to {sends}"
-    )
+    if sender:
+        return f"`{function}/pf` reads only memory: move it into the last stage (stage {stages})"
+    return f"let `{function}/pf` write memory (`-> {memory}`) that a function of the last stage sends to {sends}"
 
 
 @rule("EARL-E040", Severity.ERROR, "only the last stage writes output buffers", "Eq. (4), Eq. (6)")
@@ -152,10 +164,14 @@ def output_buffers_in_last_stage(context: CheckContext) -> Iterator[Finding]:
                                     if len(stages) == 1
                                     else "only the last stage writes output buffers"
                                 )
+                                sender = all(r.kind is Kind.MEMORY_INPUT for r in function.reads) and all(
+                                    w.kind is Kind.OUTPUT_BUFFER for w in function.writes
+                                )
+                                others = [f.name for f in stage if f.name != function.name]
                                 yield Finding(
-                                    f"`{function.name}/pf` writes `{'`, `'.join(outputs)}` in stage {number} of `{behaviour.name}/bb` in `{subsystem_name(agent, subsystem)}`: {why}",
+                                    f"`{function.name}/pf` writes `{'`, `'.join(_families(outputs))}` in stage {number} of `{behaviour.name}/bb` in `{subsystem_name(agent, subsystem)}`: {why}",
                                     function_reference.location,
-                                    _stage_fix(function.name, outputs, len(stages), number),
+                                    _stage_fix(function.name, outputs, len(stages), number, sender, others),
                                 )
                         else:
                             for element in [*function.reads, *function.writes]:
