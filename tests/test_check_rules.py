@@ -840,7 +840,7 @@ def test_an_early_stage_output_names_every_buffer_once() -> None:
     found = [d for d in findings(text, "EARL-E040") if "writes `out/ob`" in d.message]
     assert len(found) == 1
     assert "writes `out/ob`, `extra/ob` in stage 1 of `run/bb`" in found[0].message
-    assert found[0].hint is not None and "move `emit/pf` into the last stage (stage 2)" in found[0].hint
+    assert found[0].hint == "`emit/pf` reads only memory: move it into the last stage (stage 2)"
 
 
 # ---------------------------------------------------------------- the manual's example
@@ -1203,3 +1203,24 @@ def test_the_hint_for_outputs_in_an_early_stage_says_what_fits_the_function() ->
         "`outputMotorCon/pf` writes `motorControllerCommand[*]/ob`"
     ]
     assert said[0].hint == "`outputMotorCon/pf` reads only memory: move it into the last stage (stage 2)"
+
+
+def test_a_constant_index_outside_a_fixed_array_is_refused() -> None:
+    text = edit(
+        ("        x/m: double = 0.0\n", "        x/m: double = 0.0\n        v/m: double[3] = [0.0, 0.0, 0.0]\n"),
+        ("        go/pp = x/mi > 1.0\n", "        go/pp = x/mi > 1.0 or v/mi[5] > 1.0\n"),
+    )
+    [finding] = findings(text, "EARL-E030")
+    assert finding.message == "`v/mi[5]` reads element 5 of a `double[3]`, whose elements are 0 to 2"
+    assert findings(text.replace("v/mi[5]", "v/mi[2]"), "EARL-E030") == []
+
+
+def test_a_transition_condition_reading_unwritten_memory_is_reported() -> None:
+    text = edit(
+        ("        x/m: double = 0.0\n", "        x/m: double = 0.0\n        z/m: double\n"),
+        ("        go/pp = x/mi > 1.0\n", "        go/pp = x/mi > 1.0\n        zset/pp = z/mi > 0.0\n"),
+        ("            run -> run when go/pp\n", "            run -> run when go/pp and zset/pp\n"),
+    )
+    [finding] = findings(text, "EARL-W041")
+    assert finding.message.startswith("the condition of transition `run,run/t` reads `z/mi` (through `zset/pp`)")
+    assert findings(edit(("z/m: double\n", "z/m: double = 0.0\n"), text=text), "EARL-W041") == []

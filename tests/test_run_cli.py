@@ -717,3 +717,24 @@ def test_an_element_of_an_array_output_buffer_is_plotted_by_its_index(tmp_path: 
     assert plot.returncode == 0, plot.stderr
     wrong = earl_cli("plot", str(trace), "--signal", "a/a.cs.v.value[0]", "-o", str(tmp_path / "w.png"))
     assert wrong.returncode == 1 and "the trace has `v[0]`, `v[1]`" in wrong.stderr, wrong.stderr
+
+
+def test_options_that_would_record_nothing_are_said(tmp_path: Path) -> None:
+    result = earl_cli("run", str(SPECS / "counter"), "--duration", "20ms", "--record-memory", "all")
+    assert result.returncode == 0
+    assert "--record-memory choose what a trace records; without --trace nothing is recorded" in result.stderr
+    traced = earl_cli(
+        "run",
+        str(SPECS / "counter"),
+        "--duration",
+        "20ms",
+        "--trace",
+        str(tmp_path / "t.mcap"),
+        "--record-links",
+        "counter/a:relay*",
+        "--record-links",
+        "nomatch*",
+    )
+    assert traced.returncode == 0
+    assert "--record-links `nomatch*` matches no link (the links: counter/a:cs,relay" in traced.stderr
+    assert "`counter/a:relay*`" not in traced.stderr

@@ -204,7 +204,13 @@ def test_a_fifo_input_buffer_keeps_its_capacity_by_its_overflow_policy(
     sim, _ = simulate(spec)
     sim.advance_to(0.0125)
     assert sim.state_of("pipe/a.consumer/ve").memory["seen"] == seen
-    assert len([f for f in sim.faults if f.kind == "overflow"]) == faults
+    overflows = [f.message for f in sim.faults if f.kind == "overflow"]
+    assert len(overflows) == faults
+    if overflows:  # each says what was dropped since the last receive, and the total so far
+        assert [m.split(": ", 1)[1] for m in overflows[:2]] == [
+            "1 dropped since the last receive, 1 in all",
+            "2 dropped since the last receive, 3 in all",
+        ]
 
 
 # ---------------------------------------------------------------------- determinism and traces
@@ -570,3 +576,22 @@ def test_a_memory_whose_initial_value_does_not_fit_is_said_at_its_line(tmp_path:
     [diagnostic] = refused.value.diagnostics
     assert diagnostic.code == "EARL-X010" and "the initial value of count/m must be" in diagnostic.message
     assert diagnostic.location is not None and diagnostic.location.line == line
+
+
+def test_a_condition_that_fails_names_the_primitive_predicate_at_fault(tmp_path: Path) -> None:
+    spec = tmp_path / "counter"
+    shutil.copytree(SPECS / "counter", spec)
+    text = (spec / "system.earl").read_text()
+    text = text.replace(
+        "        count/m: int = 0\n", "        count/m: int = 0\n        v/m: double[3] = [0.0, 0.0, 0.0]\n"
+    )
+    text = text.replace("done/pp = count/mi >= LIMIT", "done/pp = count/mi >= LIMIT or v/mi[5] > 1.0")
+    (spec / "system.earl").write_text(text)
+    sim = earl.simulate(earl.load(spec), check=False)  # `earl check` refuses it (EARL-E030)
+    try:
+        sim.advance_to(0.005)
+        assert sim.faults[0].message == (
+            "evaluating the terminal condition of `counting/bb` raised IndexError: tuple index out of range in `done/pp`"
+        )
+    finally:
+        sim.close()

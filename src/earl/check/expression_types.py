@@ -187,6 +187,7 @@ class ExpressionTyper:
                     return UNKNOWN
                 current = self.context.structural(field.data_type)
             elif not isinstance(accessor, FieldAccess) and isinstance(current, ArrayType):
+                self._check_index(read, accessor, current)
                 current = self.context.structural(current.element)
             else:
                 return UNKNOWN
@@ -198,6 +199,25 @@ class ExpressionTyper:
             if current.name == "string":
                 return STRING
         return OTHER
+
+    def _check_index(self, read: Read, accessor: object, array: ArrayType) -> None:
+        """A constant index outside a fixed-size array: `ranges/ib[8]` of a `double[8]` (elements 0 to 7)
+        would fail every time the condition is evaluated, and count as false."""
+        index = getattr(accessor, "index", None)
+        size = array.size
+        if not (isinstance(index, Literal) and isinstance(size, Literal)):
+            return
+        position, length = index.value, size.value
+        if isinstance(position, bool) or not isinstance(position, int) or not isinstance(length, int):
+            return
+        if not 0 <= position < length:
+            self.problems.append(
+                TypeProblem(
+                    f"`{expression_text(read)}` reads element {position} of a `{type_text(array)}`, whose elements "
+                    f"are 0 to {length - 1}",
+                    getattr(accessor, "location", None) or read.location,
+                )
+            )
 
 
 __all__ = ["BOOLEAN", "ExpressionTyper", "TypeProblem"]

@@ -309,8 +309,8 @@ def memory_read_before_written(context: CheckContext) -> Iterator[Finding]:
     """Memory without an initial value holds only its type's zero value until a function writes it. A
     state can be entered with such memory unwritten when a chain of transitions leads to it from the
     initial state through states whose behaviours never write it; there, a function that reads it before
-    an earlier stage wrote it, or a terminal or error condition the behaviour's functions do not write it
-    for, reads a value nobody computed."""
+    an earlier stage wrote it, or a terminal or error condition, or the condition of a transition out of
+    the state, that the behaviour's functions do not write it for, reads a value nobody computed."""
 
     def findings() -> Iterator[Finding]:
         for agent, subsystem in context.distinct_subsystems():
@@ -335,14 +335,23 @@ def memory_read_before_written(context: CheckContext) -> Iterator[Finding]:
                     yield from _early_function_reads(subsystem, behaviour, key, where, hint)
                     if key in _memory_written(subsystem, behaviour):
                         continue
-                    conditions = [behaviour.terminal_condition, behaviour.error_condition]
-                    for condition in conditions:
+                    # the behaviour's own conditions, and those of the transitions tried when it stops
+                    conditions = [
+                        (f"the condition of `{behaviour.name}/bb`", behaviour.terminal_condition),
+                        (f"the condition of `{behaviour.name}/bb`", behaviour.error_condition),
+                        *(
+                            (f"the condition of transition `{t.name}/t`", t.condition)
+                            for t in subsystem.fsm.transitions
+                            if t.source == name
+                        ),
+                    ]
+                    for what, condition in conditions:
                         if condition is None:
                             continue
                         for read_key, read in _memory_read(subsystem, condition.expression):
                             if read_key == key:
                                 yield Finding(
-                                    f"the condition of `{behaviour.name}/bb` reads `{key}/mi` (through `{reference_text(read.target)}`) after the first iteration {where}, before anything wrote it",
+                                    f"{what} reads `{key}/mi` (through `{reference_text(read.target)}`) after the first iteration {where}, before anything wrote it",
                                     read.location or condition.location,
                                     hint,
                                 )

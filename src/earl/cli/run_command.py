@@ -242,6 +242,7 @@ def run(arguments: argparse.Namespace) -> int:
         _close(transport)
         print(f"earl run: {error}", file=sys.stderr)
         return EXIT_FAILED
+    _say_what_is_not_recorded(arguments, simulation)
     try:
         if transport is not None:
             from earl.transport.process import wait_for_peers
@@ -259,6 +260,24 @@ def run(arguments: argparse.Namespace) -> int:
         # Zenoh session's threads would keep the process from ever ending.
         with contextlib.suppress(Exception):
             simulation.close()
+
+
+def _say_what_is_not_recorded(arguments: argparse.Namespace, simulation: Any) -> None:
+    """A line for options that would record nothing: no trace to record into, or a link pattern that
+    matches no link of the system (a misspelt glob would otherwise leave the trace quietly empty)."""
+    from fnmatch import fnmatchcase
+
+    chosen = [name for name in ("record_memory", "record_links") if getattr(arguments, name) is not None]
+    if arguments.trace is None and chosen:
+        options = " and ".join(f"--{name.replace('_', '-')}" for name in chosen)
+        print(f"earl run: {options} choose what a trace records; without --trace nothing is recorded", file=sys.stderr)
+    links = sorted(simulation.network.link_types)
+    for pattern in arguments.record_links or []:
+        if not any(fnmatchcase(link, pattern) for link in links):
+            known = ", ".join(links[:8]) + (" …" if len(links) > 8 else "")
+            print(
+                f"earl run: --record-links `{pattern}` matches no link (the links: {known or 'none'})", file=sys.stderr
+            )
 
 
 #: signals that end a run as Ctrl-C does: `kill`, `timeout`, a service manager, a closed terminal

@@ -15,13 +15,15 @@ from typing import Any
 class Channel:
     """Messages that arrived for one Input Buffer and were not yet received."""
 
-    __slots__ = ("capacity", "dropped", "overflow", "overflowed", "queue")
+    __slots__ = ("capacity", "dropped", "overflow", "overflowed", "queue", "reported")
 
     def __init__(self, capacity: int | None = None, overflow: str = "dropOldest") -> None:
         self.capacity = capacity
         self.overflow = overflow
         self.queue: deque[Any] = deque()
         self.dropped = 0
+        #: `dropped` when the receiver last reported an overflow: what was dropped since is the news
+        self.reported = 0
         #: set when a `fault`-policy FIFO overflowed; the receiver reports it and clears it
         self.overflowed = False
 

@@ -254,8 +254,12 @@ class SubsystemEngine:
                 # a FIFO can only have overflowed when something arrived
                 if channel.overflowed:
                     channel.overflowed = False
+                    since, channel.reported = channel.dropped - channel.reported, channel.dropped
                     self.report_fault(
-                        time, "overflow", f"the FIFO of `{key}/ib` overflowed ({channel.dropped} dropped)"
+                        time,
+                        "overflow",
+                        f"the FIFO of `{key}/ib` overflowed: {since} dropped since the last receive, "
+                        f"{channel.dropped} in all",
                     )
             elif new_data[key]:
                 new_data[key] = False
@@ -280,7 +284,9 @@ class SubsystemEngine:
         except (KeyboardInterrupt, SystemExit):
             raise
         except BaseException as raised:  # a Python predicate's own exception class may derive from BaseException
-            self.report_fault(time, "predicate", f"evaluating {what} raised {exception_text(explain(raised))}")
+            inside = _predicate_raising(raised)
+            where = f" in `{inside}`" if inside and inside not in what else ""
+            self.report_fault(time, "predicate", f"evaluating {what} raised {exception_text(explain(raised))}{where}")
             return False
 
     def decide(self, time: int) -> None:
@@ -305,7 +311,11 @@ class SubsystemEngine:
                 raise
             except BaseException as raised:
                 what = f"the terminal condition of `{behaviour.name}/bb`"
-                self.report_fault(time, "predicate", f"evaluating {what} raised {exception_text(explain(raised))}")
+                inside = _predicate_raising(raised)
+                where = f" in `{inside}`" if inside else ""
+                self.report_fault(
+                    time, "predicate", f"evaluating {what} raised {exception_text(explain(raised))}{where}"
+                )
                 terminal = False
             if not terminal:
                 return
@@ -337,6 +347,19 @@ class SubsystemEngine:
 
     def snapshot(self) -> dict[str, Any]:
         return dict(self.memory)
+
+
+def _predicate_raising(error: BaseException) -> str | None:
+    """`stopRequested/pp`: the innermost compiled primitive predicate the error passed through (its code is
+    named `<earl predicate SUBSYSTEM NAME/pp>`), so that a condition's fault names the predicate at fault."""
+    found = None
+    trace = error.__traceback__
+    while trace is not None:
+        filename = trace.tb_frame.f_code.co_filename
+        if filename.startswith("<earl predicate ") and filename.endswith("/pp>"):
+            found = filename[:-1].rsplit(" ", 1)[-1]
+        trace = trace.tb_next
+    return found
 
 
 def exception_text(error: BaseException) -> str:
