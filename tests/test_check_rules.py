@@ -1224,3 +1224,12 @@ def test_a_transition_condition_reading_unwritten_memory_is_reported() -> None:
     [finding] = findings(text, "EARL-W041")
     assert finding.message.startswith("the condition of transition `run,run/t` reads `z/mi` (through `zset/pp`)")
     assert findings(edit(("z/m: double\n", "z/m: double = 0.0\n"), text=text), "EARL-W041") == []
+
+
+def test_a_quantifier_whose_body_is_not_boolean_is_said_once_as_written() -> None:
+    text = BASE.replace("system base\n", "system base\n\nparam N: int = 3\n").replace(
+        "        go/pp = x/mi > 1.0\n", "        go/pp = x/mi > 1.0\n        odd/pp = any(K in 1..N: K)\n"
+    )
+    assert [d.message for d in findings(text, "EARL-E030")] == [
+        "the body of `any(K in …: …)` must be a boolean, but `K` is a number"
+    ]

@@ -83,6 +83,16 @@ class ExpressionTyper:
             self._expect(expression.operand, BOOLEAN, "the operand of `not`")
             return BOOLEAN
         if isinstance(expression, BooleanOperation):
+            quantifier = expression.unrolled
+            if quantifier is not None:
+                # `any(K in 1..N: …)` unrolled: every operand is the body for one K; said once, as written
+                self._expect(
+                    expression.operands[0],
+                    BOOLEAN,
+                    f"the body of `{quantifier.quantifier}({quantifier.index} in …: …)`",
+                    shown=expression_text(quantifier.body),
+                )
+                return BOOLEAN
             for operand in expression.operands:
                 self._expect(operand, BOOLEAN, f"an operand of `{expression.operator}`")
             return BOOLEAN
@@ -112,12 +122,12 @@ class ExpressionTyper:
             return BOOLEAN
         return UNKNOWN
 
-    def _expect(self, expression: Expression, expected: str, role: str) -> None:
+    def _expect(self, expression: Expression, expected: str, role: str, shown: str | None = None) -> None:
         actual = self.type_of(expression)
         if actual not in (expected, UNKNOWN):
             self.problems.append(
                 TypeProblem(
-                    f"{role} must be a {expected}, but `{expression_text(expression)}` is a {actual}",
+                    f"{role} must be a {expected}, but `{shown or expression_text(expression)}` is a {actual}",
                     expression.location,
                 )
             )

@@ -500,5 +500,5 @@ def _expression(expression: Expression, environment: Mapping[str, Value], member
         if len(bodies) == 1:
             return bodies[0]
         operator = "or" if expression.quantifier == "any" else "and"
-        return BooleanOperation(operator, bodies, expression.location)
+        return BooleanOperation(operator, bodies, expression.location, expression)
     raise TypeError(f"not an expression: {expression!r}")

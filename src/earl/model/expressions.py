@@ -8,7 +8,7 @@ formulas of primitive predicates, initial conditions and terminal conditions.
 from __future__ import annotations
 
 from collections.abc import Iterator, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from earl.model.frozen import quick_init
 from earl.model.kinds import Kind
@@ -133,6 +133,9 @@ class BooleanOperation:
     operator: str  # "and" | "or"
     operands: tuple[Expression, ...]
     location: SourceLocation | None = location_field()
+    #: in an expanded system, the `any`/`all` this operation unrolls (one operand per index value), so
+    #: that a message can speak of what was written; no part of the operation's meaning
+    unrolled: Quantifier | None = field(default=None, compare=False, repr=False)
 
 
 @quick_init
