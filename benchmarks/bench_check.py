@@ -310,8 +310,8 @@ def enumerate_findings(subsystem: Subsystem, fsm: FSM) -> dict[str, set[str]]:
                 found["dead"].add(first.name)
             none_holds &= tables.all ^ condition[id(first)]
             for second in leaving[position + 1 :]:
-                if not distinct(first, second) and condition[id(first)] & condition[id(second)] & stop:
-                    found["overlap"].add(f"{first.name}|{second.name}")
+                if not distinct(first, second) and first_to_hold & condition[id(second)]:
+                    found["overlap"].add(f"{first.name}|{second.name}")  # both first to hold: higher ones not
         if none_holds:
             found["stuck"].add(state.name)
     reachable, frontier = {fsm.initial}, [fsm.initial]

@@ -101,7 +101,14 @@ def brute_force(subsystem: Subsystem, fsm: FSM) -> dict[str, set[str]]:
             if not taken:
                 found["EARL-W062"].add(t.name)
         for first, second in itertools.combinations(leaving, 2):
-            both = any(value(first.condition.expression, a) and value(second.condition.expression, a) for a in stopping)
+            # both the first to hold: a transition of higher priority holding is taken instead
+            higher = [u for u in leaving if distinct(u, first) and rank(u) < rank(first)]
+            both = any(
+                value(first.condition.expression, a)
+                and value(second.condition.expression, a)
+                and not any(value(u.condition.expression, a) for u in higher)
+                for a in stopping
+            )
             if not distinct(first, second) and both:
                 found["EARL-E060"].add(f"{first.name}|{second.name}")
         if any(stops(a) and not any(value(t.condition.expression, a) for t in leaving) for a in allowed):
@@ -372,3 +379,72 @@ def test_a_condition_over_a_large_family_is_one_boolean_to_the_analysis() -> Non
     example = Path(__file__).parent.parent / "examples" / "pick_and_place"
     diagnostics = check(earl.load(example, {"N": 1000}))
     assert [d for d in diagnostics if d.severity.value == "error"] == []
+
+
+def probe_text(
+    first: str, second: str, stop: str = "true", extra: str = "", fsm_extra: str = ""
+) -> dict[str, list[str]]:
+    """`probe`, with more declarations in the subsystem (`extra`) and more lines in the FSM (`fsm_extra`)."""
+    text = PROBE.replace("TC", stop).replace("FIRST", first).replace("SECOND", second)
+    text = text.replace("        false/pp = false\n", "        false/pp = false\n" + extra)
+    text = text.replace("            run -> b when", fsm_extra + "            run -> b when")
+    found: dict[str, list[str]] = {}
+    for diagnostic in check(earl.loads(text, "probe.earl")):
+        if diagnostic.code in ("EARL-E060", "EARL-W061", "EARL-W062", "EARL-E064", "EARL-W020"):
+            found.setdefault(diagnostic.code, []).append(diagnostic.message)
+    return found
+
+
+def test_two_predicates_computed_by_python_are_two_booleans_whatever_they_read() -> None:
+    extra = '        pa/pp(v/ib) = python "m:f"\n        pb/pp(v/ib) = python "m:g"\n'
+    found = probe_text("pa/pp", "not pb/pp", extra=extra)
+    assert "EARL-E060" in found and "EARL-W061" in found
+    assert "EARL-W062" not in probe_text("pa/pp and not pb/pp", "pb/pp", extra=extra)
+
+
+def test_the_same_comparison_written_many_times_is_still_one_comparison() -> None:
+    many = "".join("            assume v/ib > 5.0 or true\n" for _ in range(70))
+    assert "EARL-E060" not in probe_text("v/ib > 5.0", "v/ib < 3.0", fsm_extra=many)
+
+
+def test_two_long_quantifiers_alike_in_their_first_words_are_two_booleans() -> None:
+    extra = "        q[K in 1..100]/ib: boolean\n"
+    found = probe_text(
+        "not any(K in 1..70: q[K]/ib) and any(K in 1..80: q[K]/ib)", "not any(K in 1..80: q[K]/ib)", extra=extra
+    )
+    assert "EARL-W062" not in found and "EARL-W020" not in found
+
+
+@pytest.mark.parametrize(
+    ("first", "second"),
+    [
+        ("v/ib > 1e16", "v/ib <= 1e16"),
+        ("n/ib > 9007199254740992", "n/ib <= 9007199254740992"),
+        ("n/ib > 1" + "0" * 400, "n/ib < -1" + "0" * 400),
+        ("v/ib < 1e999", "v/ib > 2.0"),
+    ],
+)
+def test_comparisons_with_large_constants_are_decided_exactly(first: str, second: str) -> None:
+    found = probe_text(first, second, extra="        n/ib: int\n")
+    assert "EARL-W062" not in found and "EARL-W020" not in found
+
+
+def test_timeout_of_a_field_is_timeout_of_its_buffer_and_never_holds_with_new_data() -> None:
+    assert "EARL-E060" not in probe_text("timeout(s/ib.opt)", "not timeout(s/ib)")
+    assert "EARL-E060" not in probe_text("newData(s/ib.opt)", "timeout(s/ib)")
+
+
+def test_overlaps_of_transitions_a_higher_priority_always_preempts_are_no_ambiguity() -> None:
+    found = probe_text("go/pp", "go/pp", stop="go/pp", fsm_extra="            run -> run when go/pp priority 1\n")
+    assert "EARL-E060" not in found
+    assert len(found["EARL-W062"]) == 2  # both are never taken
+
+
+def test_a_transition_covered_by_several_before_it_names_them_all() -> None:
+    found = probe_text(
+        "v/ib > 5.0 priority 1", "v/ib <= 5.0 priority 2", fsm_extra="            run -> run when true priority 3\n"
+    )
+    assert found["EARL-W062"] == [
+        "transition `run,run/t` of x/a.cs can never be taken: whenever its condition holds, one of `run,a/t`, "
+        "`run,b/t` holds too and is tried first"
+    ]

@@ -457,6 +457,12 @@ def test_stale_reads_the_set_of_buffers_whose_remote_sender_is_gone(tmp_path: Pa
         sim.advance_to(0.0035)
         assert [(t, b) for t, _, _, b in events.states][1:] == [(3 * MS, "wait")]
         assert sim.state_of("waiter/a.cs").timed_out == {"ping": True}  # a stale buffer also times out
+        # a message that comes while the buffer is still stale (before its sender's liveliness is known):
+        # the buffer has new data, so it did not time out
+        engine.channels["ping"].deliver(1.0)
+        sim.advance_to(0.0045)
+        waiter = sim.state_of("waiter/a.cs")
+        assert waiter.new_data == {"ping": True} and waiter.timed_out == {"ping": False}
     finally:
         sim.close()
 

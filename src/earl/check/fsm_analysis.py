@@ -33,9 +33,11 @@ from __future__ import annotations
 
 import importlib
 import itertools
+import math
 import sys
 from collections.abc import Iterator
 from dataclasses import dataclass
+from fractions import Fraction
 from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
@@ -134,8 +136,10 @@ def _constant(expression: Expression) -> Constant | None:
     return None
 
 
-#: the most operands of one `and`/`or`, and comparisons of one value, the analysis looks into
+#: the most operands of one `and`/`or` the analysis looks into
 _MOST_OPERANDS = 64
+#: the most different comparisons of one value with constants it relates (their regions cost the square)
+_MOST_COMPARISONS = 128
 
 
 def _shortened(text: str) -> str:
@@ -158,7 +162,11 @@ class _Encoder:
         #: the variables a condition names itself; examples show these, not what predicates stand for
         self.surface: set[str] = set()
         self._depth = 0  # > 0 while encoding a predicate's definition
-        self.definitions: dict[str, Expression] = {p.name: p.expression for p in subsystem.primitive_predicates}
+        #: what each predicate stands for; one computed by Python is a Boolean of its own (its
+        #: `python(reads)` says only what it reads, which two different predicates may share)
+        self.definitions: dict[str, Expression] = {
+            p.name: p.expression for p in subsystem.primitive_predicates if p.implementation is None
+        }
         self._defining: set[str] = set()
         self._constants: dict[str, Function] = {}  # predicates whose definitions are constants
         self.meaning = self.bdd.true  # what the atoms mean: definitions, comparisons, newData
@@ -168,10 +176,12 @@ class _Encoder:
         self.call_arguments: dict[str, Read] = {}
 
     def variable(self, text: str) -> Function:
+        """The Boolean named by `text` (the whole text: two long formulas alike in their first words
+        are two Booleans); messages show it shortened."""
         name = self.by_text.get(text)
         if name is None:
             name = self.by_text[text] = f"v{len(self.by_text)}"
-            self.names[name] = text
+            self.names[name] = _shortened(text)
             self.bdd.declare(name)
         if self._depth == 0:
             self.surface.add(name)
@@ -187,7 +197,7 @@ class _Encoder:
             if len(expression.operands) > _MOST_OPERANDS:
                 # `any(K in 1..N: …)` unrolled for a large N: one Boolean of its own, so that no
                 # BDD grows with N (dd's operations recurse once per variable)
-                return self.variable(_shortened(expression_text(expression)))
+                return self.variable(expression_text(expression))
             operands = [self.encode(o) for o in expression.operands]
             result = operands[0]
             for operand in operands[1:]:
@@ -199,12 +209,21 @@ class _Encoder:
             return self._comparison(expression)
         if isinstance(expression, Call) and len(expression.arguments) == 1:
             argument = expression.arguments[0]
-            variable = self.variable(expression_text(expression))
+            if isinstance(argument, Read) and argument.path and expression.function in ("timeout", "stale"):
+                # `timeout(x/ib.f)` is `timeout(x/ib)`: a buffer times out or goes stale as a whole
+                argument = Read(argument.target, (), argument.location)
+                expression = Call(expression.function, (argument,), expression.location)
             if isinstance(argument, Read):
-                self.calls[(expression.function, expression_text(argument))] = variable
-                self.call_arguments[expression_text(argument)] = argument
-            return variable
+                return self._call(expression.function, argument)
+            return self.variable(expression_text(expression))
         return self.variable(expression_text(expression))
+
+    def _call(self, function: str, argument: Read) -> Function:
+        """`newData(x/ib)`, `timeout(x/ib)`, `stale(x/ib)`: a Boolean each, related by `constraints`."""
+        variable = self.variable(expression_text(Call(function, (argument,))))
+        self.calls[(function, expression_text(argument))] = variable
+        self.call_arguments[expression_text(argument)] = argument
+        return variable
 
     def _predicate(self, read: Read) -> Function:
         text = expression_text(read)
@@ -249,34 +268,39 @@ class _Encoder:
         return self.variable(text)
 
     def constraints(self) -> Function:
-        """What the atoms mean (call once every formula is encoded)."""
+        """What the atoms mean (call once every formula is encoded): comparisons by their regions;
+        `newData(x/ib.f)` only with `newData(x/ib)`; `timeout(x/ib)` only without it (a buffer that took
+        a message did not time out, stale or not). `stale` is related to nothing: a message may arrive
+        from a peer whose liveliness is not known yet."""
         meaning = self.meaning
         for atoms in self.comparisons.values():
             meaning &= self._regions(atoms)
-        for (function, argument), variable in self.calls.items():
-            read = self.call_arguments[argument]
-            whole = self.calls.get(("newData", expression_text(Read(read.target))))
-            if function == "newData" and read.path and whole is not None:
-                meaning &= variable.implies(whole)
-            elif function in ("timeout", "stale") and not read.path:
-                arrived = self.calls.get(("newData", argument))
-                if arrived is not None:
-                    meaning &= variable.implies(~arrived)
+        depth, self._depth = self._depth, 1  # the buffer's own `newData` is no word of a condition
+        try:
+            for (function, _), variable in list(self.calls.items()):
+                read = self.call_arguments[_]
+                if function == "newData" and read.path:
+                    meaning &= variable.implies(self._call("newData", Read(read.target)))
+                elif function == "timeout":
+                    meaning &= variable.implies(~self._call("newData", read))
+        finally:
+            self._depth = depth
         return meaning
 
     def _regions(self, atoms: list[tuple[str, Constant, Function]]) -> Function:
         """One value compared with constants lies in one region of the line (or is one of the strings):
         the atoms hold together only as in one of the regions."""
-        if len(atoms) > _MOST_OPERANDS:
+        atoms = list({id(variable): (op, c, variable) for op, c, variable in atoms}.values())  # each once
+        if len(atoms) > _MOST_COMPARISONS:
             return self.bdd.true  # regions × atoms grows as the square: such comparisons stay unrelated
         constants = [constant for _, constant, _ in atoms]
-        if all(_is_number(c) for c in constants):
-            points = sorted({float(c) for c in constants})  # type: ignore[arg-type]
-            samples: list[Constant] = [points[0] - 1.0, points[-1] + 1.0]
-            samples += points
+        if all(_is_number(c) and (isinstance(c, int) or math.isfinite(c)) for c in constants):  # type: ignore[arg-type]
+            # exact: a float is a fraction, and so is an int of any size (2**53 + 1 is not 2**53)
+            points = sorted({Fraction(c) for c in constants})  # type: ignore[arg-type]
+            samples: list[object] = [points[0] - 1, points[-1] + 1, *points]
             samples += [(low + high) / 2 for low, high in itertools.pairwise(points)]
         elif all(isinstance(c, str) for c in constants) and all(op in ("==", "!=") for op, _, _ in atoms):
-            samples = [*dict.fromkeys(constants), object()]  # type: ignore[list-item]  # the strings, and any other
+            samples = [*dict.fromkeys(constants), object()]  # the strings, and any other
         else:
             return self.bdd.true
         regions = self.bdd.false
@@ -387,10 +411,16 @@ def analyse(context: CheckContext, subsystem: Subsystem, fsm: FSM, owner: str) -
                     "check the condition, the behaviour's terminal condition and the `assume` formulas",
                 )
             elif first_to_hold == bdd.false:
-                winner = next(t for t in before if (holds & conditions[id(t)]) != bdd.false)
+                covering = [t for t in before if (holds & conditions[id(t)]) != bdd.false]
+                alone = next((t for t in covering if (holds & ~conditions[id(t)]) == bdd.false), None)
+                tried = (
+                    f"`{alone.name}/t` holds too and is tried first"
+                    if alone is not None
+                    else "one of " + ", ".join(f"`{t.name}/t`" for t in covering) + " holds too and is tried first"
+                )
                 dead[id(transition)] = Finding(
                     f"transition `{transition.name}/t` of {owner} can never be taken: whenever its condition "
-                    f"holds, `{winner.name}/t` holds too and is tried first",
+                    f"holds, {tried}",
                     transition.location,
                     "narrow the condition of the transition tried first, or change the priorities",
                 )
@@ -398,7 +428,8 @@ def analyse(context: CheckContext, subsystem: Subsystem, fsm: FSM, owner: str) -
             for second in leaving[position + 1 :]:
                 if _distinct_priorities(first, second):
                     continue
-                both = conditions[id(first)] & conditions[id(second)] & stop
+                # both the first to hold: one of higher priority holding would be taken instead
+                both = taken[id(first)] & taken[id(second)]
                 if both != bdd.false:
                     findings["EARL-E060"].append(
                         Finding(

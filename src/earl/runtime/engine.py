@@ -272,9 +272,11 @@ class SubsystemEngine:
                 any_set = any_set or flag
             self._timeouts_set = any_set
         if self.stale:
-            # a stale buffer also reads as timed out until its sender returns; `stale(x/ib)` tells it apart
+            # a stale buffer also reads as timed out until its sender returns; `stale(x/ib)` tells it apart.
+            # One that took a message now did not time out (a message can come before the sender's
+            # liveliness is known): `timeout(x/ib)` never holds with `newData(x/ib)`.
             for key in self.stale:
-                self.timed_out[key] = True
+                self.timed_out[key] = not new_data[key]
             self._timeouts_set = True
 
     # ------------------------------------------------------------------ Figure 5b, step 5 and Figure 5a
