@@ -738,3 +738,36 @@ def test_options_that_would_record_nothing_are_said(tmp_path: Path) -> None:
     assert traced.returncode == 0
     assert "--record-links `nomatch*` matches no link (the links: counter/a:cs,relay" in traced.stderr
     assert "`counter/a:relay*`" not in traced.stderr
+
+
+def test_a_stop_while_waiting_for_the_next_instant_is_made_at_once(tmp_path: Path) -> None:
+    """Real time, periods of 20 s: the run sleeps between instants, and a stop must not wait for the next."""
+    spec = counter_copy(tmp_path)
+    spec.write_text(spec.read_text().replace("period 10 ms", "period 20 s"))
+    process = subprocess.Popen(
+        [*EARL, "run", str(spec.parent), "--realtime", "--duration", "120s", "--no-progress"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        time.sleep(4.0)
+        started = time.monotonic()
+        process.send_signal(signal.SIGTERM)
+        process.send_signal(signal.SIGTERM)  # as `timeout` does: to the run and to its group, the same request
+        _, stderr = process.communicate(timeout=30)
+    finally:
+        process.kill()
+    assert process.returncode == 130, stderr
+    assert time.monotonic() - started < 5
+    assert "interrupted at " in stderr and "trace is closed" not in stderr
+
+
+def test_a_plot_that_cannot_be_drawn_makes_the_run_exit_1(tmp_path: Path) -> None:
+    png = tmp_path / "p.png"
+    # `count` exists, but its element 5 does not: found only once the trace is read
+    result = earl_cli(
+        "run", str(SPECS / "counter"), "--duration", "20ms", "--plot", str(png), "--signal", "counter/a.cs.count[5]"
+    )
+    assert result.returncode == 1, result.stderr
+    assert "no plot" in result.stdout + result.stderr and not png.exists()

@@ -601,3 +601,18 @@ def test_a_condition_that_fails_names_the_primitive_predicate_at_fault(tmp_path:
         )
     finally:
         sim.close()
+
+
+def test_advance_by_takes_a_duration_and_should_stop_a_function() -> None:
+    sim = earl.simulate(earl.load(SPECS / "counter"), seed=1)
+    try:
+        with pytest.raises(ValueError, match="advance_by takes a duration of 0 s or more"):
+            sim.advance_by(-0.01)
+        with pytest.raises(TypeError, match="should_stop takes a function"):
+            sim.advance_to(0.01, should_stop="x")  # type: ignore[arg-type]
+        sim.advance_by(0.02, should_stop=lambda: False)
+        assert sim.time == pytest.approx(0.02)
+        sim.advance_by(0.02, should_stop=lambda: True)  # between two instants: at once
+        assert sim.time == pytest.approx(0.02)
+    finally:
+        sim.close()

@@ -156,8 +156,8 @@ def test_the_environment_goes_to_the_process_whose_agents_act_on_it_unless_the_f
     assert _placed(tmp_path, [(TASK, "environment = false"), (ROBOT, "environment = true")], ROBOT) == [False, True]
     assert _placed(tmp_path, [(TASK, "environment = false"), (ROBOT, "")], ROBOT) == [False, True]
     assert _placed(tmp_path, [(TASK, ""), (["b/a"], "")], []) == [True, False]  # nobody acts: the first
-    # the robot's process keeps its effectors away from any environment: nobody gets one
-    assert _placed(tmp_path, [(TASK, ""), (ROBOT, "environment = false")], ROBOT) == [False, False]
+    # nobody acts on it: nobody needs it
+    assert _placed(tmp_path, [(TASK, "environment = false"), (["b/a"], "environment = false")], []) == [False, False]
     # a process that names its own environment in `args` is left to the user
     args = 'args = ["--environment", "hardware:open"]'
     assert _placed(tmp_path, [(["manip/a"], args), (["grip/a"], "")], ROBOT) == [None, True]
@@ -175,6 +175,10 @@ def test_the_environment_goes_to_the_process_whose_agents_act_on_it_unless_the_f
             [(TASK, "environment = true"), (ROBOT, "")],
             "process 2 runs `manip/a`, whose Real Effectors or Receptors act on the environment, but the "
             "environment lives in process 1 (task/a); run `manip/a` in process 1",
+        ),
+        (
+            [(TASK, ""), (ROBOT, "environment = false")],
+            "no process runs the environment, but `manip/a` (process 2) has Real Effectors or Receptors",
         ),
         (
             [(["manip/a"], "environment = true"), (["grip/a", "task/a"], "")],

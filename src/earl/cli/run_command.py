@@ -163,8 +163,7 @@ def run(arguments: argparse.Namespace) -> int:
     if arguments.plot and not arguments.trace:
         arguments.trace = str(Path(arguments.plot).with_suffix(".mcap"))
     environment = arguments.environment or settings.environment
-    no_environment = environment == "none"
-    if no_environment:
+    if environment == "none":
         environment = None
     agents = [a.strip() for a in arguments.agents.split(",") if a.strip()] if arguments.agents is not None else None
     if agents == []:  # `--agents ,` or `--agents ""`: not "all of them", which is no --agents at all
@@ -254,7 +253,7 @@ def run(arguments: argparse.Namespace) -> int:
                 simulation.close()  # nothing ran; the trace is still closed and readable
                 print("earl run: interrupted while waiting for the other processes", file=sys.stderr)
                 return EXIT_INTERRUPTED
-        return _execute(simulation, duration, arguments, None if no_environment else settings.report, path)
+        return _execute(simulation, duration, arguments, None if environment is None else settings.report, path)
     finally:
         # Closed already, unless printing failed (a reader that went away: `earl run … | head`); an open
         # Zenoh session's threads would keep the process from ever ending.
@@ -289,6 +288,8 @@ class _StopRequest:
     (`except: pass`) swallows the KeyboardInterrupt, and the run must still stop at its next step."""
 
     requested = False
+    #: whether a Ctrl-C (SIGINT) asked: a second one stops at once
+    by_ctrl_c = False
 
 
 @contextlib.contextmanager
@@ -318,16 +319,19 @@ def _stopped_like_ctrl_c() -> Iterator[_StopRequest]:
 @contextlib.contextmanager
 def _stopped_between_instants() -> Iterator[_StopRequest]:
     """Ctrl-C, SIGTERM and SIGHUP ask the run to stop once the instant running has run to its end, so
-    that every subsystem has run the same instants; a second one stops it at once, inside the instant
-    (a function that never returns)."""
+    that every subsystem has run the same instants; a second Ctrl-C stops it at once, inside the instant
+    (a function that never returns). A repeated SIGTERM or SIGHUP is the same request: `timeout` sends
+    its SIGTERM to the run and again to the run's process group."""
     request = _StopRequest()
 
-    def stop(*_: object) -> None:
-        if request.requested:
+    def stop(number: int, *_: object) -> None:
+        if request.requested and number == signal.SIGINT and request.by_ctrl_c:
             raise KeyboardInterrupt
-        request.requested = True
-        with contextlib.suppress(OSError):  # said from a signal handler: one write, no Rich
-            os.write(2, b"earl run: stopping after this instant (once more to stop at once)\n")
+        request.by_ctrl_c = request.by_ctrl_c or number == signal.SIGINT
+        if not request.requested:
+            request.requested = True
+            with contextlib.suppress(OSError):  # said from a signal handler: one write, no Rich
+                os.write(2, b"earl run: stopping after this instant (Ctrl-C again to stop at once)\n")
 
     with handling_stop_signals(stop):
         yield request
@@ -394,24 +398,24 @@ def _execute(simulation: Any, duration: float, arguments: argparse.Namespace, re
         from earl.transport.process import print_link_statistics
 
         print_link_statistics(simulation.transport)
-    if arguments.plot:
-        _plot(arguments, console)
+    plotted = _plot(arguments, console) if arguments.plot else True
     if report:
         _report(simulation, report, path, console)
     if broken is not None:
         console.print(f"earl run: {brief(str(broken))} at {simulation.time:.3f} s; the run stopped there")
         return EXIT_FAILED
     if interrupted:
-        console.print(f"earl run: interrupted at {simulation.time:.3f} s; the trace is closed")
+        closed = "; the trace is closed" if arguments.trace else ""
+        console.print(f"earl run: interrupted at {simulation.time:.3f} s{closed}")
         return EXIT_INTERRUPTED
     if exited is not None:
         status = exited.code
         console.print(
             f"earl run: the spec's code called sys.exit({'' if status is None else repr(status)}) at "
-            f"{simulation.time:.3f} s; the run stopped there and the trace is closed"
+            f"{simulation.time:.3f} s; the run stopped there" + (" and the trace is closed" if arguments.trace else "")
         )
-        return EXIT_OK if status in (None, 0) else EXIT_FAILED
-    return EXIT_OK
+        return EXIT_OK if status in (None, 0) and plotted else EXIT_FAILED
+    return EXIT_OK if plotted else EXIT_FAILED  # a plot asked for and not drawn, as `earl plot` says it
 
 
 def _advance(
@@ -490,7 +494,8 @@ def _summary(simulation: Any, wall: float, arguments: argparse.Namespace) -> Non
         console.print(f"trace: {arguments.trace} (earl trace summary {arguments.trace}; opens in Foxglove)")
 
 
-def _plot(arguments: argparse.Namespace, console: Console) -> None:
+def _plot(arguments: argparse.Namespace, console: Console) -> bool:
+    """Whether the plot was drawn; the run and its trace are whole either way."""
     from earl.runtime.plot import plot_signals
     from earl.runtime.trace_reader import TraceError
 
@@ -498,11 +503,12 @@ def _plot(arguments: argparse.Namespace, console: Console) -> None:
         plot_signals(Path(arguments.trace), arguments.signal, Path(arguments.plot))
     except TraceError as error:
         console.print(f"earl run: no plot: {error}")
-        return
+        return False
     except OSError as error:  # a read-only directory, a full disk: the run and its trace are fine
         console.print(f"earl run: no plot: cannot write {arguments.plot}: {error.strerror or error}")
-        return
+        return False
     console.print(f"plot: {arguments.plot}")
+    return True
 
 
 def _report(simulation: Any, report: str, path: Path, console: Console) -> None:

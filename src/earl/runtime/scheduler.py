@@ -146,15 +146,23 @@ class Scheduler:
             # a stop is made between two instants, never inside one (docs/semantics.md)
             if should_stop is not None and queue[0][0] > self.now and should_stop():
                 return
+            if realtime:
+                due = queue[0][0]
+                if advance is not None and due > self._environment_time:
+                    self._environment_time = due  # stepped before the wait, whose time it may use
+                    advance(due * 1e-9)
+                if due > 0 and not self._clock_running:
+                    self._start_clock()
+                # a stop asked while waiting for the next instant is made at once: no instant is running
+                if not self._sleep_until_due(due, should_stop if due > self.now else None):
+                    return
             time, _, _, kind, engine, token = pop(queue)
             self.now = time
             if advance is not None and time > self._environment_time:
                 self._environment_time = time
                 advance(time * 1e-9)
-            if realtime:
-                if time > 0 and not self._clock_running:
-                    self._start_clock()
-                self._wait_until(time, engine, kind)
+            if realtime and kind == _START:
+                self._record_lateness(time, engine)
             if kind == _START:
                 # `_start` and `_push` written out: this is the path of nearly every event
                 if not engine.iterate(time):
@@ -178,6 +186,14 @@ class Scheduler:
                     self._push(self._finish(engine, time, timed_out=False), engine, _START)
             elif engine.waiting and token == tokens[engine.name]:  # _TIMEOUT
                 self._push(self._finish(engine, time, timed_out=True), engine, _START)
+        if realtime and until > self.now:
+            # real time reaches `until` on the wall clock too, not only the events before it: a stop while
+            # waiting says the run time the wall clock had reached
+            if not self._clock_running:
+                self._start_clock()
+            if not self._sleep_until_due(until, should_stop):
+                self.now = max(self.now, min(self.clock() - self._wall_start, until))
+                return
         self.now = max(self.now, until)
         if advance is not None and self.now > self._environment_time:
             self._environment_time = self.now
@@ -308,7 +324,11 @@ class Scheduler:
                 if remaining <= 0:
                     return
                 if remaining > 300_000:
-                    inbox.wait((remaining - 200_000) * 1e-9)
+                    should_stop = self._should_stop
+                    if should_stop is not None and should_stop():
+                        return  # the loop that called makes the stop: no instant is running
+                    # in steps of at most 50 ms, so that a stop request (a flag a signal handler set) is seen
+                    inbox.wait(min(remaining - 200_000, 50_000_000) * 1e-9)
                 else:
                     # the last stretch is polled, as a timed wait overshoots; yielding the GIL on each turn
                     # lets a Zenoh callback deliver meanwhile instead of waiting out the switch interval
@@ -399,16 +419,21 @@ class Scheduler:
         following = engine.iteration_start + period
         return following if following > time else time
 
-    def _wait_until(self, time: int, engine: SubsystemEngine, kind: int) -> None:
+    def _sleep_until_due(self, time: int, should_stop: Callable[[], bool] | None) -> bool:
+        """Wait until run time `time` on the wall clock: sleep most of the way, in steps of at most 50 ms
+        so that a stop request is seen (a signal handler only sets a flag), then spin the last 0.2 ms, as
+        a sleep alone wakes up to a scheduler tick late. False when `should_stop()` came true first."""
         due = self._wall_start + time
-        remaining = due - self.clock()
-        if remaining > 300_000:
-            # sleep most of the way, then spin: a sleep alone wakes up to a scheduler tick late
-            wall.sleep((remaining - 200_000) * 1e-9)
+        while True:
+            remaining = due - self.clock()
+            if remaining <= 300_000:
+                break
+            if should_stop is not None and should_stop():
+                return False
+            wall.sleep(min(remaining - 200_000, 50_000_000) * 1e-9)
         while self.clock() < due:
             pass
-        if kind == _START:
-            self._record_lateness(time, engine)
+        return True
 
     def _start_clock(self) -> None:
         """Run time 0 is now on the wall clock: the first instant has run (`_clock_running`)."""

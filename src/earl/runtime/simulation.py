@@ -176,6 +176,8 @@ class Simulation:
             raise ValueError(
                 f"advance_to takes a finite run time of at most {Duration.MAX_SECONDS:g} s, not {seconds!r}"
             )
+        if should_stop is not None and not callable(should_stop):
+            raise TypeError(f"should_stop takes a function of no arguments, not {should_stop!r:.60}")
         if seconds < 0:
             # a run time starts at 0: a slip between advance_to and advance_by, most likely
             raise ValueError(f"advance_to takes a run time from 0 on, not {seconds!r} (advance_by takes a duration)")
@@ -193,8 +195,13 @@ class Simulation:
             self._stopped_inside = f"{type(error).__name__} at {self.time:.6f} s"
             raise
 
-    def advance_by(self, seconds: float) -> None:
-        self.advance_to(self.time + seconds)
+    def advance_by(self, seconds: float, should_stop: Callable[[], bool] | None = None) -> None:
+        """Run on for `seconds` of run time (>= 0)."""
+        if isinstance(seconds, bool) or not isinstance(seconds, numbers.Real):
+            raise TypeError(f"advance_by takes a duration in seconds (a number), not {seconds!r}")
+        if seconds < 0:
+            raise ValueError(f"advance_by takes a duration of 0 s or more, not {seconds!r}")
+        self.advance_to(self.time + seconds, should_stop)
 
     def close(self) -> None:
         """End the run: the statistics are closed, the trace file finished, the environment closed."""

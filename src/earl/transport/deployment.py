@@ -134,7 +134,15 @@ class Deployment:
                 "(`environment = false` in the others) and run every agent with Real Effectors or Receptors there"
             )
         if not holders:
-            return  # no process holds it: the Real Effectors and Receptors are bound to something else
+            unheld = [(n, agent) for n, p in numbered for agent in p.agents if agent in acting]
+            if unheld:
+                number, agent = unheld[0]
+                raise DeploymentError(
+                    f"{self.path}: no process runs the environment, but `{agent}` (process {number}) has Real "
+                    f"Effectors or Receptors that act on it; give process {number} `environment = true`, or "
+                    'its own environment in its `args` (`args = ["--environment", "module:factory"]`)'
+                )
+            return
         number, holder = holders[0]
         for other_number, process in numbered:
             away = [agent for agent in process.agents if agent in acting]
