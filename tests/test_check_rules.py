@@ -1213,6 +1213,8 @@ def test_a_constant_index_outside_a_fixed_array_is_refused() -> None:
     [finding] = findings(text, "EARL-E030")
     assert finding.message == "`v/mi[5]` reads element 5 of a `double[3]`, whose elements are 0 to 2"
     assert findings(text.replace("v/mi[5]", "v/mi[2]"), "EARL-E030") == []
+    [negative] = findings(text.replace("v/mi[5]", "v/mi[1 - 2]"), "EARL-E030")
+    assert negative.message == "`v/mi[1 - 2]` reads element -1 of a `double[3]`, whose elements are 0 to 2"
 
 
 def test_a_transition_condition_reading_unwritten_memory_is_reported() -> None:

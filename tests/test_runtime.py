@@ -603,6 +603,24 @@ def test_a_condition_that_fails_names_the_primitive_predicate_at_fault(tmp_path:
         sim.close()
 
 
+def test_a_negative_element_index_is_a_fault_not_an_element_from_the_end(tmp_path: Path) -> None:
+    spec = tmp_path / "counter"
+    shutil.copytree(SPECS / "counter", spec)
+    text = (spec / "system.earl").read_text()
+    text = text.replace(
+        "        count/m: int = 0\n", "        count/m: int = 0\n        v/m: double[3] = [0.0, 0.0, 9.0]\n"
+    )
+    text = text.replace("done/pp = count/mi >= LIMIT", "done/pp = count/mi >= LIMIT or v/mi[0 - 1] > 1.0")
+    (spec / "system.earl").write_text(text)
+    sim = earl.simulate(earl.load(spec), check=False)  # `earl check` refuses it (EARL-E030)
+    try:
+        sim.advance_to(0.005)
+        assert sim.state_of("counter/a.cs").state == "counting"  # `v/mi[2]` (9.0) was not read
+        assert "element -1 does not exist (elements count from 0) in `done/pp`" in sim.faults[0].message
+    finally:
+        sim.close()
+
+
 def test_advance_by_takes_a_duration_and_should_stop_a_function() -> None:
     sim = earl.simulate(earl.load(SPECS / "counter"), seed=1)
     try:

@@ -11,6 +11,7 @@ from earl.model.expressions import (
     BooleanOperation,
     Call,
     Comparison,
+    ConstantError,
     Expression,
     FieldAccess,
     ListLiteral,
@@ -20,6 +21,7 @@ from earl.model.expressions import (
     Not,
     Quantifier,
     Read,
+    evaluate_constant,
 )
 from earl.model.kinds import Kind
 from earl.model.location import SourceLocation
@@ -215,9 +217,13 @@ class ExpressionTyper:
         would fail every time the condition is evaluated, and count as false."""
         index = getattr(accessor, "index", None)
         size = array.size
-        if not (isinstance(index, Literal) and isinstance(size, Literal)):
+        if index is None or not isinstance(size, Literal):
             return
-        position, length = index.value, size.value
+        try:  # `v/mi[1 + 3]`, `v/mi[K - 1]` with K put in by the expansion: constants too
+            position = evaluate_constant(index, {})
+        except ConstantError:
+            return
+        length = size.value
         if isinstance(position, bool) or not isinstance(position, int) or not isinstance(length, int):
             return
         if not 0 <= position < length:

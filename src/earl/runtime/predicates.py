@@ -59,8 +59,15 @@ def compile_predicate(
     """
     source = f"lambda {_ARGUMENTS}: {_source(expression)}"
     code = compile(source, f"<earl predicate {description}>", "eval")
-    function: CompiledPredicate = eval(code, {"__builtins__": {}, "stale": stale})
+    function: CompiledPredicate = eval(code, {"__builtins__": {}, "stale": stale, "_element": _element})
     return function
+
+
+def _element(index: int) -> int:
+    """An array index of a condition computed at run time: elements count from 0, and none is negative."""
+    if index < 0:
+        raise IndexError(f"element {index} does not exist (elements count from 0)")
+    return index
 
 
 def predicate_source(expression: Expression) -> str:
@@ -121,7 +128,11 @@ def _path(read: Read) -> str:
         if isinstance(accessor, FieldAccess):
             parts.append(f"[{accessor.name!r}]")
         elif isinstance(accessor, IndexAccess):
-            parts.append(f"[{_source(accessor.index)}]")
+            index = accessor.index
+            if isinstance(index, Literal) and isinstance(index.value, int) and index.value >= 0:
+                parts.append(f"[{_source(index)}]")
+            else:  # Python would read a negative index from the end: an element the spec has not
+                parts.append(f"[_element({_source(index)})]")
     return "".join(parts)
 
 
