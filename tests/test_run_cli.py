@@ -18,6 +18,7 @@ import earl
 from earl.diagnostics import EarlError
 
 SPECS = Path(__file__).parent / "runtime_specs"
+EXAMPLE = Path(__file__).parent.parent / "examples" / "pick_and_place"
 EARL = [sys.executable, "-m", "earl.cli.main"]
 
 
@@ -765,9 +766,35 @@ def test_a_stop_while_waiting_for_the_next_instant_is_made_at_once(tmp_path: Pat
 
 def test_a_plot_that_cannot_be_drawn_makes_the_run_exit_1(tmp_path: Path) -> None:
     png = tmp_path / "p.png"
-    # `count` exists, but its element 5 does not: found only once the trace is read
+    # `forward` is an output buffer, but the link that carries its values is not recorded
     result = earl_cli(
-        "run", str(SPECS / "counter"), "--duration", "20ms", "--plot", str(png), "--signal", "counter/a.cs.count[5]"
+        "run",
+        str(SPECS / "counter"),
+        "--duration",
+        "20ms",
+        "--plot",
+        str(png),
+        "--signal",
+        "counter/a.relay/ve.forward",
+        "--record-links",
+        "nothing",
     )
     assert result.returncode == 1, result.stderr
     assert "no plot" in result.stdout + result.stderr and not png.exists()
+
+
+@pytest.mark.parametrize(
+    ("signal_name", "fragment"),
+    [
+        ("manip/a.cs.currentJointPos[9]", "`currentJointPos` has elements 0 to 5 where the signal indexes it, not 9"),
+        ("manip/a.cs.windingCurrent[7]", "`windingCurrent` has members 1..6"),
+        ("manip/a.cs.currentJointPos.x", "`currentJointPos` has no field `x` where the signal names it"),
+    ],
+)
+def test_run_plot_refuses_an_index_or_field_the_signal_s_element_lacks_before_the_run(
+    tmp_path: Path, signal_name: str, fragment: str
+) -> None:
+    result = earl_cli(
+        "run", str(EXAMPLE), "--duration", "100s", "--plot", str(tmp_path / "p.png"), "--signal", signal_name
+    )
+    assert result.returncode == 2 and fragment in result.stderr, result.stderr

@@ -6,7 +6,9 @@ import re
 from pathlib import Path
 
 from earl.diagnostics import did_you_mean
-from earl.model.elements import System
+from earl.model.elements import Memory, OutputBuffer, Subsystem, System
+from earl.model.expressions import Literal
+from earl.model.types import ArrayType, StructType
 from earl.runtime.names import subsystem_name
 from earl.runtime.trace_reader import read_signals, signal_element
 
@@ -56,7 +58,48 @@ def memory_to_record(expanded: System, signals: list[str]) -> list[str]:
                 f"`{signal}`: `{owner}` has no memory or output buffer `{element}`"
                 + (f"; {hint}" if hint else f" (it has {known})")
             )
+        problem = _path_problem(expanded, subsystem, element, signal[len(owner) + 1 + len(element) :])
+        if problem is not None:
+            raise ValueError(f"`{signal}`: {problem}")
     return sorted(set(record))
+
+
+_STEP = re.compile(r"\[(\*|\d+)\]|\.([A-Za-z_]\w*)")
+
+
+def _path_problem(expanded: System, subsystem: Subsystem, element: str, path: str) -> str | None:
+    """What is wrong with the part of a signal after its element (`[2].motorPos`), or None: an index a
+    family or a fixed array does not have, a field its struct does not have."""
+    from earl.runtime.values import TypeSystem, ValueTypeError
+
+    declared: list[Memory | OutputBuffer] = [m for m in subsystem.memories if m.name == element]
+    declared = declared or [o for o in subsystem.output_buffers if o.name == element]
+    steps = [(match.group(1), match.group(2)) for match in _STEP.finditer(path)]
+    if "".join(match.group(0) for match in _STEP.finditer(path)) != path:
+        return f"`{path}` is not a path of `[index]` and `.field` steps"
+    members = [d.index for d in declared if d.index is not None]
+    if members and steps:  # the first brackets choose a member of the family
+        index, _ = steps.pop(0)
+        if index is None or (index != "*" and int(index) not in members):
+            return f"`{element}` has members {min(members)}..{max(members)}"
+    types = TypeSystem(expanded)
+    try:
+        current: object = types.resolve(declared[0].data_type)
+        for index, field in steps:
+            if field is not None:
+                if not isinstance(current, StructType) or current.field_named(field) is None:
+                    return f"`{element}` has no field `{field}` where the signal names it"
+                current = types.resolve(current.field_named(field).data_type)  # type: ignore[union-attr]
+            else:
+                if not isinstance(current, ArrayType):
+                    return f"`{element}` is not an array where the signal indexes it"
+                size = current.size.value if isinstance(current.size, Literal) else None
+                if index != "*" and isinstance(size, int) and int(index) >= size:
+                    return f"`{element}` has elements 0 to {size - 1} where the signal indexes it, not {index}"
+                current = types.resolve(current.element)
+    except ValueTypeError:
+        return None  # a type the checker reports; the plot says what it finds
+    return None
 
 
 def plot_signals(trace: Path, signals: list[str], output: Path, title: str | None = None) -> None:
