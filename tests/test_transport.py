@@ -464,8 +464,8 @@ def test_a_deployment_that_does_not_cover_the_system_stops_earl_run(
     deploy = tmp_path / "deploy.toml"
     deploy.write_text("[[process]]\nagents = ['sender']\nlisten = 'tcp/127.0.0.1:1'\n")
     arguments = ["run", str(PINGPONG), "--transport", "zenoh", "--agents", "sender", "--deployment", str(deploy)]
-    assert main(arguments) == 2
-    assert "the agent `receiver/a` runs in no process" in capsys.readouterr().err
+    assert main(arguments) == 1  # as `earl launch` says it: the file is wrong, not the command line
+    assert "earl run: " in (said := capsys.readouterr().err) and "the agent `receiver/a` runs in no process" in said
 
 
 class RecordingLinks:

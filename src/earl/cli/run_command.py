@@ -22,6 +22,7 @@ from rich.text import Text
 from earl.cli.common import UsageError, brief, parse_parameters, spec_path, usage_error
 from earl.cli.output import print_diagnostics
 from earl.diagnostics import EarlError
+from earl.transport.deployment import DeploymentError
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 
@@ -229,6 +230,10 @@ def run(arguments: argparse.Namespace) -> int:
         _close(transport)
         print_diagnostics(error.diagnostics, error.sources)
         print("earl run: the specification cannot run; nothing was executed", file=sys.stderr)
+        return EXIT_FAILED
+    except DeploymentError as error:  # before ValueError, which it is: the file is wrong, not an option
+        _close(transport)
+        print(f"earl run: {error}", file=sys.stderr)
         return EXIT_FAILED
     except ValueError as error:
         _close(transport)

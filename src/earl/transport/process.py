@@ -80,8 +80,8 @@ def open_transport(
             group = deployment.group_of(names)
             if environment is not None and not group.names_its_environment:
                 environment_here = bool(group.environment)
-        except DeploymentError as error:
-            raise ValueError(str(error)) from None
+        except DeploymentError:
+            raise  # a file that cannot be used: exit 1, as `earl launch` says it
         connect = deployment.connect_for(group)
         config = default_config([group.listen], connect)
         where = f"listening on {group.listen}, connecting to {', '.join(connect) or 'nobody'}"
