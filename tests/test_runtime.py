@@ -634,3 +634,24 @@ def test_advance_by_takes_a_duration_and_should_stop_a_function() -> None:
         assert sim.time == pytest.approx(0.02)
     finally:
         sim.close()
+
+
+def test_a_memory_family_starts_each_member_from_its_own_index(tmp_path: Path) -> None:
+    spec = tmp_path / "counter"
+    shutil.copytree(SPECS / "counter", spec)
+    text = (spec / "system.earl").read_text()
+    text = text.replace(
+        "        count/m: int = 0\n", "        count/m: int = 0\n        history[J in 1..3]/m: double = 2 * J + 0.5\n"
+    )
+    (spec / "system.earl").write_text(text)
+    system = earl.load(spec)
+    from earl.check import check
+
+    assert [d for d in check(system) if d.severity.value == "error"] == []
+    sim = earl.simulate(system)
+    try:
+        sim.advance_to(0.001)
+        memory = sim.state_of("counter/a.cs").memory
+        assert [memory[f"history[{j}]"] for j in (1, 2, 3)] == [2.5, 4.5, 6.5]
+    finally:
+        sim.close()

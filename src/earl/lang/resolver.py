@@ -489,7 +489,12 @@ class Resolver:
                     )
         for memory in subsystem.memories:
             if memory.initial_value is not None:
-                self.expression(memory.initial_value, table, scope, owner, reads_allowed=False)
+                # a family's index is known in its own initial value: `history[J in 1..N]/m: double = J`
+                declared = table.lookup(Kind.MEMORY).get(memory.name)
+                inner = scope
+                if memory.family is not None and declared is not None and declared.family is not None:
+                    inner = {**scope, memory.family.index: declared.family}
+                self.expression(memory.initial_value, table, inner, owner, reads_allowed=False)
         for predicate in subsystem.primitive_predicates:
             self.expression(predicate.expression, table, scope, owner)
         for function in subsystem.partial_transition_functions:

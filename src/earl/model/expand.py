@@ -279,7 +279,8 @@ def _subsystem(subsystem: Subsystem, environment: Environment, index: int | None
             )
     for memory in subsystem.memories:
         for member in _family(memory, inner, members):
-            initial = None if memory.initial_value is None else _expression(memory.initial_value, inner, members)
+            own = inner if memory.family is None or member is None else {**inner, memory.family.index: member}
+            initial = None if memory.initial_value is None else _expression(memory.initial_value, own, members)
             result.memories.append(
                 Memory(
                     memory.name,
