@@ -572,11 +572,8 @@ def test_advance_to_a_time_reached_does_nothing_and_a_negative_one_is_refused() 
 
 def test_a_memory_whose_initial_value_does_not_fit_is_said_at_its_line(tmp_path: Path) -> None:
     """`earl check` refuses it (EARL-E043); unchecked, the run names the memory's line, not the subsystem's."""
-    spec = tmp_path / "counter"
-    shutil.copytree(SPECS / "counter", spec)
-    text = (spec / "system.earl").read_text()
-    (spec / "system.earl").write_text(text.replace("count/m: int = 0", "count/m: int = true", 1))
-    line = 1 + text[: text.index("count/m: int = 0")].count("\n")
+    spec = copy_spec("counter", tmp_path, {"count/m: int = 0": "count/m: int = true"})
+    line = 1 + spec.read_text()[: spec.read_text().index("count/m: int = true")].count("\n")
     with pytest.raises(earl.EarlError) as refused:
         earl.simulate(earl.load(spec), check=False)
     [diagnostic] = refused.value.diagnostics
@@ -585,14 +582,14 @@ def test_a_memory_whose_initial_value_does_not_fit_is_said_at_its_line(tmp_path:
 
 
 def test_a_condition_that_fails_names_the_primitive_predicate_at_fault(tmp_path: Path) -> None:
-    spec = tmp_path / "counter"
-    shutil.copytree(SPECS / "counter", spec)
-    text = (spec / "system.earl").read_text()
-    text = text.replace(
-        "        count/m: int = 0\n", "        count/m: int = 0\n        v/m: double[3] = [0.0, 0.0, 0.0]\n"
+    spec = copy_spec(
+        "counter",
+        tmp_path,
+        {
+            "        count/m: int = 0\n": "        count/m: int = 0\n        v/m: double[3] = [0.0, 0.0, 0.0]\n",
+            "done/pp = count/mi >= LIMIT": "done/pp = count/mi >= LIMIT or v/mi[5] > 1.0",
+        },
     )
-    text = text.replace("done/pp = count/mi >= LIMIT", "done/pp = count/mi >= LIMIT or v/mi[5] > 1.0")
-    (spec / "system.earl").write_text(text)
     sim = earl.simulate(earl.load(spec), check=False)  # `earl check` refuses it (EARL-E030)
     try:
         sim.advance_to(0.005)
@@ -604,14 +601,14 @@ def test_a_condition_that_fails_names_the_primitive_predicate_at_fault(tmp_path:
 
 
 def test_a_negative_element_index_is_a_fault_not_an_element_from_the_end(tmp_path: Path) -> None:
-    spec = tmp_path / "counter"
-    shutil.copytree(SPECS / "counter", spec)
-    text = (spec / "system.earl").read_text()
-    text = text.replace(
-        "        count/m: int = 0\n", "        count/m: int = 0\n        v/m: double[3] = [0.0, 0.0, 9.0]\n"
+    spec = copy_spec(
+        "counter",
+        tmp_path,
+        {
+            "        count/m: int = 0\n": "        count/m: int = 0\n        v/m: double[3] = [0.0, 0.0, 9.0]\n",
+            "done/pp = count/mi >= LIMIT": "done/pp = count/mi >= LIMIT or v/mi[0 - 1] > 1.0",
+        },
     )
-    text = text.replace("done/pp = count/mi >= LIMIT", "done/pp = count/mi >= LIMIT or v/mi[0 - 1] > 1.0")
-    (spec / "system.earl").write_text(text)
     sim = earl.simulate(earl.load(spec), check=False)  # `earl check` refuses it (EARL-E030)
     try:
         sim.advance_to(0.005)
@@ -637,13 +634,13 @@ def test_advance_by_takes_a_duration_and_should_stop_a_function() -> None:
 
 
 def test_a_memory_family_starts_each_member_from_its_own_index(tmp_path: Path) -> None:
-    spec = tmp_path / "counter"
-    shutil.copytree(SPECS / "counter", spec)
-    text = (spec / "system.earl").read_text()
-    text = text.replace(
-        "        count/m: int = 0\n", "        count/m: int = 0\n        history[J in 1..3]/m: double = 2 * J + 0.5\n"
+    spec = copy_spec(
+        "counter",
+        tmp_path,
+        {
+            "        count/m: int = 0\n": "        count/m: int = 0\n        history[J in 1..3]/m: double = 2 * J + 0.5\n"
+        },
     )
-    (spec / "system.earl").write_text(text)
     system = earl.load(spec)
     from earl.check import check
 

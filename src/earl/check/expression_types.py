@@ -155,8 +155,9 @@ class ExpressionTyper:
             return True
         return self.context.same_type(first, second)  # type: ignore[arg-type]
 
-    def _structure(self, read: Read) -> PrimitiveType | ArrayType | StructType | None:
-        """The type a read of a buffer or memory yields, aliases followed; None when not known."""
+    def _structure(self, read: Read, check_indices: bool = False) -> PrimitiveType | ArrayType | StructType | None:
+        """The type a read of a buffer or memory yields, aliases followed; None when not known. With
+        `check_indices`, a constant index outside a fixed-size array on the way is a problem."""
         target = read.target
         element: InputBuffer | Memory | None
         if target.kind is Kind.INPUT_BUFFER:
@@ -175,34 +176,19 @@ class ExpressionTyper:
                     return None
                 current = self.context.structural(field.data_type)
             elif not isinstance(accessor, FieldAccess) and isinstance(current, ArrayType):
+                if check_indices:
+                    self._check_index(read, accessor, current)
                 current = self.context.structural(current.element)
             else:
                 return None
         return current  # type: ignore[return-value]
 
     def _read(self, read: Read) -> str:
-        target = read.target
-        if target.kind is Kind.PRIMITIVE_PREDICATE:
+        if read.target.kind is Kind.PRIMITIVE_PREDICATE:
             return BOOLEAN
-        element: InputBuffer | Memory | None
-        if target.kind is Kind.INPUT_BUFFER:
-            element = self.context.input_buffer(self.subsystem, target)
-        else:
-            element = self.context.memory(self.subsystem, target)
-        if element is None:
+        current = self._structure(read, check_indices=True)
+        if current is None:
             return UNKNOWN
-        current = self.context.structural(element.data_type)
-        for accessor in read.path:
-            if isinstance(accessor, FieldAccess) and isinstance(current, StructType):
-                field = current.field_named(accessor.name)
-                if field is None:
-                    return UNKNOWN
-                current = self.context.structural(field.data_type)
-            elif not isinstance(accessor, FieldAccess) and isinstance(current, ArrayType):
-                self._check_index(read, accessor, current)
-                current = self.context.structural(current.element)
-            else:
-                return UNKNOWN
         if isinstance(current, PrimitiveType):
             if current.name == "boolean":
                 return BOOLEAN

@@ -110,7 +110,7 @@ def plot_signals(trace: Path, signals: list[str], output: Path, title: str | Non
     import matplotlib.pyplot as plt
 
     data = read_signals(trace, signals)
-    panels = list(dict.fromkeys((s.subsystem, re.split(r"[.\[]", s.name, maxsplit=1)[0]) for s in data.series))
+    panels = list(dict.fromkeys((s.subsystem, signal_element(s.name)) for s in data.series))
     figure, axes = plt.subplots(len(panels), 1, figsize=(10, 2.6 * len(panels) + 0.6), sharex=True, squeeze=False)
     palette = plt.get_cmap("Pastel1")
     for row, (subsystem, element) in enumerate(panels):
@@ -120,7 +120,7 @@ def plot_signals(trace: Path, signals: list[str], output: Path, title: str | Non
             colour = colours.setdefault(state, palette(len(colours) % 9))
             axis.axvspan(start, stop, color=colour, alpha=0.6, linewidth=0, label=f"state {state}")
         for series in data.series:
-            if series.subsystem == subsystem and re.split(r"[.\[]", series.name, maxsplit=1)[0] == element:
+            if series.subsystem == subsystem and signal_element(series.name) == element:
                 # a value holds until the next one: extend the last to the end of the run
                 times = [*series.times, data.end]
                 values = [*series.values, series.values[-1]]

@@ -193,12 +193,12 @@ def read_signals(path: Path, names: list[str]) -> Signals:
             wanted[f"{subsystem}/memory"] = (subsystem, "")
         # only the links of the output buffer the name starts with: a control subsystem's other links
         # can carry tens of thousands of messages that this plot would decode for nothing
-        element = _element(inner)
+        element = signal_element(inner)
         for topic, metadata in available.items():
             source = metadata.get("source", "")
             if topic.startswith("link/") and source.startswith(subsystem + "."):
                 buffer = source[len(subsystem) + 1 :]
-                if _element(buffer) == element:
+                if signal_element(buffer) == element:
                     wanted.setdefault(topic, (subsystem, buffer))
         wanted[f"{subsystem}/fsm"] = (subsystem, "")
     leaves: dict[tuple[str, str], tuple[list[float], list[float]]] = {}
@@ -237,8 +237,8 @@ def read_signals(path: Path, names: list[str]) -> Signals:
             if owner == subsystem and pattern.match(leaf)
         ]
         if not matched:
-            element = _element(inner)
-            same = sorted({leaf for (owner, leaf) in leaves if owner == subsystem and _element(leaf) == element})
+            element = signal_element(inner)
+            same = sorted({leaf for (owner, leaf) in leaves if owner == subsystem and signal_element(leaf) == element})
             if same:
                 hint = f"the trace has {', '.join(f'`{leaf}`' for leaf in same[:6])}{' …' if len(same) > 6 else ''}"
             elif f"{subsystem}/memory" not in available:
@@ -263,9 +263,6 @@ def read_signals(path: Path, names: list[str]) -> Signals:
 def signal_element(name: str) -> str:
     """The element a signal or buffer name starts with: `motorControllerCommand` of `motorControllerCommand[2].x`."""
     return re.split(r"[.\[]", name, maxsplit=1)[0]
-
-
-_element = signal_element
 
 
 def _natural(name: str) -> list[object]:
