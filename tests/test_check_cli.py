@@ -16,12 +16,13 @@ from earl.cli.main import main
 
 EXAMPLE = Path(__file__).parent.parent / "examples" / "pick_and_place" / "system.earl"
 
-# Two purely computational agents joined by one link: every rule holds.
+# Two purely computational agents joined by one link: every rule holds.  (The periods share the
+# `cs {` lines, so that the line numbers below stay those of the canonical layout.)
 CLEAN = """\
 system demo
 
 a1/a {
-    cs {
+    cs { period 1 ms
         out/ob: double
         x/m: double = 0.0
         go/pp = x/mi > 1.0
@@ -40,7 +41,7 @@ a1/a {
 }
 
 a2/a {
-    cs {
+    cs { period 1 ms
         inp/ib: double
         y/m: double = 0.0
         got/pp = newData(inp/ib)

@@ -23,12 +23,12 @@ from earl.model.text import expression_text
 
 EXAMPLE = Path(__file__).parent.parent / "examples" / "pick_and_place" / "system.earl"
 
-# Line numbers matter below: BASE is 46 lines long, and text appended with `add` starts at line 48.
+# Line numbers matter below: BASE is 46 lines long (its periods share the `cs {` lines to keep them), and text appended with `add` starts at line 48.
 BASE = """\
 system base
 
 a1/a {
-    cs {
+    cs { period 1 ms
         out/ob: double
         x/m: double = 0.0
         go/pp = x/mi > 1.0
@@ -47,7 +47,7 @@ a1/a {
 }
 
 a2/a {
-    cs {
+    cs { period 1 ms
         inp/ib: double
         y/m: double = 0.0
         got/pp = newData(inp/ib)
@@ -558,6 +558,20 @@ CASES: list[Case] = [
         ),
     ),
     Case(
+        "EARL-E017",
+        edit(("    cs { period 1 ms\n        inp/ib", "    cs {\n        inp/ib")),
+        34,
+        13,
+        "a2/a.cs has no `period` and state `run` waits for no obligatory buffer, so nothing paces it",
+        edit(
+            ("    cs { period 1 ms\n        inp/ib", "    cs {\n        inp/ib"),
+            (
+                "            state run: run/bb\n            run -> run when got/pp",
+                "            state run: run/bb { obligatory inp/ib }\n            run -> run when got/pp",
+            ),
+        ),
+    ),
+    Case(
         "EARL-W022",
         edit(
             ("        inp/ib: double\n", "        inp/ib: double\n        spare/ib: double\n"),
@@ -1012,7 +1026,7 @@ def test_table_1_counts_every_member_of_an_agent_family() -> None:
 
 FAMILY_AGENT = """\
 a3[I in 1..3]/a {
-    cs {
+    cs { period 1 ms
         cmd[K in 1..2]/ob: double
         c[K in 1..2]/m: double = 0.0
         plan/pf(c[*]/mi -> c[*]/mo)
@@ -1026,7 +1040,7 @@ a3[I in 1..3]/a {
             state run: run/bb
         }
     }
-    m[K in 1..2]/ve {
+    m[K in 1..2]/ve { period 1 ms
         param which: int = K
         cmd/ib: double
         drive/ob: double

@@ -193,6 +193,28 @@ def waits_for_nothing_for_ever(context: CheckContext) -> Iterator[Finding]:
                 )
 
 
+@rule("EARL-E017", Severity.ERROR, "something paces every state of a subsystem", "§2.2, Figure 5")
+def every_state_is_paced(context: CheckContext) -> Iterator[Finding]:
+    """A subsystem iterates every `period`; without one, only its obligatory Input Buffers pace it (each
+    iteration waits for their messages). A state of a subsystem without a period that waits for no
+    obligatory buffer would iterate again at once, for ever, in zero time: `earl run` refuses it
+    (EARL-X012), and this rule says so before a run."""
+    for agent, subsystem in context.distinct_subsystems():
+        if subsystem.fsm is None or subsystem.period is not None:
+            continue
+        inputs = [instance_name(buffer.name, buffer.index) for buffer in subsystem.input_buffers]
+        example = inputs[0] if inputs else "x"
+        for state in subsystem.fsm.states:
+            if not state.obligatory:
+                yield Finding(
+                    f"{subsystem_name(agent, subsystem)} has no `period` and state `{state.name}` waits for no "
+                    "obligatory buffer, so nothing paces it",
+                    state.location,
+                    "give the subsystem a `period` (`period 10 ms`), or list the buffers the state waits for: "
+                    f"`state {state.name}: {state.behaviour}/bb {{ obligatory {example}/ib }}`",
+                )
+
+
 @rule("EARL-W011", Severity.WARNING, "every Input Buffer is fed by a link", "§2.2, §2.3")
 def unfed_input_buffers(context: CheckContext) -> Iterator[Finding]:
     """An Input Buffer receives messages only over a link (§2.3); one that no link feeds keeps its type's
