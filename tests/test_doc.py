@@ -211,6 +211,73 @@ def test_markdown_has_table_6_with_bullets_and_every_image(site: Path) -> None:
         assert (site / image[image.index("](") + 2 : -1]).is_file()
 
 
+class _Cells(HTMLParser):
+    """The text of every table cell of an HTML page, spaces collapsed."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.cells: list[str] = []
+        self._text: list[str] | None = None
+
+    def handle_starttag(self, tag: str, attrs: list[tuple[str, str | None]]) -> None:
+        if tag in ("td", "th"):
+            self._text = []
+
+    def handle_endtag(self, tag: str) -> None:
+        if tag in ("td", "th") and self._text is not None:
+            self.cells.append(" ".join("".join(self._text).split()))
+            self._text = None
+
+    def handle_data(self, data: str) -> None:
+        if self._text is not None:
+            self._text.append(data)
+
+
+def _cells(html: str) -> list[str]:
+    parser = _Cells()
+    parser.feed(html)
+    return parser.cells
+
+
+def _markdown_cells_missing_from_the_html(site: Path) -> list[str]:
+    """index.md read as GitHub reads it (CommonMark with tables): every cell must say what index.html's
+    cells say. Only a header group's label differs by design: Markdown has no spanning cells, so it
+    prefixes the columns under it (`/mo phaseComplete`)."""
+    from markdown_it import MarkdownIt
+
+    html = set(_cells((site / "index.html").read_text(encoding="utf-8")))
+    markdown = MarkdownIt("commonmark").enable("table").render((site / "index.md").read_text(encoding="utf-8"))
+    return [
+        cell
+        for cell in _cells(markdown)
+        if cell and cell not in html and not (cell.startswith(("/mo ", "/ob ")) and cell[4:] in html)
+    ]
+
+
+def test_markdown_reads_back_as_the_html_says(site: Path) -> None:
+    """Expressions keep their spaces (`a/pp and not b/pp`, not `a/ppand notb/pp`), neighbouring code
+    does not merge into a double-backtick span, and every cell reads as in the HTML."""
+    assert _markdown_cells_missing_from_the_html(site) == []
+    markdown = (site / "index.md").read_text(encoding="utf-8")
+    assert "[`phaseComplete/pp`](#pp-task-a-cs-phaseComplete) `and not` [`manipulatorEmergency/pp`]" in markdown
+
+
+def test_markdown_writes_a_bar_inside_code_as_github_reads_it(tmp_path: Path) -> None:
+    spec = tmp_path / "bar.earl"
+    spec.write_text(
+        EXAMPLE.read_text(encoding="utf-8").replace(
+            'python "pick_and_place.task:approach"', 'python "pick_and_place.task:appr|oach"'
+        ),
+        encoding="utf-8",
+    )
+    assert "appr|oach" in spec.read_text(encoding="utf-8")
+    site = tmp_path / "site"
+    assert main(["doc", str(spec), "-o", str(site)]) == 0
+    markdown = (site / "index.md").read_text(encoding="utf-8")
+    assert "&#124;" not in markdown and "appr\\|oach" in markdown
+    assert _markdown_cells_missing_from_the_html(site) == []
+
+
 def test_check_errors_are_shown_and_fail_the_command(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     spec = tmp_path / "lonely.earl"
     # A virtual effector without its real effector breaks Equation (1).

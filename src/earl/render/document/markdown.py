@@ -6,12 +6,14 @@ row only, and the `/mo` and `/ob` header groups become prefixes of the columns.
 
 from __future__ import annotations
 
+import re
+from collections.abc import Sequence
+
 from earl.render.document.tree import (
     Block,
     BulletList,
     Cell,
     Code,
-    Content,
     Document,
     Figure,
     Inline,
@@ -29,48 +31,84 @@ def _escape(text: str) -> str:
     return text.replace("\\", "\\\\").replace("|", "\\|").replace("*", "\\*").replace("_", "\\_").replace("<", "&lt;")
 
 
-def _code(text: str) -> str:
-    fence = "``" if "`" in text else "`"
-    return f"{fence}{text.replace('|', '&#124;')}{fence}"
+def _code(text: str, in_table: bool) -> str:
+    """`text` as a code span that CommonMark and GitHub read back as `text`.
+
+    The spaces at its ends stay outside the span (CommonMark trims a space from each end of a span,
+    so `` ` and not ` `` would read "and not" glued to its neighbours); the fence is longer than any
+    run of backticks inside. In a table cell a `|` is written `\\|`: GitHub splits the cells before
+    it reads code spans and then drops the backslash, where an entity would be shown as written."""
+    body = text.strip(" ")
+    if not body:
+        return text
+    lead, trail = text[: len(text) - len(text.lstrip(" "))], text[len(text.rstrip(" ")) :]
+    longest = max((len(run) for run in re.findall("`+", body)), default=0)
+    fence = "`" * (longest + 1)
+    pad = " " if body.startswith("`") or body.endswith("`") else ""
+    if in_table:
+        body = body.replace("|", "\\|")
+    return f"{lead}{fence}{pad}{body}{pad}{fence}{trail}"
 
 
-def inline(part: Inline) -> str:
+def _merged(parts: Sequence[Inline]) -> list[Inline]:
+    """Neighbouring code written as one span: two spans side by side (`` `a``b` ``) would read as one
+    span fenced by a double backtick."""
+    merged: list[Inline] = []
+    for part in parts:
+        if isinstance(part, Code) and merged and isinstance(merged[-1], Code):
+            merged[-1] = Code(merged[-1].text + part.text)
+        else:
+            merged.append(part)
+    return merged
+
+
+def _as_code(part: Inline) -> Inline:
+    """A piece of a Monospace run: its text is code, a link's text too."""
+    if isinstance(part, Text):
+        return Code(part.text)
+    if isinstance(part, Link):
+        return Link(part.anchor, tuple(_as_code(piece) for piece in part.content))
+    return part
+
+
+def inline(part: Inline, in_table: bool = False) -> str:
     if isinstance(part, Text):
         return _escape(part.text)
     if isinstance(part, Code):
-        return _code(part.text)
+        return _code(part.text, in_table)
     if isinstance(part, Link):
-        return f"[{content(part.content)}](#{part.anchor})"
+        return f"[{content(part.content, in_table)}](#{part.anchor})"
     if isinstance(part, Strong):
-        return f"**{content(part.content)}**"
+        return f"**{content(part.content, in_table)}**"
     if isinstance(part, Monospace):
-        # Markdown has no links inside code spans: each piece becomes its own span
-        return "".join(inline(Code(piece.text)) if isinstance(piece, Text) else inline(piece) for piece in part.content)
+        # Markdown has no links inside code spans: each piece between links becomes its own span
+        pieces: list[Inline] = [_as_code(piece) for piece in part.content]
+        return content(pieces, in_table)
     raise TypeError(part)
 
 
-def content(parts: Content) -> str:
-    return "".join(inline(part) for part in parts).replace("\n", " ")
+def content(parts: Sequence[Inline], in_table: bool = False) -> str:
+    return "".join(inline(part, in_table) for part in _merged(parts)).replace("\n", " ")
 
 
 def _cell(item: Cell) -> str:
     anchor = f'<a id="{item.anchor}"></a>' if item.anchor else ""
-    return anchor + content(item.content)
+    return anchor + content(item.content, in_table=True)
 
 
 def _header(item: Table) -> list[str]:
     """One header row: a spanning group's label becomes a prefix of the cells under it."""
     if len(item.header) == 1:
-        return [content(c.content) for c in item.header[0]]
+        return [content(c.content, in_table=True) for c in item.header[0]]
     top, bottom = item.header[0], item.header[1]
     names: list[str] = []
     below = iter(bottom)
     for group in top:
         if group.rowspan > 1:
-            names.append(content(group.content))
+            names.append(content(group.content, in_table=True))
             continue
-        prefix = content(group.content)
-        names += [f"{prefix} {content(next(below).content)}" for _ in range(group.colspan)]
+        prefix = content(group.content, in_table=True)
+        names += [f"{prefix} {content(next(below).content, in_table=True)}" for _ in range(group.colspan)]
     return names
 
 
