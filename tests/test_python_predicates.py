@@ -155,3 +155,22 @@ def test_a_predicate_that_raises_is_one_fault_per_decision(tmp_path: Path) -> No
         assert [f.kind for f in sim.faults] == ["predicate"]
     finally:
         sim.close()
+
+
+def test_the_document_and_the_sysml_export_name_its_code(tmp_path: Path) -> None:
+    """Table 4 and the SysML constraint say which code computes the predicate; the export calls the
+    library's opaque `EARL::python` (which exists), with the predicate's reads as arguments."""
+    from earl.cli.main import main
+
+    spec = write(tmp_path)
+    sys.modules.pop("limits", None)  # imported by the runs above
+    assert main(["doc", str(spec), "-o", str(tmp_path / "site")]) == 0
+    assert '`python "limits:big"(`[`x/mi`]' in (tmp_path / "site" / "index.md").read_text(encoding="utf-8")
+    assert main(["export", "sysml", str(spec), "-o", str(tmp_path / "thresholds.sysml")]) == 0
+    exported = (tmp_path / "thresholds.sysml").read_text(encoding="utf-8")
+    constraint = exported[exported.index("constraint <'big/pp'>") :]
+    constraint = constraint[: constraint.index("}")]
+    assert 'Computed by python "limits:big".' in constraint
+    assert "EARL::python(" in constraint
+    assert "calc def python {" in (tmp_path / "EARL.sysml").read_text(encoding="utf-8")
+    assert "limits" not in sys.modules

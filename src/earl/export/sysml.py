@@ -457,7 +457,10 @@ class _Writer:
     ) -> None:
         own = names.name(predicate.name, None, Kind.PRIMITIVE_PREDICATE)
         with self.block(f"constraint {_declaration(own, f'{predicate.name}/pp')} : EARL::PrimitivePredicate :> pp"):
-            self.element_doc(predicate.location)
+            implementation = (
+                f"Computed by python {literal(predicate.implementation.path)}." if predicate.implementation else ""
+            )
+            self.element_doc(predicate.location, implementation)
             self.emit(expressions.text(predicate.expression))
 
     def partial_transition_function(self, function: PartialTransitionFunction, names: _SubsystemNames) -> None:

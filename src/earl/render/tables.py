@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from earl.model.elements import Subsystem
+from earl.model.elements import PrimitivePredicate, Subsystem
 from earl.model.kinds import Kind
 from earl.model.text import expression_text
 from earl.model.types import type_text
@@ -99,7 +99,17 @@ def memory_table(subsystem: Subsystem) -> list[MemoryRow]:
 
 
 def predicate_table(subsystem: Subsystem) -> list[PredicateRow]:
-    return [PredicateRow(p.name, expression_text(p.expression)) for p in subsystem.primitive_predicates]
+    return [PredicateRow(p.name, _definition(p)) for p in subsystem.primitive_predicates]
+
+
+def _definition(predicate: PrimitivePredicate) -> str:
+    """A predicate's `fun`; one computed by Python names its code: `python "gripping:stable"(grip/mi)`."""
+    written = expression_text(predicate.expression)
+    if predicate.implementation is None:
+        return written
+    arguments = written[len("python") :] if written.startswith("python(") else f"({written})"
+    return f'python "{predicate.implementation.path}"{arguments}'
+
 
 
 def transition_table(subsystem: Subsystem) -> list[TransitionRow]:
