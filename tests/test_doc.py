@@ -8,6 +8,7 @@ the manual's tables say.  Needs Graphviz's `dot`; the browser test needs Debian'
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import sys
 from html.parser import HTMLParser
@@ -472,3 +473,31 @@ def test_doc_leaves_what_it_did_not_write_and_refuses_a_users_index(tmp_path: Pa
     assert main(["doc", str(EXAMPLE), "-o", str(own)]) == 2
     assert (own / "index.html").read_text() == "<html>my project page</html>"
     assert not (own / "diagrams").exists()
+
+
+def test_distinct_elements_get_distinct_anchors_and_diagrams(tmp_path: Path) -> None:
+    """System `arm_a` and agent `arm/a`; transitions `idle -> wait_home` and `idle_wait -> home`; a
+    `* -> idle`: each has its own anchor, and each figure its own file (none silently dropped)."""
+    spec = Path(__file__).parent / "doc_specs" / "collisions" / "system.earl"
+    site = tmp_path / "site"
+    assert main(["doc", str(spec), "-o", str(site)]) == 0
+    page = (site / "index.html").read_text(encoding="utf-8")
+    ids = re.findall(r'\bid="([^"]+)"', page)
+    assert len(ids) == len(set(ids)), sorted({i for i in ids if ids.count(i) > 1})
+    images = re.findall(r'<img[^>]*\bsrc="([^"]+)"', page)
+    assert len(images) == len(set(images)) == len(list((site / "diagrams").glob("*.svg")))
+    system_types = next(i for i in images if i.endswith("types-arm_a.svg"))
+    assert "[Package] arm_a dataTypes" in (site / system_types).read_text(encoding="utf-8")
+
+
+def test_a_name_too_long_for_a_file_name_still_makes_a_document(tmp_path: Path) -> None:
+    long = "a" + "VeryLongName" * 30
+    spec = tmp_path / "long.earl"
+    spec.write_text(
+        EXAMPLE.read_text(encoding="utf-8").replace("jointMove", long),
+        encoding="utf-8",
+    )
+    site = tmp_path / "site"
+    assert main(["doc", str(spec), "-o", str(site)]) == 0
+    names = [path.name for path in (site / "diagrams").iterdir()]
+    assert names and max(len(name) for name in names) <= 130

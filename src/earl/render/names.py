@@ -8,6 +8,7 @@ expressions) comes from `earl.model.text`, so every reader spells an element ali
 
 from __future__ import annotations
 
+import hashlib
 import re
 from typing import Protocol, TypeVar
 
@@ -115,10 +116,20 @@ def lookup(table: dict[Key, T], reference: ElementReference) -> T | None:
 
 
 # ---------------------------------------------------------------------- anchors and file names
-_UNSAFE = re.compile(r"[^A-Za-z0-9]+")
+# `_` is kept: names may hold it, and `arm_a` must not become the slug of `arm/a`.
+_UNSAFE = re.compile(r"[^A-Za-z0-9_]+")
+#: file systems refuse names over 255 bytes; a diagram's file name is its slug and a suffix
+_LONGEST = 120
 
 
 def slug(*parts: str) -> str:
-    """A stable identifier for HTML anchors and file names: `manip-a-cs-jointMove-bb`."""
-    text = "-".join(_UNSAFE.sub("-", part).strip("-") for part in parts if part)
-    return text or "x"
+    """A stable identifier for HTML anchors and file names: `manip-a-cs-jointMove-bb`.
+
+    Distinct elements get distinct slugs: EARL names are letters, digits and `_`, and the
+    characters that join them (`/`, `,`, `.`, `[`) become `-`. A slug too long for a file name
+    keeps its start and ends with a digest of the whole."""
+    text = "-".join(_UNSAFE.sub("-", part).strip("-") for part in parts if part) or "x"
+    if len(text) > _LONGEST:
+        digest = hashlib.sha256(text.encode("utf-8")).hexdigest()[:12]
+        text = f"{text[: _LONGEST - 13]}-{digest}"
+    return text
