@@ -501,3 +501,48 @@ def test_a_name_too_long_for_a_file_name_still_makes_a_document(tmp_path: Path) 
     assert main(["doc", str(spec), "-o", str(site)]) == 0
     names = [path.name for path in (site / "diagrams").iterdir()]
     assert names and max(len(name) for name in names) <= 130
+
+
+MEMBER_LINK = """\
+system member
+
+a1/a {
+    cs {
+        period 1 ms
+        out/ob: double
+    }
+}
+
+a2/a {
+    cs {
+        period 1 ms
+        inp[K in 1..2]/ib: double
+    }
+}
+
+link a1,a2: a1/a.cs.out -> a2/a.cs.inp[1]
+
+r/r {
+    a1/a
+    a2/a
+    link a1,a2
+}
+"""
+
+
+def test_a_link_into_one_member_of_a_family_is_drawn_into_that_member(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`-> a2/a.cs.inp[1]` feeds `inp[1]` only (`earl check` says `inp[2]` is fed by no link): the
+    document, the system diagram and its Mermaid text say `inp[1]`, not the family `inp[K]`."""
+    spec = tmp_path / "member.earl"
+    spec.write_text(MEMBER_LINK, encoding="utf-8")
+    assert main(["diagram", str(spec), "--view", "system", "--format", "mermaid"]) == 0
+    assert "a1,a2: out/ob → inp[1]/ib : double" in capsys.readouterr().out
+    assert main(["diagram", str(spec), "--view", "system", "-o", str(tmp_path / "system.svg")]) == 0
+    drawing = (tmp_path / "system.svg").read_text(encoding="utf-8")
+    assert "inp[1]/ib" in drawing and "inp[K]" not in drawing
+    assert main(["doc", str(spec), "-o", str(tmp_path / "site")]) == 0
+    markdown = (tmp_path / "site" / "index.md").read_text(encoding="utf-8")
+    assert "[`a2/a.cs.inp[1]/ib`](#ib-a2-a-cs-inp-K)" in markdown
+    assert "(a1,a2, into inp[1])" in markdown

@@ -54,7 +54,7 @@ def system_mermaid(subject: Subject) -> str:
         if id(agent) not in placed:
             lines.append(agent_line("    ", positions[id(agent)]))
     for link in inter_agent_links(system):
-        label = f"{link_label(link.link)}: {link.source_buffer}/ob → {link.destination_buffer}/ib : {link.data_type}"
+        label = f"{link_label(link.link)}: {link.source_end}/ob → {link.destination_end}/ib : {link.data_type}"
         source = _identifier("a", agent_name(link.source))
         destination = _identifier("a", agent_name(link.destination))
         lines.append(f'    {source} -->|"{text(label)}"| {destination}')

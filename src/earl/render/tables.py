@@ -111,7 +111,6 @@ def _definition(predicate: PrimitivePredicate) -> str:
     return f'python "{predicate.implementation.path}"{arguments}'
 
 
-
 def transition_table(subsystem: Subsystem) -> list[TransitionRow]:
     if subsystem.fsm is None:
         return []

@@ -253,12 +253,12 @@ class DocumentBuilder:
             rows.append(
                 [
                     cell(code(link.link.name_text), anchor=slug("aa", link.link.name_text)),
-                    cell((Link(slug("ob", source, link.source_buffer), code(f"{source}.{link.source_buffer}/ob")),)),
+                    cell((Link(slug("ob", source, link.source_buffer), code(f"{source}.{link.source_end}/ob")),)),
                     cell(
                         (
                             Link(
                                 slug("ib", destination, link.destination_buffer),
-                                code(f"{destination}.{link.destination_buffer}/ib"),
+                                code(f"{destination}.{link.destination_end}/ib"),
                             ),
                         )
                     ),
@@ -594,13 +594,19 @@ def _buffer_links(system: System, agent: Agent) -> BufferLinks:
             table.setdefault((id(_cs(agent)), "ob", outer.source_buffer), []).append(
                 (
                     slug("ib", destination, outer.destination_buffer),
-                    f"{destination}.{outer.destination_buffer}/ib",
-                    label,
+                    f"{destination}.{outer.destination_end}/ib",
+                    label if outer.source_end == outer.source_buffer else f"{label}, from {outer.source_end}",
                 )
             )
         if outer.destination is agent:
             table.setdefault((id(_cs(agent)), "ib", outer.destination_buffer), []).append(
-                (slug("ob", source, outer.source_buffer), f"{source}.{outer.source_buffer}/ob", label)
+                (
+                    slug("ob", source, outer.source_buffer),
+                    f"{source}.{outer.source_end}/ob",
+                    label
+                    if outer.destination_end == outer.destination_buffer
+                    else f"{label}, into {outer.destination_end}",
+                )
             )
     return table
 

@@ -10,13 +10,14 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from earl.model.elements import Agent, Link, System
-from earl.model.expressions import ElementReference
+from earl.model.expressions import ElementReference, Literal
 from earl.model.kinds import Kind
 from earl.model.tables import AgentType
+from earl.model.text import index_text
 from earl.model.types import type_text
 from earl.render.diagram import Diagram
 from earl.render.dot import FILL, Graph, html
-from earl.render.names import Key, agent_name, element_key, family_note, indexed_name, link_label, lookup
+from earl.render.names import Indexed, Key, agent_name, element_key, family_note, indexed_name, link_label, lookup
 from earl.render.views.common import Port, block, link_statements, node_id
 
 AgentTypeOf = Callable[[Agent], AgentType | None]
@@ -28,10 +29,19 @@ class InterAgentLink:
 
     link: Link
     source: Agent
-    source_buffer: str  # the buffer's indexed name
+    source_buffer: str  # the buffer's indexed name: `cmd[K]` for a family
     destination: Agent
     destination_buffer: str
     data_type: str
+    #: the buffers as the link names them: `cmd[1]` where it feeds one member of the family `cmd[K]`
+    source_end: str = ""
+    destination_end: str = ""
+
+    def __post_init__(self) -> None:
+        if not self.source_end:
+            object.__setattr__(self, "source_end", self.source_buffer)
+        if not self.destination_end:
+            object.__setattr__(self, "destination_end", self.destination_buffer)
 
 
 def inter_agent_links(system: System) -> list[InterAgentLink]:
@@ -56,10 +66,31 @@ def inter_agent_links(system: System) -> list[InterAgentLink]:
             continue
         result.append(
             InterAgentLink(
-                link, source, indexed_name(output), destination, indexed_name(input_), type_text(output.data_type)
+                link,
+                source,
+                indexed_name(output),
+                destination,
+                indexed_name(input_),
+                type_text(output.data_type),
+                end_name(output, link.source.buffer),
+                end_name(input_, link.destination.buffer),
             )
         )
     return result
+
+
+def end_name(buffer: Indexed, reference: ElementReference | None) -> str:
+    """The buffer at a link's end as the link names it: `cmd[1]` when it feeds one member of the
+    family `cmd[K]`, which is otherwise drawn as a whole."""
+    if (
+        reference is not None
+        and buffer.family is not None
+        and buffer.index is None
+        and reference.indices
+        and all(isinstance(index, Literal) for index in reference.indices)
+    ):
+        return f"{buffer.name}[{', '.join(index_text(index) for index in reference.indices)}]"
+    return indexed_name(buffer)
 
 
 def system_view(system: System, agent_type: AgentTypeOf = lambda agent: None) -> Diagram:
@@ -68,8 +99,8 @@ def system_view(system: System, agent_type: AgentTypeOf = lambda agent: None) ->
     ports_in: dict[int, list[Port]] = {id(a): [] for a in system.agents}
     ports_out: dict[int, list[Port]] = {id(a): [] for a in system.agents}
     for link in links:
-        _add_port(ports_out[id(link.source)], "ob", link.source_buffer)
-        _add_port(ports_in[id(link.destination)], "ib", link.destination_buffer)
+        _add_port(ports_out[id(link.source)], "ob", link.source_end)
+        _add_port(ports_in[id(link.destination)], "ib", link.destination_end)
 
     names: list[str] = [system.name]
     nodes: dict[int, str] = {}
@@ -112,8 +143,8 @@ def system_view(system: System, agent_type: AgentTypeOf = lambda agent: None) ->
     for number, link in enumerate(links):
         name = link_label(link.link)
         link_names.append(name)
-        source = f"{nodes[id(link.source)]}:{_port('ob', link.source_buffer)}:e"
-        destination = f"{nodes[id(link.destination)]}:{_port('ib', link.destination_buffer)}:w"
+        source = f"{nodes[id(link.source)]}:{_port('ob', link.source_end)}:e"
+        destination = f"{nodes[id(link.destination)]}:{_port('ib', link.destination_end)}:w"
         backward = positions[id(link.destination)] < positions[id(link.source)]
         node, *link_edges = link_statements(number, source, destination, name, link.data_type, backward)
         source_robot, destination_robot = robot_of.get(id(link.source)), robot_of.get(id(link.destination))
