@@ -546,3 +546,20 @@ def test_a_link_into_one_member_of_a_family_is_drawn_into_that_member(
     markdown = (tmp_path / "site" / "index.md").read_text(encoding="utf-8")
     assert "[`a2/a.cs.inp[1]/ib`](#ib-a2-a-cs-inp-K)" in markdown
     assert "(a1,a2, into inp[1])" in markdown
+
+
+def test_the_agents_table_puts_each_member_in_the_robot_that_lists_it(tmp_path: Path) -> None:
+    """The robot lists `worker[1]/a` and `worker[2]/a` of the family `worker[K in 1..3]/a`: expanded,
+    `worker[3]/a` belongs to no robot, as the system diagram draws it."""
+    spec = Path(__file__).parent / "doc_specs" / "fleet" / "system.earl"
+    assert main(["doc", str(spec), "--expand", "-o", str(tmp_path / "site")]) == 0
+    rows = {
+        line.split(" | ")[0]: line.split(" | ")[1]
+        for line in (tmp_path / "site" / "index.md").read_text(encoding="utf-8").splitlines()
+        if line.startswith("| [`worker[")
+    }
+    assert rows == {
+        "| [`worker[1]/a`](#agent-worker-1-a)": "`fleetRobot/r`",
+        "| [`worker[2]/a`](#agent-worker-2-a)": "`fleetRobot/r`",
+        "| [`worker[3]/a`](#agent-worker-3-a)": "—",
+    }

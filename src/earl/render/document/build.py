@@ -57,7 +57,7 @@ from earl.render.tables import (
 from earl.render.views.activity import activity_view
 from earl.render.views.agent import agent_links, agent_view
 from earl.render.views.fsm import fsm_view
-from earl.render.views.system import InterAgentLink, inter_agent_links, system_view
+from earl.render.views.system import InterAgentLink, inter_agent_links, robot_numbers, system_view
 from earl.render.views.types import agent_types, closure, types_view
 
 _REFERENCE = re.compile(r"\b([A-Za-z_]\w*)((?:\[[^\]]*\])?)/(pp|ib|ob|mi|mo|m|bb|pf)\b")
@@ -211,9 +211,10 @@ class DocumentBuilder:
             + [cell(f"|{kind}|") for kind in ("cs", "ve", "re", "vr", "rr", "aa")]
         ]
         rows = []
+        robot_of = robot_numbers(system)
         for agent in system.agents:
             name = agent_name(agent)
-            robot = next((f"{r.name}/r" for r in system.robots if any(a.name == agent.name for a in r.agents)), "—")
+            robot = f"{system.robots[robot_of[id(agent)]].name}/r" if id(agent) in robot_of else "—"
             row = self.subject.agent_type(agent)
             instances = context.instances(agent) or [agent]
             first = instances[0]

@@ -170,6 +170,18 @@ def system_view(system: System, agent_type: AgentTypeOf = lambda agent: None) ->
     return Diagram("system", graph.header, graph.source(), "system", (*names, *link_names))
 
 
+def robot_numbers(system: System) -> dict[int, int]:
+    """By the agent's `id`: the number of the first robot that lists it (one agent, one member of a
+    family, or every member); agents of no robot are absent."""
+    agents_by_key = {element_key(a, Kind.AGENT): a for a in system.agents}
+    robot_of: dict[int, int] = {}
+    for number, robot in enumerate(system.robots):
+        for reference in robot.agents:
+            for agent in _robot_members(reference, agents_by_key):
+                robot_of.setdefault(id(agent), number)
+    return robot_of
+
+
 def _robot_members(reference: ElementReference, agents: dict[Key, Agent]) -> list[Agent]:
     """The agents a robot lists: one agent, one member, or every member of a family."""
     found = lookup(agents, reference)
