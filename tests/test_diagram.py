@@ -332,3 +332,54 @@ def test_the_activity_view_without_a_target_suggests_one_of_the_spec(capsys: pyt
     assert main(["diagram", str(MOBILE), "--view", "activity"]) == 2
     err = capsys.readouterr().err
     assert "e.g. base/a.cs." in str(err) and "manip/a" not in str(err)
+
+
+PRIMITIVES_ONLY = """\
+system prim
+
+r/r {
+    a/a
+}
+
+a/a {
+    cs {
+        period 10 ms
+        x/m: int = 0
+        f/pf(x/mi -> x/mo)
+        idle/bb {
+            tf = {f/pf}
+            tc = false
+        }
+        fsm {
+            initial idle
+            state idle: idle/bb
+        }
+    }
+}
+
+empty/a {
+}
+"""
+
+
+def test_a_view_with_nothing_in_it_still_draws_its_frame_and_says_so() -> None:
+    """Graphviz draws no cluster without a node: the frame and its header would vanish, leaving a
+    blank picture."""
+    system = earl.loads(PRIMITIVES_ONLY, "prim.earl")
+    drawn = svg_text(build_diagram(system, "types").svg())
+    assert "[Package] prim dataTypes" in drawn and "only primitive types" in drawn
+    drawn = svg_text(build_diagram(system, "agent", "empty/a").svg())
+    assert "[Agent] empty/a" in drawn and "no subsystem" in drawn
+
+
+def test_a_family_member_outside_the_range_is_no_target(system: System) -> None:
+    assert build_diagram(system, "fsm", "manip/a.motorController[6]/ve").header.endswith("motorController[K]/ve.fsm")
+    for outside in ("7", "0", "-1"):
+        with pytest.raises(TargetError, match="no subsystem"):
+            build_diagram(system, "fsm", f"manip/a.motorController[{outside}]/ve")
+
+
+def test_the_only_fsm_is_drawn_without_a_target_in_every_format(capsys: pytest.CaptureFixture[str]) -> None:
+    system = earl.loads(PRIMITIVES_ONLY, "prim.earl")
+    assert build_diagram(system, "fsm").header == "stm [FSM] a/a.cs.fsm"
+    assert "title: stm [FSM] a/a.cs.fsm" in mermaid_of(Subject(system), "fsm", None)

@@ -15,11 +15,11 @@ from functools import cached_property
 
 from earl.check import context_for
 from earl.check.context import CheckContext
-from earl.model.elements import Agent, Subsystem, System
+from earl.model.elements import Agent, System
 from earl.model.tables import AgentType
 from earl.render.diagram import Diagram
 from earl.render.names import agent_name, qualified_subsystem_name
-from earl.render.targets import TargetError, all_subsystems, find_agent, find_behaviour, find_subsystem
+from earl.render.targets import TargetError, all_subsystems, find_agent, find_behaviour, find_subsystem, only_fsm
 from earl.render.views.activity import activity_view
 from earl.render.views.agent import agent_view
 from earl.render.views.fsm import fsm_view
@@ -76,7 +76,7 @@ def diagram_of(subject: Subject, view: str, target: str | None) -> Diagram:
         agent = find_agent(system, target) if target is not None else _only_agent(system)
         return agent_view(agent, system)
     if view == "fsm":
-        agent, subsystem = find_subsystem(system, target) if target is not None else _only_fsm(system)
+        agent, subsystem = find_subsystem(system, target) if target is not None else only_fsm(system)
         if subsystem.fsm is None:
             raise TargetError(f"{qualified_subsystem_name(agent, subsystem)} has no FSM to draw")
         return fsm_view(subsystem.fsm, qualified_subsystem_name(agent, subsystem), subsystem, subject.expand)
@@ -107,11 +107,3 @@ def _only_agent(system: System) -> Agent:
         return system.agents[0]
     names = ", ".join(agent_name(a) for a in system.agents)
     raise TargetError(f"the agent view needs --target naming one of the agents: {names}")
-
-
-def _only_fsm(system: System) -> tuple[Agent, Subsystem]:
-    found = [(a, s) for a, s in all_subsystems(system) if s.fsm is not None]
-    if len(found) == 1:
-        return found[0]
-    names = ", ".join(qualified_subsystem_name(a, s) for a, s in found[:12])
-    raise TargetError(f"the fsm view needs --target naming a subsystem, e.g. {names}")

@@ -12,7 +12,7 @@ from earl.model.kinds import Kind
 from earl.model.text import expression_text
 from earl.render.build import Subject
 from earl.render.names import agent_name, element_key, link_label, lookup, qualified_subsystem_name
-from earl.render.targets import TargetError, find_subsystem
+from earl.render.targets import TargetError, find_subsystem, only_fsm
 from earl.render.views.system import inter_agent_links
 
 
@@ -88,9 +88,7 @@ def mermaid_of(subject: Subject, view: str, target: str | None) -> str:
         return system_mermaid(subject)
     if view == "fsm":
         system = subject.shown
-        if target is None:
-            raise TargetError("the fsm view needs --target naming a subsystem, e.g. manip/a.cs")
-        agent, subsystem = find_subsystem(system, target)
+        agent, subsystem = find_subsystem(system, target) if target is not None else only_fsm(system)
         if subsystem.fsm is None:
             raise TargetError(f"{qualified_subsystem_name(agent, subsystem)} has no FSM to draw")
         return fsm_mermaid(subsystem.fsm, qualified_subsystem_name(agent, subsystem), subsystem)

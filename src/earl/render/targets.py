@@ -11,10 +11,12 @@ A family is named without an index, or with its index variable
 from __future__ import annotations
 
 import re
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 from earl.model.elements import Agent, BasicBehaviour, Family, Subsystem, System
+from earl.model.expand import family_members, parameter_values
+from earl.model.expressions import ConstantError
 from earl.render.names import agent_name, qualified_subsystem_name
 
 _SEGMENT = re.compile(r"^(?P<name>[A-Za-z_]\w*)(?:\[(?P<index>[^\]]*)\])?(?:/(?P<kind>[a-z]+))?$")
@@ -45,7 +47,12 @@ def _segments(text: str) -> list[Segment]:
     return result
 
 
-def _matches(segment: Segment, name: str, family: Family | None, index: int | None, kind: str) -> bool:
+Environment = Mapping[str, bool | int | float | str]
+
+
+def _matches(
+    segment: Segment, name: str, family: Family | None, index: int | None, kind: str, environment: Environment
+) -> bool:
     if segment.name != name or (segment.kind is not None and segment.kind != kind):
         return False
     if index is not None:  # a member of an expanded family answers to its number only
@@ -53,7 +60,20 @@ def _matches(segment: Segment, name: str, family: Family | None, index: int | No
     if family is None:
         return segment.index is None
     # a family drawn once answers to its name, its index variable, or any member's number
-    return True
+    number = None if segment.index is None else segment.index.strip()
+    if number is None or number == family.index or not number.lstrip("-").isdigit():
+        return True
+    try:
+        return int(number) in family_members(family, environment)
+    except ConstantError:  # its range needs an agent's own parameters: the name alone decides
+        return True
+
+
+def _environment(system: System) -> Environment:
+    try:
+        return parameter_values(system.parameters, {})
+    except ConstantError:
+        return {}
 
 
 def _choices(names: Sequence[str]) -> str:
@@ -66,24 +86,40 @@ def find_agent(system: System, text: str) -> Agent:
     first = segments[0]
     if first.kind is None and len(segments) == 1:
         first = Segment(first.name, first.index, "a")
-    found = [a for a in system.agents if _matches(first, a.name, a.family, a.index, "a")]
+    environment = _environment(system)
+    found = [a for a in system.agents if _matches(first, a.name, a.family, a.index, "a", environment)]
     if len(found) != 1 or len(segments) != 1:
         raise TargetError(f"no agent `{text}`; the agents are {_choices([agent_name(a) for a in system.agents])}")
     return found[0]
 
 
-def _subsystem_in(agent: Agent, segment: Segment) -> Subsystem | None:
+def _subsystem_in(agent: Agent, segment: Segment, environment: Environment) -> Subsystem | None:
     for subsystem in agent.subsystems:
         kind = subsystem.kind.value
         if segment.name == "cs" and segment.kind in (None, "cs") and kind == "cs":
             return subsystem
-        if segment.kind is not None and _matches(segment, subsystem.name, subsystem.family, subsystem.index, kind):
+        if segment.kind is not None and _matches(
+            segment, subsystem.name, subsystem.family, subsystem.index, kind, environment
+        ):
             return subsystem
     return None
 
 
 def all_subsystems(system: System) -> list[tuple[Agent, Subsystem]]:
     return [(agent, subsystem) for agent in system.agents for subsystem in agent.subsystems]
+
+
+def only_fsm(system: System) -> tuple[Agent, Subsystem]:
+    """The subsystem whose FSM is drawn when no --target is given: the only one that has an FSM."""
+    found = [(a, s) for a, s in all_subsystems(system) if s.fsm is not None]
+    if len(found) == 1:
+        return found[0]
+    if not found:
+        raise TargetError("no subsystem has an FSM to draw")
+    raise TargetError(
+        "the fsm view needs --target naming a subsystem, e.g. "
+        + ", ".join(qualified_subsystem_name(a, s) for a, s in found[:12])
+    )
 
 
 def find_subsystem(system: System, text: str) -> tuple[Agent, Subsystem]:
@@ -95,7 +131,7 @@ def find_subsystem(system: System, text: str) -> tuple[Agent, Subsystem]:
         agent = find_agent(system, segments[0].name + _index(segments[0]) + "/" + (segments[0].kind or "a"))
     except TargetError:
         raise TargetError(f"no subsystem `{text}`; the subsystems are {_choices(choices)}") from None
-    subsystem = _subsystem_in(agent, segments[1])
+    subsystem = _subsystem_in(agent, segments[1], _environment(system))
     if subsystem is None:
         raise TargetError(f"no subsystem `{text}`; the subsystems are {_choices(choices)}")
     return agent, subsystem
@@ -117,7 +153,8 @@ def find_behaviour(system: System, text: str) -> tuple[Agent, Subsystem, BasicBe
     if behaviour is None:
         own = [f"{b.name}/bb" for b in subsystem.basic_behaviours]
         where = qualified_subsystem_name(agent, subsystem)
-        raise TargetError(f"{where} has no basic behaviour `{segments[2].name}/bb`; it has {_choices(own)}")
+        has = f"it has {_choices(own)}" if own else "it has none"
+        raise TargetError(f"{where} has no basic behaviour `{segments[2].name}/bb`; {has}")
     return agent, subsystem, behaviour
 
 

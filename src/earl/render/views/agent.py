@@ -98,6 +98,8 @@ def agent_view(agent: Agent, system: System | None = None) -> Diagram:
     graph.graph_attributes["ranksep"] = "1.1"
     names: list[str] = [name]
     nodes: dict[Key, tuple[str, Subsystem]] = {}
+    if not agent.subsystems:  # Graphviz draws no cluster without a node: the frame and its header would vanish
+        graph.add('none [shape="plaintext", fontsize="10", label="no subsystem"];')
     for subsystem in agent.subsystems:
         key = element_key(subsystem, subsystem.kind)
         node = node_id("ss", subsystem_name(subsystem))

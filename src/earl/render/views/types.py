@@ -104,6 +104,8 @@ def types_view(definitions: Sequence[TypeDefinition], owner: str, subject: str =
                     f"{node_id('type', definition.name)} -> {node_id('type', target)} "
                     f'[dir="both", arrowtail="diamond", arrowhead="open", label="{html(label)}"];'
                 )
+    if not definitions:  # Graphviz draws no cluster without a node: the frame and its header would vanish
+        graph.add('none [shape="plaintext", fontsize="10", label="no struct or alias: only primitive types"];')
     # Types that stand alone would stack in one tall column; invisible edges set them in rows of three.
     alone = [node_id("type", d.name) for d in definitions if d.name not in connected]
     for start in range(0, len(alone), 3):
