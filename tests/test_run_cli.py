@@ -448,6 +448,37 @@ def test_a_stop_signal_to_the_whole_process_group_leaves_a_readable_trace(tmp_pa
     assert "counting,finished" in summary.stdout
 
 
+@pytest.mark.parametrize("stop", [signal.SIGTERM, signal.SIGINT])
+def test_a_stop_signal_as_the_trace_is_opened_still_leaves_a_readable_trace(tmp_path: Path, stop: int) -> None:
+    """The signal comes as the trace's writer starts, before the run (and the writer) handle it: the
+    writer, in a session of its own, never sees it and finishes the file when the pipe closes; the run
+    ends with 130, not SIGTERM's silent 143."""
+    trace = tmp_path / "run.mcap"
+    process = subprocess.Popen(
+        [*EARL, "run", str(SPECS / "counter"), "--realtime", "--duration", "60s", "--trace", str(trace)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
+    deadline = time.monotonic() + 30
+    while not trace.exists() and time.monotonic() < deadline:
+        time.sleep(0.002)
+    os.killpg(process.pid, stop)
+    _, stderr = process.communicate(timeout=30)
+    assert process.returncode == 130, stderr
+    assert "Traceback" not in stderr and "cannot write the trace" not in stderr
+    if not trace.exists():  # stopped before the run started: said, and no empty trace left behind
+        assert "interrupted before the run started; nothing was executed; no trace was written" in stderr
+        return
+    deadline = time.monotonic() + 30
+    summary = earl_cli("trace", "summary", str(trace))
+    while summary.returncode != 0 and time.monotonic() < deadline:  # the writer may still be finishing
+        time.sleep(0.2)
+        summary = earl_cli("trace", "summary", str(trace))
+    assert summary.returncode == 0, summary.stderr
+
+
 def test_ctrl_c_stops_the_run_even_when_the_specs_code_swallows_it(tmp_path: Path) -> None:
     spec = counter_copy(tmp_path)
     functions = spec.parent / "counting" / "cs.py"

@@ -265,7 +265,7 @@ def _reader_gone() -> bool:
 
 
 def _kill_session(child: subprocess.Popen[bytes]) -> None:
-    """SIGKILL to the child's whole session, its trace writer with it (the writer ignores SIGTERM)."""
+    """SIGKILL to the child's whole session; its trace writer, in a session of its own, finishes the file."""
     try:
         os.killpg(child.pid, signal.SIGKILL)
     except OSError:

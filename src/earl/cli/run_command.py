@@ -139,6 +139,17 @@ def register(commands: Any) -> None:
 
 
 def run(arguments: argparse.Namespace) -> int:
+    """`earl run`. A stop signal before the run has started (while the spec is read and checked, the
+    environment built) ends it too, with exit 130, instead of SIGTERM's silent death (143)."""
+    try:
+        with _stopped_like_ctrl_c():
+            return _run(arguments)
+    except KeyboardInterrupt:
+        print("earl run: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+
+
+def _run(arguments: argparse.Namespace) -> int:
     from earl.lang.loader import load
     from earl.runtime.durations import parse_duration
     from earl.runtime.simulation import Simulation, read_run_settings
@@ -226,6 +237,16 @@ def run(arguments: argparse.Namespace) -> int:
             agents=agents,
             transport=transport,
         )
+    except KeyboardInterrupt:  # a stop signal while the spec was read and the run set up
+        _close(transport)
+        said = "nothing was executed"
+        if arguments.trace and Path(arguments.trace).exists():
+            # created by this command a moment ago (an existing file is refused), holding no run
+            with contextlib.suppress(OSError):
+                Path(arguments.trace).unlink()
+                said += f"; no trace was written to {arguments.trace}"
+        print(f"earl run: interrupted before the run started; {said}", file=sys.stderr)
+        return EXIT_INTERRUPTED
     except EarlError as error:
         _close(transport)
         print_diagnostics(error.diagnostics, error.sources)

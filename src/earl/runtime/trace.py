@@ -440,6 +440,10 @@ class BackgroundSink:
             stdout=subprocess.DEVNULL,
             stderr=subprocess.PIPE,
             env={**os.environ, "PYTHONPATH": search_path},
+            # A session of its own: a stop signal for the run's process group or session (Ctrl-C,
+            # `timeout`, `earl launch`'s SIGKILL) never reaches it, not even while it starts and has not
+            # yet set its signals aside. It ends when the run says so, or when the pipe closes.
+            start_new_session=True,
         )
         _widen(self._process.stdin)
         self._due = _clock() + self.LATEST

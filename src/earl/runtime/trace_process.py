@@ -3,9 +3,10 @@
 It reads length-prefixed msgpack batches from its standard input, written by
 `BackgroundSink` in the run's process (trusted: its parent), and applies them to a
 `McapSink`.  Ctrl-C reaches every process of the terminal, and SIGTERM or SIGHUP
-every process of the group (`timeout`, a closed terminal): this one ignores them
-all and finishes the file when the run says so, or when its input ends because
-the run was killed.  A write that fails (a full disk) ends it with exit code 1 and one line on
+every process of the group (`timeout`, a closed terminal): this one runs in a
+session of its own, where none of them reaches it, ignores them besides, and
+finishes the file when the run says so, or when its input ends because the run
+was killed.  A write that fails (a full disk) ends it with exit code 1 and one line on
 standard error, which the run reports.
 """
 
