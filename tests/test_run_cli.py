@@ -829,3 +829,15 @@ def test_run_plot_refuses_an_index_or_field_the_signal_s_element_lacks_before_th
         "run", str(EXAMPLE), "--duration", "100s", "--plot", str(tmp_path / "p.png"), "--signal", signal_name
     )
     assert result.returncode == 2 and fragment in result.stderr, result.stderr
+
+
+def test_a_signal_without_a_value_in_a_short_run_is_left_out_of_the_plot_not_the_plot(tmp_path: Path) -> None:
+    """run.toml's signals include an optional field the task agent first sends after 8 s: a 2 s run
+    still draws the others, and says which one had no value."""
+    png = tmp_path / "p.png"
+    result = earl_cli("run", str(EXAMPLE), "--duration", "2s", "--plot", str(png), "--no-progress")
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert png.is_file()
+    said = " ".join((result.stdout + result.stderr).split())
+    assert "`task/a.cs.manipulatorCommand.jointPosSetpoint[*]` had no value in this run" in said
+    assert "drawn without it" in said

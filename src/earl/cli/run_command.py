@@ -526,13 +526,15 @@ def _plot(arguments: argparse.Namespace, console: Console) -> bool:
     from earl.runtime.trace_reader import TraceError
 
     try:
-        plot_signals(Path(arguments.trace), arguments.signal, Path(arguments.plot))
+        left_out = plot_signals(Path(arguments.trace), arguments.signal, Path(arguments.plot))
     except TraceError as error:
         console.print(f"earl run: no plot: {error}")
         return False
     except OSError as error:  # a read-only directory, a full disk: the run and its trace are fine
         console.print(f"earl run: no plot: cannot write {arguments.plot}: {error.strerror or error}")
         return False
+    for line in left_out:
+        console.print(f"earl run: plot: {line}")
     console.print(f"plot: {arguments.plot}")
     return True
 

@@ -107,11 +107,13 @@ def run_plot(arguments: argparse.Namespace) -> int:
     if problem is not None:
         return usage_error(f"cannot write {arguments.output!r}: {problem}")
     try:
-        plot_signals(path, arguments.signal, Path(arguments.output), arguments.title)
+        left_out = plot_signals(path, arguments.signal, Path(arguments.output), arguments.title)
     except TraceError as error:
         sys.stderr.write(f"earl plot: {error}\n")
         return EXIT_FAILED
     except OSError as error:  # a read-only directory, a full disk
         return usage_error(f"cannot write {arguments.output}: {error.strerror or error}")
+    for line in left_out:
+        sys.stderr.write(f"earl plot: {line}\n")
     print(f"wrote {arguments.output}")
     return EXIT_OK

@@ -102,8 +102,10 @@ def _path_problem(expanded: System, subsystem: Subsystem, element: str, path: st
     return None
 
 
-def plot_signals(trace: Path, signals: list[str], output: Path, title: str | None = None) -> None:
-    """Write a PNG (or SVG/PDF, by the suffix): one panel per element of a subsystem, its FSM states behind."""
+def plot_signals(trace: Path, signals: list[str], output: Path, title: str | None = None) -> list[str]:
+    """Write a PNG (or SVG/PDF, by the suffix): one panel per element of a subsystem, its FSM states behind.
+
+    Returns a line for each signal left out because it had no value in the run (`Signals.empty`)."""
     import matplotlib
 
     matplotlib.use("Agg")  # files only: no display needed, none opened
@@ -147,3 +149,4 @@ def plot_signals(trace: Path, signals: list[str], output: Path, title: str | Non
     output.parent.mkdir(parents=True, exist_ok=True)
     figure.savefig(output, dpi=110)
     plt.close(figure)
+    return [f"{line}; drawn without it" for line in data.empty]

@@ -170,6 +170,9 @@ class Signals:
     series: list[Series]
     bands: dict[str, list[tuple[float, float, str]]]
     end: float
+    #: a line for each signal whose element the trace holds but that had no value in this run (an
+    #: optional field never sent, an array sent empty): the others are drawn without it
+    empty: list[str] = field(default_factory=list)
 
 
 def read_signals(path: Path, names: list[str]) -> Signals:
@@ -229,6 +232,7 @@ def read_signals(path: Path, names: list[str]) -> Signals:
         except (KeyError, TypeError, ValueError, AttributeError):
             raise _not_from_earl(path, topic) from None
     series: list[Series] = []
+    empty: list[str] = []
     for name, subsystem, inner in owners:
         pattern = re.compile(re.escape(inner).replace(r"\[\*\]", r"\[\d+\]") + "$")
         matched = [
@@ -241,7 +245,9 @@ def read_signals(path: Path, names: list[str]) -> Signals:
             same = sorted({leaf for (owner, leaf) in leaves if owner == subsystem and signal_element(leaf) == element})
             if same:
                 hint = f"the trace has {', '.join(f'`{leaf}`' for leaf in same[:6])}{' …' if len(same) > 6 else ''}"
-            elif f"{subsystem}/memory" not in available:
+                empty.append(f"`{name}` had no value in this run ({hint})")
+                continue
+            if f"{subsystem}/memory" not in available:
                 hint = (
                     f"if it is memory, record it with `--record-memory {subsystem}`; an output buffer is in the "
                     "trace when a link leaves it (and `--record-links` keeps that link)"
@@ -257,7 +263,9 @@ def read_signals(path: Path, names: list[str]) -> Signals:
         ]
         for subsystem, changes in stays.items()
     }
-    return Signals(series, bands, end)
+    if not series:
+        raise TraceError(f"no signal has a value in this trace: {'; '.join(empty)}")
+    return Signals(series, bands, end, empty)
 
 
 def signal_element(name: str) -> str:
