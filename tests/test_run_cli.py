@@ -132,7 +132,8 @@ def test_a_damaged_trace_is_a_clear_error_for_summary_and_plot(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """Cut short or with bytes changed anywhere (a disk error, a copy that stopped): exit 1 and one line,
-    whatever the MCAP reader or its decompressor raises on the way."""
+    whatever the MCAP reader or its decompressor raises on the way, or, for a file whose end is missing
+    or damaged, what comes before the damage, with a line that says so."""
     from earl.cli.main import main
 
     trace = tmp_path / "run.mcap"
@@ -160,6 +161,8 @@ def test_a_damaged_trace_is_a_clear_error_for_summary_and_plot(
                 failures += 1
                 assert output.err.startswith(f"earl {command[0]}: "), output.err
                 assert output.err.count("\n") == 1
+            elif "no valid end" in " ".join((output.out + output.err).split()):
+                failures += 1  # found, and read up to the damage
     assert failures >= len(cases)  # most damage is found: some changed bytes (in a padding, say) harm nothing
 
 
@@ -841,3 +844,20 @@ def test_a_signal_without_a_value_in_a_short_run_is_left_out_of_the_plot_not_the
     said = " ".join((result.stdout + result.stderr).split())
     assert "`task/a.cs.manipulatorCommand.jointPosSetpoint[*]` had no value in this run" in said
     assert "drawn without it" in said
+
+
+def test_a_trace_cut_short_is_read_up_to_the_cut(tmp_path: Path) -> None:
+    """A run killed together with its writer leaves a file without its summary, its last chunk cut:
+    the summary and the plot read every record before the cut; the summary says the run's end is
+    missing."""
+    trace = tmp_path / "run.mcap"
+    assert earl_cli("run", str(SPECS / "counter"), "--duration", "2s", "--trace", str(trace)).returncode == 0
+    data = trace.read_bytes()
+    cut = tmp_path / "cut.mcap"
+    cut.write_bytes(data[: len(data) * 2 // 3])
+    summary = earl_cli("trace", "summary", str(cut))
+    assert summary.returncode == 0, summary.stderr
+    assert "counter/a.cs" in summary.stdout and "no valid end" in " ".join(summary.stdout.split())
+    plot = earl_cli("plot", str(cut), "--signal", "counter/a.relay/ve.forward", "-o", str(tmp_path / "p.png"))
+    assert plot.returncode == 0, plot.stderr
+    assert (tmp_path / "p.png").is_file()

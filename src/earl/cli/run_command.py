@@ -482,8 +482,10 @@ def _advance(
 def _summary(simulation: Any, wall: float, arguments: argparse.Namespace) -> None:
     console = Console(highlight=False, markup=False)
     table = Table(title=f"system {simulation.system.name}: {simulation.time:.3f} s", title_justify="left")
-    table.add_column("subsystem")
-    table.add_column("state at the end")
+    # names in full: the members of a family differ only at their end (`manip/a.motorController[3]/ve`)
+    longest = max((len(name) for name in simulation.subsystems), default=9)
+    table.add_column("subsystem", no_wrap=True, min_width=longest)
+    table.add_column("state at the end", overflow="fold")
     table.add_column("iterations", justify="right")
     table.add_column("transitions", justify="right")
     table.add_column("faults", justify="right")

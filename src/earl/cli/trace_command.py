@@ -52,7 +52,7 @@ def register(commands: Any) -> None:
 
 
 def run_summary(arguments: argparse.Namespace) -> int:
-    from earl.runtime.trace_reader import TraceError, summarise
+    from earl.runtime.trace_reader import CUT, TraceError, summarise
 
     path = Path(arguments.file)
     if not path.is_file():
@@ -66,7 +66,8 @@ def run_summary(arguments: argparse.Namespace) -> int:
     end = summary.end_time * 1e-9
     settings = ", ".join(f"{k}={v}" for k, v in summary.settings.items())
     table = Table(title=f"{path.name}: {end:.3f} s ({settings})", title_justify="left")
-    table.add_column("subsystem")
+    # names in full: the members of a family differ only at their end (`manip/a.motorController[3]/ve`)
+    table.add_column("subsystem", no_wrap=True, min_width=max((len(name) for name in summary.subsystems), default=9))
     table.add_column("time in each state")
     table.add_column("transitions taken")
     table.add_column("iterations", justify="right")
@@ -80,6 +81,8 @@ def run_summary(arguments: argparse.Namespace) -> int:
         iterations = str(subsystem.iterations) if summary.ended else "?"
         table.add_row(name, states, transitions, iterations, str(subsystem.faults))
     console.print(table)
+    if summary.cut:
+        console.print(f"{path.name}: {CUT}")
     if not summary.ended:
         console.print(
             f"the trace ends at {end:.3f} s without the run's end (the run was killed): what it holds is whole, "

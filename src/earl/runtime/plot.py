@@ -10,7 +10,7 @@ from earl.model.elements import Memory, OutputBuffer, Subsystem, System
 from earl.model.expressions import Literal
 from earl.model.types import ArrayType, StructType
 from earl.runtime.names import subsystem_name
-from earl.runtime.trace_reader import read_signals, signal_element
+from earl.runtime.trace_reader import CUT, read_signals, signal_element
 
 #: the kinds of file a plot is written as, by the suffix (what Matplotlib's Agg backend writes)
 PLOT_SUFFIXES = (".png", ".svg", ".pdf", ".jpg", ".jpeg", ".eps", ".ps")
@@ -149,4 +149,4 @@ def plot_signals(trace: Path, signals: list[str], output: Path, title: str | Non
     output.parent.mkdir(parents=True, exist_ok=True)
     figure.savefig(output, dpi=110)
     plt.close(figure)
-    return [f"{line}; drawn without it" for line in data.empty]
+    return [f"{line}; drawn without it" for line in data.empty] + ([CUT] if data.cut else [])

@@ -17,6 +17,8 @@ from typing import Any
 
 from mcap.exceptions import EndOfFile, McapError
 from mcap.reader import make_reader
+from mcap.records import Channel, Message
+from mcap.stream_reader import StreamReader
 
 from earl.runtime.values import iter_leaves
 
@@ -44,18 +46,66 @@ class TraceSummary:
     settings: dict[str, Any]
     #: whether the run's end is in the trace (with the iteration counts); not when the run was killed
     ended: bool = True
+    #: set when the file had no valid end (cut short, or damaged): read up to its first damaged record
+    cut: bool = False
 
 
-def _messages(path: Path, topics: list[str] | None = None) -> Iterator[tuple[str, dict[str, str], int, Any]]:
+#: said when a file without a valid end was read up to its first damaged record
+CUT = "the file has no valid end (cut short, or damaged): read up to its first damaged record"
+
+
+def _messages(
+    path: Path, topics: list[str] | None = None, cut: list[bool] | None = None
+) -> Iterator[tuple[str, dict[str, str], int, Any]]:
+    """Every message (of `topics`) in file order; `cut` gets True appended when the file had to be read
+    up to a cut."""
+    yielded = False
     try:
         with open(path, "rb") as stream:
             reader = make_reader(stream)
             for _, channel, message in reader.iter_messages(topics=topics, log_time_order=False):
+                yielded = True
                 yield channel.topic, channel.metadata, message.log_time, json.loads(message.data)
+        return
     except FileNotFoundError:
         raise TraceError(f"no such file: {path}") from None
     except Exception as error:  # a damaged file provokes whatever the reader and its decompressors raise
+        if yielded:
+            raise _unreadable(path, error) from None
+        failure = error
+    # No summary at its end: a trace cut short (a run killed with its writer, a copy interrupted). Its
+    # records are read in order up to the cut, so that what the run wrote before is not lost.
+    wanted = None if topics is None else set(topics)
+    seen_channel = False
+    if cut is not None:
+        cut.append(True)
+    try:
+        for channel, record in _records_up_to_the_cut(path):
+            seen_channel = True
+            if record is not None and (wanted is None or channel.topic in wanted):
+                yield channel.topic, channel.metadata, record.log_time, json.loads(record.data)
+    except ValueError as error:  # a message that is not JSON (or not UTF-8): damage, not a cut
         raise _unreadable(path, error) from None
+    if not seen_channel:  # not an MCAP file at all, or nothing before the damage
+        raise _unreadable(path, failure) from None
+
+
+def _records_up_to_the_cut(path: Path) -> Iterator[tuple[Channel, Message | None]]:
+    """Each channel as it is declared (with None) and each message with its channel, in file order,
+    until the file ends or its first damaged record (a chunk cut in half)."""
+    channels: dict[int, Channel] = {}
+    with open(path, "rb") as stream:
+        records = StreamReader(stream).records
+        while True:
+            try:
+                record = next(records)
+            except Exception:  # the cut: an end of file inside a record, a chunk that does not decompress
+                return
+            if isinstance(record, Channel):
+                channels[record.id] = record
+                yield record, None
+            elif isinstance(record, Message) and record.channel_id in channels:
+                yield channels[record.channel_id], record
 
 
 def _unreadable(path: Path, error: BaseException) -> TraceError:
@@ -77,14 +127,17 @@ def _not_from_earl(path: Path, topic: str) -> TraceError:
 
 def summarise(path: Path) -> TraceSummary:
     summariser = _Summariser()
-    for topic, metadata, time, data in _messages(path):
+    cut: list[bool] = []
+    for topic, metadata, time, data in _messages(path, cut=cut):
         try:
             summariser.add(topic, metadata, time, data)
         except (KeyError, TypeError, ValueError, AttributeError):
             raise _not_from_earl(path, topic) from None
     if not summariser.seen_run:
         raise TraceError(f"{path} is an MCAP file but not an earl trace (it has no /earl/run topic)")
-    return summariser.summary()
+    summary = summariser.summary()
+    summary.cut = bool(cut)
+    return summary
 
 
 class _Summariser:
@@ -141,16 +194,23 @@ class _Summariser:
 
 
 def topics(path: Path) -> dict[str, dict[str, str]]:
+    failure: Exception | None = None
     try:
         with open(path, "rb") as stream:
             summary = make_reader(stream).get_summary()
     except FileNotFoundError:
         raise TraceError(f"no such file: {path}") from None
     except Exception as error:  # as in `_messages`
-        raise _unreadable(path, error) from None
-    if summary is None:
-        return {}
-    return {channel.topic: dict(channel.metadata) for channel in summary.channels.values()}
+        summary, failure = None, error
+    if summary is not None:
+        return {channel.topic: dict(channel.metadata) for channel in summary.channels.values()}
+    # a trace cut short has no summary: its channels are declared before their first message
+    found = {
+        channel.topic: dict(channel.metadata) for channel, message in _records_up_to_the_cut(path) if message is None
+    }
+    if not found and failure is not None:
+        raise _unreadable(path, failure) from None
+    return found
 
 
 @dataclass
@@ -173,6 +233,8 @@ class Signals:
     #: a line for each signal whose element the trace holds but that had no value in this run (an
     #: optional field never sent, an array sent empty): the others are drawn without it
     empty: list[str] = field(default_factory=list)
+    #: whether the file had no valid end and was read up to its first damaged record
+    cut: bool = False
 
 
 def read_signals(path: Path, names: list[str]) -> Signals:
@@ -207,7 +269,8 @@ def read_signals(path: Path, names: list[str]) -> Signals:
     leaves: dict[tuple[str, str], tuple[list[float], list[float]]] = {}
     stays: dict[str, list[tuple[float, str]]] = {}
     end = 0.0
-    for topic, _, time, data in _messages(path, [*wanted, "/earl/run"]):
+    cut: list[bool] = []
+    for topic, _, time, data in _messages(path, [*wanted, "/earl/run"], cut):
         seconds = time * 1e-9
         end = max(end, seconds)
         if topic == "/earl/run":
@@ -265,7 +328,7 @@ def read_signals(path: Path, names: list[str]) -> Signals:
     }
     if not series:
         raise TraceError(f"no signal has a value in this trace: {'; '.join(empty)}")
-    return Signals(series, bands, end, empty)
+    return Signals(series, bands, end, empty, bool(cut))
 
 
 def signal_element(name: str) -> str:
