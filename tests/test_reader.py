@@ -193,3 +193,32 @@ def test_a_syntax_error_is_explained_by_lark_and_the_reader_recovers() -> None:
     parsed = _parse("system t\n\na/a {\n    cs {\n        period 2 ms\n    }\n}\n")
     assert parsed.system_name == "t"
     assert parsed.declarations[0].location.line == 3
+
+
+def test_a_real_parameter_computed_from_a_family_index_is_in_scope_with_one_value_per_member() -> None:
+    """`param GAIN: double = 0.5 * ID` (ID itself `= K`): a predicate and an initial value may use it;
+    expanded, each member has its own value; a member whose value does not fit the type is refused."""
+    text = """\
+system gains
+
+arm/a {
+    joint[K in 1..2]/ve {
+        period 1 ms
+        param ID: int = K
+        param GAIN: double = 0.5 * ID
+        param OFFSET: double = 0.25 * K
+        x/ib: double
+        m/m: double = GAIN
+        far/pp = x/ib > GAIN and x/ib < OFFSET
+    }
+}
+"""
+    from earl.model.expand import expand
+
+    expanded = expand(earl.loads(text, "gains.earl"))
+    members = [s for s in expanded.agents[0].subsystems]
+    assert [(s.index, s.memories[0].initial_value.value) for s in members] == [(1, 0.5), (2, 1.0)]  # type: ignore[union-attr]
+    with pytest.raises(earl.EarlError) as refused:
+        earl.loads(text.replace("param OFFSET: double = 0.25 * K", "param OFFSET: string = K"), "gains.earl")
+    (problem,) = refused.value.diagnostics
+    assert problem.code == "EARL-R005" and "where K = 1" in problem.message

@@ -12,6 +12,7 @@ from typing import Any
 import pytest
 
 import earl
+from earl.model.elements import Duration
 from earl.runtime.events import Recorder
 from earl.runtime.simulation import Simulation
 
@@ -652,3 +653,20 @@ def test_a_memory_family_starts_each_member_from_its_own_index(tmp_path: Path) -
         assert [memory[f"history[{j}]"] for j in (1, 2, 3)] == [2.5, 4.5, 6.5]
     finally:
         sim.close()
+
+
+@pytest.mark.parametrize(
+    ("duration", "fragment"),
+    [
+        (Duration(0.0001, "us"), "period is 0.0001 us; it must be at least 1 ns"),
+        (Duration(1, "min"), "period is in `min`; the units are s, ms, us"),
+    ],
+)
+def test_a_period_built_in_python_that_time_could_not_follow_is_refused(duration: Duration, fragment: str) -> None:
+    """The reader refuses `period 0.0001 us` (EARL-S012); a model built or edited in Python never met the
+    reader, and a period that rounds to 0 ns would hold the run at one instant for ever."""
+    system = earl.load(SPECS / "counter")
+    system.agent("counter").control_subsystem.period = duration  # type: ignore[union-attr]
+    with pytest.raises(earl.EarlError) as refused:
+        earl.simulate(system, check=False)
+    assert [(d.code, fragment in d.message) for d in refused.value.diagnostics] == [("EARL-X014", True)]

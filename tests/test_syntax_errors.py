@@ -463,6 +463,14 @@ SYNTAX = [
         "a duration is at most 1,000,000,000 s",
     ),
     Malformed(
+        "duration_below_a_nanosecond",
+        _in_cs("        period 0.0001 us\n"),
+        9,
+        16,
+        "EARL-S012",
+        "a duration is at least 1 ns (earl keeps time in whole nanoseconds), not 0.0001 us",
+    ),
+    Malformed(
         "duration_of_centuries",
         _in_cs("        period 1e13 s\n"),
         9,

@@ -20,7 +20,7 @@ READING_CODES: dict[str, str] = {
     "EARL-S008": "a duration without one of the units `s`, `ms`, `us`",
     "EARL-S010": "a link family that declares two indices",
     "EARL-S011": "a subsystem with a second `fsm`",
-    "EARL-S012": "a duration that is not positive, or longer than 10⁹ s",
+    "EARL-S012": "a duration shorter than 1 ns (or not positive), or longer than 10⁹ s",
     "EARL-S013": "an unknown FIFO overflow policy",
     "EARL-S014": "a state that names something other than a Basic Behaviour",
     "EARL-S015": "an expression nested too deeply",

@@ -75,7 +75,15 @@ class IndexRange:
         return range(self.first, self.last + 1)
 
 
-Scope = dict[str, "Value | IndexRange"]
+@dataclass(frozen=True)
+class PerMember:
+    """A parameter of a family computed from its index, whose values are not whole numbers
+    (`param GAIN: double = 0.5 * K`): in scope, with one value per member, known once expanded."""
+
+    type_name: str
+
+
+Scope = dict[str, "Value | IndexRange | PerMember"]
 
 
 @dataclass
@@ -173,11 +181,15 @@ class Resolver:
                 continue
             if parameter.name in overrides:
                 value: Value = overrides[parameter.name]
-            elif any(isinstance(scope.get(n.name), IndexRange) for n in _names(parameter.value)):
+            elif any(isinstance(scope.get(n.name), IndexRange | PerMember) for n in _names(parameter.value)):
                 # `param joint: int = K` differs per family member: check every member's value.
-                values = self.index_values(parameter.value, scope) if type_name in _INTEGER_TYPES else None
-                if values is not None and values:
-                    scope[parameter.name] = IndexRange(min(values), max(values))
+                if type_name in _INTEGER_TYPES:
+                    values = self.index_values(parameter.value, scope)
+                    if values is not None and values:
+                        scope[parameter.name] = IndexRange(min(values), max(values))
+                else:
+                    self._member_values(parameter, type_name, scope)
+                    scope[parameter.name] = PerMember(type_name)
                 continue
             else:
                 try:
@@ -205,6 +217,35 @@ class Resolver:
             if type_name in ("double", "float32", "float64"):
                 value = float(value)
             scope[parameter.name] = value
+
+    def _member_values(self, parameter: Parameter, type_name: str, scope: Scope) -> None:
+        """Each member's value of a parameter computed from family indices fits its type (R005), where
+        it depends on the indices alone; one computed from another such parameter is checked as the
+        family is expanded."""
+        names = {n.name for n in _names(parameter.value)}
+        if any(isinstance(scope.get(name), PerMember) for name in names):
+            return
+        ranged = sorted(name for name in names if isinstance(scope.get(name), IndexRange))
+        ranges = [scope[name].values() for name in ranged]  # type: ignore[union-attr]
+        if _product_size(ranges) > 10_000:
+            return
+        base = _values(scope)
+        for combination in itertools.product(*ranges):
+            members = dict(zip(ranged, combination, strict=True))
+            try:
+                value = evaluate_constant(parameter.value, {**base, **members})
+            except ConstantError as problem:
+                self.error(str(problem), problem.location or parameter.location, "EARL-R004")
+                return
+            wrong = parameter_value_problem(type_name, value)
+            if wrong is not None:
+                where = ", ".join(f"{name} = {index}" for name, index in members.items())
+                self.error(
+                    f"parameter `{parameter.name}` is `{type_name}` but, where {where}, {wrong}",
+                    parameter.value.location or parameter.location,
+                    "EARL-R005",
+                )
+                return
 
     # ------------------------------------------------------------------ data types
     def _types(self, scope: Scope) -> None:
@@ -308,7 +349,7 @@ class Resolver:
 
     # ------------------------------------------------------------------ constants and families
     def constant_integer(self, expression: Expression, scope: Scope, what: str) -> int | None:
-        if any(isinstance(scope.get(n.name), IndexRange) for n in _names(expression)):
+        if any(isinstance(scope.get(n.name), IndexRange | PerMember) for n in _names(expression)):
             return None  # depends on a family index; checked per member where it matters
         try:
             value = evaluate_constant(expression, _values(scope))
@@ -913,7 +954,7 @@ def _names(expression: Expression) -> list[Name]:
 
 
 def _values(scope: Scope) -> dict[str, Value]:
-    return {name: value for name, value in scope.items() if not isinstance(value, IndexRange)}
+    return {name: value for name, value in scope.items() if not isinstance(value, IndexRange | PerMember)}
 
 
 def _product_size(ranges: Sequence[range]) -> int:

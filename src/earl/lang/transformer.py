@@ -384,6 +384,15 @@ class ElementBuilder:
                     code="EARL-S012",
                 )
             )
+        if duration.seconds < 1e-9:  # time is kept in whole nanoseconds: it would round to 0, an instant for ever
+            raise SpecificationSyntaxError(
+                Diagnostic(
+                    Severity.ERROR,
+                    f"a duration is at least 1 ns (earl keeps time in whole nanoseconds), not {children[0]} {children[1]}",
+                    self._loc(children[0]),
+                    code="EARL-S012",
+                )
+            )
         return duration
 
     def input_buffer(self, meta: Meta, children: list[Any]) -> InputBuffer:

@@ -13,9 +13,10 @@ from pathlib import Path
 from typing import Any, Protocol
 
 from earl.diagnostics import Diagnostic, EarlError, Severity
-from earl.model.elements import Agent, Link, LinkEnd, PrimitivePredicate, Subsystem, System
+from earl.model.elements import Agent, Duration, Link, LinkEnd, PrimitivePredicate, Subsystem, System
 from earl.model.expressions import ElementReference, Literal, Read
 from earl.model.kinds import Kind
+from earl.model.location import SourceLocation
 from earl.model.types import DataType
 from earl.runtime.binding import (
     PREDICATE_SIGNATURE,
@@ -111,6 +112,17 @@ def build_network(
                 agent_parameters[agent.family.index] = agent.index
             agent_parameters.update({p.name: _value(p.value) for p in agent.parameters})
             for subsystem in agent.subsystems:
+                wrong = _duration_problem(subsystem)
+                if wrong is not None:  # a model built in Python, where the reader's S012 never looked
+                    problems.append(
+                        Diagnostic(
+                            Severity.ERROR,
+                            f"{subsystem_name(agent, subsystem)} cannot run: {wrong[0]}",
+                            wrong[1] or subsystem.location,
+                            code="EARL-X014",
+                        )
+                    )
+                    continue
                 try:
                     engine = _engine(
                         agent, subsystem, len(network.engines), agent_parameters, types, recorder, environment, seed
@@ -146,6 +158,25 @@ def build_network(
     if problems:
         raise EarlError(problems, system.sources)  # type: ignore[arg-type]
     return network
+
+
+def _duration_problem(subsystem: Subsystem) -> tuple[str, SourceLocation | None] | None:
+    """What is wrong with the subsystem's period or a state's timeout, where time could not advance."""
+    durations = [("period", subsystem.period, subsystem.location)]
+    if subsystem.fsm is not None:
+        durations += [
+            (f"the timeout of state `{state.name}`", state.timeout, state.location) for state in subsystem.fsm.states
+        ]
+    for what, duration, location in durations:
+        if duration is None:
+            continue
+        if duration.unit not in Duration.UNITS:
+            return f"{what} is in `{duration.unit}`; the units are {', '.join(Duration.UNITS)}", location
+        if not isinstance(duration.value, int | float) or isinstance(duration.value, bool):
+            return f"{what} is {duration.value!r}, not a number", location
+        if not 1e-9 <= duration.seconds <= Duration.MAX_SECONDS:
+            return f"{what} is {duration.value:g} {duration.unit}; it must be at least 1 ns and at most 10⁹ s", location
+    return None
 
 
 def _value(expression: Any) -> Any:
