@@ -291,7 +291,7 @@ durations: SearchStrategy[Duration] = st.builds(
         st.floats(min_value=0.0, max_value=1e9, exclude_min=True),
     ),
     st.sampled_from(("s", "ms", "us")),
-)
+).filter(lambda duration: duration.seconds >= 1e-9)  # and those below 1 ns, which would round to 0 ns
 
 
 # ---------------------------------------------------------------------- subsystem body
