@@ -149,3 +149,47 @@ def test_save_writes_canonical_text_that_loads_back(tmp_path: Path) -> None:
     earl.save(system, target)
     assert target.read_text() == CANONICAL
     assert earl.load(target) == system
+
+
+@pytest.mark.parametrize(
+    "body",
+    ["cs { timeout/ib: boolean  period 1 ms }", "cs { state/pp = true  count/m: int = 0 }"],
+)
+def test_fmt_never_writes_a_canonical_text_that_would_not_read_back(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], body: str
+) -> None:
+    """Canonical order moves `period` and memory first; a name that is also a keyword (`timeout/ib`,
+    `state/pp`) reads differently there. The file is left as it is, and the command says why."""
+    spec = tmp_path / "kw.earl"
+    text = f"system k\n\na/a {{\n    {body}\n}}\n"
+    spec.write_text(text)
+    for mode in ([], ["--check"], ["--write"], ["--diff"]):
+        assert main(["fmt", *mode, str(spec)]) == 1
+        err = capsys.readouterr().err
+        assert "cannot be put in canonical form" in err and "rename it" in err and "left as it is" in err
+    assert spec.read_text() == text
+
+
+def test_fmt_diff_marks_a_last_line_without_its_newline(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    spec = tmp_path / "n.earl"
+    spec.write_text("system d\nparam N: int = 1")
+    assert main(["fmt", "--diff", str(spec)]) == 0
+    assert "-param N: int = 1\n\\ No newline at end of file\n" in capsys.readouterr().out
+
+
+def test_fmt_reads_a_pipe_once(tmp_path: Path) -> None:
+    """`earl fmt --check <(cat spec)` reads a pipe, which can be read only once: read twice, the second
+    read found nothing and a canonical file was called not canonical."""
+    import shutil
+    import subprocess
+    import sys
+
+    bash = shutil.which("bash")
+    if bash is None:
+        pytest.skip("no bash here")
+    spec = tmp_path / "tidy.earl"
+    spec.write_text(CANONICAL)
+    command = f"{sys.executable} -m earl.cli.main fmt --check <(cat {spec}) && {sys.executable} -m earl.cli.main fmt <(cat {spec})"
+    result = subprocess.run([bash, "-c", command], capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout == CANONICAL

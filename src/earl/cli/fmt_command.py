@@ -10,7 +10,7 @@ from typing import Any
 from earl.cli.common import UsageError, spec_path, usage_error
 from earl.cli.output import print_diagnostics
 from earl.diagnostics import EarlError
-from earl.lang.loader import parse_file, save
+from earl.lang.loader import parse_file_as_read, parse_source, save
 
 
 def register(commands: Any) -> None:
@@ -38,14 +38,22 @@ def run(arguments: argparse.Namespace) -> int:
     status = 0
     for path in paths:
         try:
-            system = parse_file(path)  # formatting needs the syntax only, so a library file works too
+            # formatting needs the syntax only, so a library file works too
+            system, data = parse_file_as_read(path)
         except EarlError as error:
             print_diagnostics(error.diagnostics, error.sources)
             status = 1
             continue
         # as the bytes are: `\r\n` or `\r` line ends are not canonical (universal newlines would hide them)
-        original = path.read_bytes().decode("utf-8", errors="replace")
+        original = data.decode("utf-8", errors="replace")
         canonical = system.to_earl()
+        problem = _reads_back_differently(system, canonical, str(path))
+        if problem is not None:
+            sys.stderr.write(
+                f"earl fmt: {path}: cannot be put in canonical form: {problem}; the file is left as it is\n"
+            )
+            status = 1
+            continue
         if arguments.check:
             if original != canonical:
                 sys.stderr.write(f"{path}: not canonical (run `earl fmt --write {path}`)\n")
@@ -66,7 +74,28 @@ def run(arguments: argparse.Namespace) -> int:
                 str(path),
                 f"{path} (canonical)",
             )
-            sys.stdout.writelines(diff)
+            for line in diff:
+                # a last line without its newline is marked as `diff` and `patch` expect
+                sys.stdout.write(line if line.endswith("\n") else line + "\n\\ No newline at end of file\n")
         else:
             sys.stdout.write(canonical)
     return status
+
+
+def _reads_back_differently(system: Any, canonical: str, path: str) -> str | None:
+    """Why the canonical text would not read back as the same specification, or None.
+
+    Canonical order moves declarations, and a name that is also a keyword (`timeout/ib`,
+    `state/pp`) can read differently in its new place: such a text is never written."""
+    try:
+        again = parse_source(canonical, path)
+    except EarlError as error:
+        first = error.diagnostics[0]
+        line = f" at line {first.location.line}" if first.location is not None else ""
+        return (
+            f"its canonical text would not read back ({first.message}{line}); a name that is also a keyword "
+            "(`timeout`, `state`, `period`, …) reads differently where canonical order puts it: rename it"
+        )
+    if again != system:
+        return "its canonical text would read back as a different specification"
+    return None

@@ -54,6 +54,11 @@ def _opened(path: Path) -> BinaryIO:
 
 
 def read_file(path: Path, sources: SourceMap, location: SourceLocation | None = None) -> ParsedFile:
+    return _read_file(path, sources, location)[0]
+
+
+def _read_file(path: Path, sources: SourceMap, location: SourceLocation | None = None) -> tuple[ParsedFile, bytes]:
+    """The file parsed, and its bytes as read (once: a named pipe cannot be read twice)."""
     shown = _display_path(path)
     try:
         with _opened(path) as file:
@@ -89,7 +94,7 @@ def read_file(path: Path, sources: SourceMap, location: SourceLocation | None = 
     except EarlError as error:
         error.sources = sources
         raise
-    return parse_text(text, shown, sources)
+    return parse_text(text, shown, sources), data
 
 
 def locate_spec(path: Path) -> Path:
@@ -227,12 +232,24 @@ def set_parameters(system: System, parameters: Mapping[str, ParameterValue]) -> 
 
 def parse_file(path: str | Path) -> System:
     """One file read for its syntax only: no imports followed, no names resolved (what `earl fmt` needs)."""
+    return parse_file_as_read(path)[0]
+
+
+def parse_file_as_read(path: str | Path) -> tuple[System, bytes]:
+    """`parse_file`, and the file's bytes as read: a named pipe or process substitution (`<(cat x)`)
+    can be read only once, and the bytes keep the line ends that a decoded text would not."""
     sources = SourceMap()
-    root = read_file(Path(path), sources)
+    root, data = _read_file(Path(path), sources)
     system = merge(root, [], sources, library=True)
     system.source_file = root.path
     system.sources = sources
-    return system
+    return system, data
+
+
+def parse_source(text: str, path: str) -> System:
+    """A text read for its syntax only, as `parse_file` reads a file."""
+    sources = SourceMap()
+    return merge(parse_text(text, path, sources), [], sources, library=True)
 
 
 def save(system: System, path: str | Path) -> None:
