@@ -5,6 +5,7 @@ from __future__ import annotations
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -246,3 +247,29 @@ def test_spans_cover_what_was_written_parentheses_included() -> None:
     assert inner.location is not None and (inner.location.column, inner.location.end_column) == (21, 34)
     assert q.location is not None and (q.location.column, q.location.end_column) == (9, 22)
     assert q.expression.location is not None and q.expression.location.column == 17  # inside the parentheses
+
+
+def test_check_resolves_a_system_built_or_edited_in_python() -> None:
+    """What the reader would refuse in a file, `earl.check.check` reports for a model built in Python:
+    names that resolve to nothing, a period time could not follow, a priority that is no number."""
+    from pathlib import Path
+
+    from earl.check import check
+    from earl.model.elements import Duration, Predicate, Transition
+    from earl.model.expressions import Literal
+
+    def codes(edit: Any) -> list[str]:
+        system = earl.load(Path(__file__).parent / "runtime_specs" / "counter")
+        cs = system.agent("counter").control_subsystem
+        assert cs is not None and cs.fsm is not None
+        edit(cs)
+        return sorted({d.code or "" for d in check(system) if d.severity.name == "ERROR"})
+
+    assert codes(lambda cs: None) == []
+    assert codes(lambda cs: cs.fsm.transitions.append(Transition("counting", "nowhere", Predicate(Literal(True))))) == [
+        "EARL-R032"
+    ]
+    assert codes(lambda cs: setattr(cs.fsm, "initial", "nope")) == ["EARL-R031"]
+    assert codes(lambda cs: setattr(cs, "period", Duration(-2, "ms"))) == ["EARL-S012"]
+    assert codes(lambda cs: setattr(cs, "period", 0.002)) == ["EARL-S012"]
+    assert codes(lambda cs: setattr(cs.fsm.transitions[0], "priority", "1")) == ["EARL-R033"]

@@ -16,6 +16,7 @@ from earl.check.merging import Said, merge_family_members
 from earl.check.registry import RULES, Finding, Rule
 from earl.collector import paused as collector_paused
 from earl.diagnostics import Diagnostic, Severity, did_you_mean
+from earl.lang.resolver import resolve
 from earl.model.elements import System
 from earl.model.expand import expand
 from earl.model.types import PARAMETER_TYPES, parameter_value_problem
@@ -39,6 +40,11 @@ def check(system: System, parameters: Mapping[str, bool | int | float | str] | N
     if unknown:
         return unknown
     with collector_paused():
+        # A system built or edited in Python never met the reader: its names are resolved here, as
+        # `load` resolves a file's (a transition to a state that does not exist, a duplicate agent …).
+        unresolved = [d for d in resolve(system, parameters or {}) if d.severity is Severity.ERROR]
+        if unresolved:
+            return unresolved
         return check_context(context_for(system, parameters))
 
 

@@ -61,6 +61,7 @@ READING_CODES: dict[str, str] = {
     "EARL-R030": "a state naming an undeclared behaviour",
     "EARL-R031": "an initial state that is not a state",
     "EARL-R032": "a transition naming an undeclared state",
+    "EARL-R033": "a transition priority that is not a whole number, 0 or more (a model built in Python)",
     "EARL-R040": "an unknown function",
     "EARL-R041": "a function called with the wrong number of arguments",
     "EARL-R042": "`newData`/`timeout`/`stale` applied to something other than an Input Buffer",

@@ -23,6 +23,7 @@ from earl.model.elements import (
     Parameter,
     Subsystem,
     System,
+    duration_problem,
 )
 from earl.model.expressions import (
     BUILTIN_FUNCTIONS,
@@ -575,8 +576,17 @@ class Resolver:
             self.expression(behaviour.terminal_condition.expression, table, scope, owner)
             if behaviour.error_condition is not None:
                 self.expression(behaviour.error_condition.expression, table, scope, owner)
+        durations = [("the period", subsystem.period, subsystem.location)]
         if subsystem.fsm is not None:
             self._fsm(subsystem.fsm, table, scope, owner)
+            durations += [
+                (f"the timeout of state `{state.name}`", state.timeout, state.location)
+                for state in subsystem.fsm.states
+            ]
+        for what, duration, location in durations:
+            wrong = None if duration is None else duration_problem(duration)
+            if wrong is not None:  # the reader refuses such a duration; a model built in Python may hold one
+                self.error(f"{what} of `{owner}` {wrong}", location, "EARL-S012")
 
     def _fsm(self, fsm: FSM, table: _SubsystemTable, scope: Scope, owner: str) -> None:
         states: dict[str, Any] = {}
@@ -617,6 +627,15 @@ class Resolver:
                             else f"declare `state {end}: BEHAVIOUR/bb` first"
                         ),
                     )
+            priority = transition.priority
+            if priority is not None and (isinstance(priority, bool) or not isinstance(priority, int) or priority < 0):
+                # only a model built in Python can say this: the grammar reads a whole number
+                self.error(
+                    f"transition `{transition.name}/t` has the priority {priority!r}; a priority is a whole number, "
+                    "0 or more (lower first)",
+                    transition.location,
+                    "EARL-R033",
+                )
             self.expression(transition.condition.expression, table, scope, owner)
         for assumption in fsm.assumptions:
             self.expression(assumption.expression, table, scope, owner)

@@ -47,6 +47,21 @@ class Duration:
         return self.value * self.UNITS[self.unit]
 
 
+def duration_problem(duration: object) -> str | None:
+    """What keeps `duration` from being a period or timeout, in words, or None: a unit other than
+    `s`, `ms`, `us`, no number, or a length under 1 ns (time is kept in whole nanoseconds) or over
+    `Duration.MAX_SECONDS`. The reader refuses these as it reads; a model built in Python is asked."""
+    if not isinstance(duration, Duration):
+        return f'is {duration!r}, not a Duration such as `Duration(2, "ms")`'
+    if duration.unit not in Duration.UNITS:
+        return f"is in `{duration.unit}`; the units are {', '.join(Duration.UNITS)}"
+    if isinstance(duration.value, bool) or not isinstance(duration.value, int | float):
+        return f"is {duration.value!r} {duration.unit}, not a number"
+    if not 1e-9 <= duration.seconds <= Duration.MAX_SECONDS:
+        return f"is {duration.value:g} {duration.unit}; it must be at least 1 ns and at most 10⁹ s"
+    return None
+
+
 @dataclass
 class Parameter:
     """`param N: int = 6`: a named constant, visible in its block and the blocks inside it."""

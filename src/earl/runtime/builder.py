@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import Any, Protocol
 
 from earl.diagnostics import Diagnostic, EarlError, Severity
-from earl.model.elements import Agent, Duration, Link, LinkEnd, PrimitivePredicate, Subsystem, System
+from earl.model.elements import Agent, Link, LinkEnd, PrimitivePredicate, Subsystem, System, duration_problem
 from earl.model.expressions import ElementReference, Literal, Read
 from earl.model.kinds import Kind
 from earl.model.location import SourceLocation
@@ -168,14 +168,9 @@ def _duration_problem(subsystem: Subsystem) -> tuple[str, SourceLocation | None]
             (f"the timeout of state `{state.name}`", state.timeout, state.location) for state in subsystem.fsm.states
         ]
     for what, duration, location in durations:
-        if duration is None:
-            continue
-        if duration.unit not in Duration.UNITS:
-            return f"{what} is in `{duration.unit}`; the units are {', '.join(Duration.UNITS)}", location
-        if not isinstance(duration.value, int | float) or isinstance(duration.value, bool):
-            return f"{what} is {duration.value!r}, not a number", location
-        if not 1e-9 <= duration.seconds <= Duration.MAX_SECONDS:
-            return f"{what} is {duration.value:g} {duration.unit}; it must be at least 1 ns and at most 10⁹ s", location
+        wrong = None if duration is None else duration_problem(duration)
+        if wrong is not None:
+            return f"{what} {wrong}", location
     return None
 
 
