@@ -273,3 +273,16 @@ def test_check_resolves_a_system_built_or_edited_in_python() -> None:
     assert codes(lambda cs: setattr(cs, "period", Duration(-2, "ms"))) == ["EARL-S012"]
     assert codes(lambda cs: setattr(cs, "period", 0.002)) == ["EARL-S012"]
     assert codes(lambda cs: setattr(cs.fsm.transitions[0], "priority", "1")) == ["EARL-R033"]
+
+
+def test_earl_check_is_reached_from_import_earl_alone() -> None:
+    """The docs write `earl.check.check(system)`; a fresh `import earl` must reach it (loaded on first use)."""
+    code = (
+        "import sys, earl\n"
+        "assert 'earl.check' not in sys.modules\n"
+        "print(len(earl.check.check(earl.load(sys.argv[1]))) >= 0)\n"
+    )
+    example = Path(__file__).parent.parent / "examples" / "pick_and_place"
+    result = subprocess.run([sys.executable, "-c", code, str(example)], capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip() == "True"

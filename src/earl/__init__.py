@@ -66,6 +66,18 @@ def simulate(system: System, **options: object) -> Simulation:
 
 __version__ = "0.1.0"
 
+#: the packages `earl.NAME` reaches without an import of its own (`earl.check.check(system)`), loaded
+#: on first use so that `import earl` stays quick
+_SUBPACKAGES = frozenset({"check", "export", "lang", "render", "runtime", "transport"})
+
+
+def __getattr__(name: str) -> object:
+    if name in _SUBPACKAGES:
+        import importlib
+
+        return importlib.import_module(f"earl.{name}")
+    raise AttributeError(f"module 'earl' has no attribute {name!r}")
+
 
 def _display_in_notebooks() -> None:
     """In a Jupyter kernel, model objects display as their diagrams (SVG); elsewhere nothing is loaded."""
