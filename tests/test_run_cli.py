@@ -861,3 +861,21 @@ def test_a_trace_cut_short_is_read_up_to_the_cut(tmp_path: Path) -> None:
     plot = earl_cli("plot", str(cut), "--signal", "counter/a.relay/ve.forward", "-o", str(tmp_path / "p.png"))
     assert plot.returncode == 0, plot.stderr
     assert (tmp_path / "p.png").is_file()
+
+
+def test_trace_and_plot_on_one_file_is_a_usage_error(tmp_path: Path) -> None:
+    same = tmp_path / "same.png"
+    result = earl_cli("run", str(SPECS / "counter"), "--trace", str(same), "--plot", str(same), "--signal", "x")
+    assert result.returncode == 2
+    assert "--trace and --plot both name" in result.stderr and not same.exists()
+
+
+def test_a_report_that_calls_sys_exit_does_not_choose_the_exit_code(tmp_path: Path) -> None:
+    example = tmp_path / "pick_and_place"
+    shutil.copytree(EXAMPLE, example)
+    settings = example / "run.toml"
+    settings.write_text(re.sub(r'report = "[^"]*"', 'report = "closing:summary"', settings.read_text()))
+    (example / "closing.py").write_text("import sys\n\n\ndef summary(simulation):\n    sys.exit(5)\n")
+    result = earl_cli("run", str(example), "--duration", "20ms", "--no-progress")
+    assert result.returncode == 0, result.stderr
+    assert "the report `closing:summary` called sys.exit(5)" in result.stdout + result.stderr

@@ -397,6 +397,7 @@ def test_the_command_refuses_an_invalid_spec(tmp_path: Path, capsys: pytest.Capt
         (["export", "sysml", str(SMALL), "-o", "/nonexistent/dir/x.sysml"], "no such directory"),
         (["export", "sysml", str(SMALL), "--param", "N"], "NAME=VALUE"),
         (["export", "uml", str(SMALL)], "invalid choice"),
+        (["export", "sysml", str(SMALL), "-o", "/tmp/EARL.sysml"], "is where the library EARL.sysml goes"),
     ],
 )
 def test_the_command_reports_usage_errors(

@@ -380,3 +380,25 @@ def test_a_null_leaf_of_a_trace_is_a_gap_in_a_plot_not_a_missing_signal() -> Non
     leaves = list(iter_leaves({"position": [1.0, None], "stop": False}))
     assert [name for name, _ in leaves] == ["position[0]", "position[1]", "stop"]
     assert leaves[0][1] == 1.0 and math.isnan(leaves[1][1]) and leaves[2][1] is False
+
+
+def test_an_output_buffer_read_as_an_attribute_before_it_is_written_is_told_to_keep_a_variable(
+    tmp_path: Path,
+) -> None:
+    """`outputs.level` read before it is written: for an output buffer, `outputs["level"]` would be a
+    fault too, so the advice is a variable, not that."""
+    (tmp_path / "system.earl").write_text(SHARED_NAMES_SPEC)
+    (tmp_path / "sharing.py").write_text(
+        SHARED_NAMES_CODE.replace("    outputs.level = inputs.level\n", "    outputs.level = outputs.level or 1.0\n")
+    )
+    sim = earl.simulate(earl.load(tmp_path / "system.earl"), check=False)
+    try:
+        sim.advance_to(0.0005)
+        fault = next(f for f in sim.faults if f.subsystem == "twin/a.echo/ve")
+        assert "read `outputs.level` before writing it; an output buffer holds nothing" in fault.message
+        assert 'outputs["level"]' not in fault.message
+    finally:
+        sim.close()
+        import sys
+
+        sys.modules.pop("sharing", None)

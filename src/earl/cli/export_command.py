@@ -68,6 +68,11 @@ def run(arguments: argparse.Namespace) -> int:
     if output is None:
         sys.stdout.write(text)
         return 0
+    if not arguments.no_library and (output.parent / LIBRARY_FILE).resolve() == output.resolve():
+        return usage_error(
+            f"-o {output} is where the library {LIBRARY_FILE} goes, beside the export: name the export otherwise "
+            f"(e.g. -o {output.parent / (system.name + '.sysml')}), or leave the library out with --no-library"
+        )
     try:
         refuse_to_overwrite_inputs(output, system.sources)
         if not arguments.no_library:
@@ -80,9 +85,8 @@ def run(arguments: argparse.Namespace) -> int:
         # written, neither is the model, and nothing is left half done
         if not arguments.no_library:
             library = output.parent / LIBRARY_FILE
-            if library.resolve() != output.resolve():
-                library.write_text(library_text(), encoding="utf-8")
-                written.append(library)
+            library.write_text(library_text(), encoding="utf-8")
+            written.append(library)
         output.write_text(text, encoding="utf-8")
         written.insert(0, output)
     except OSError as error:

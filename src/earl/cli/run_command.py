@@ -28,7 +28,7 @@ EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 
 EPILOG = """\
 examples:
-  earl run examples/pick_and_place                        the manual's example, 10 s simulated
+  earl run examples/pick_and_place                        the manual's example, 13 s simulated (run.toml)
   earl run examples/pick_and_place --param N=3 --trace run.mcap --record-memory manip/a.cs
   earl run spec.earl --duration 30s --seed 7              another seed, another random stream
   earl run spec.earl --realtime --duration 5s             paced by the wall clock, jitter reported
@@ -174,6 +174,8 @@ def _run(arguments: argparse.Namespace) -> int:
     arguments.signal = signals
     if arguments.plot and not arguments.trace:
         arguments.trace = str(Path(arguments.plot).with_suffix(".mcap"))
+    if arguments.plot and Path(arguments.plot).resolve() == Path(arguments.trace).resolve():
+        return usage_error(f"--trace and --plot both name {arguments.plot}: the plot would replace the trace")
     environment = arguments.environment or settings.environment
     if environment == "none":
         environment = None
@@ -556,6 +558,9 @@ def _report(simulation: Any, report: str, path: Path, console: Console) -> None:
             return
         except Exception as error:  # the report is the example's code: say what failed, keep the exit code
             console.print(f"earl run: the report `{report}` failed: {type(error).__name__}: {error}")
+            return
+        except SystemExit as leaving:  # sys.exit in the report must not choose earl's exit code
+            console.print(f"earl run: the report `{report}` called sys.exit({leaving.code!r}); its text is lost")
             return
     if text:
         print(text)

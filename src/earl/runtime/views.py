@@ -448,11 +448,17 @@ def explain(error: BaseException) -> BaseException:
             if isinstance(view, Inputs):
                 return view._earl_undeclared(name)
             if isinstance(view, Outputs):
-                if view._earl_targets.get(name) is not None:
+                target = view._earl_targets.get(name)
+                if target is not None:
+                    # memory can be read back before it is written (its value before the stage); an
+                    # output buffer holds nothing until the call writes it
+                    advice = (
+                        f'`outputs["{name}"]` reads what it holds (memory\'s value before the stage)'
+                        if target.is_memory
+                        else "an output buffer holds nothing until the call writes it: keep the value in a variable"
+                    )
                     return UndeclaredAccess(
-                        f"`{view._earl_function}` read `outputs.{name}` before writing it; "
-                        f'`outputs["{name}"]` reads what it holds (memory\'s value before the stage)',
-                        write=False,
+                        f"`{view._earl_function}` read `outputs.{name}` before writing it; {advice}", write=False
                     )
                 try:
                     view._earl_refuse(name, write=False)
