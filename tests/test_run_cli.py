@@ -798,9 +798,10 @@ def test_a_stop_while_waiting_for_the_next_instant_is_made_at_once(tmp_path: Pat
     assert "interrupted at " in stderr and "trace is closed" not in stderr
 
 
-def test_a_plot_that_cannot_be_drawn_makes_the_run_exit_1(tmp_path: Path) -> None:
+def test_a_plot_records_the_links_of_the_output_buffers_it_draws(tmp_path: Path) -> None:
+    """`forward` is an output buffer: its values are the messages on its link, which the plot records
+    even when --record-links would leave it out."""
     png = tmp_path / "p.png"
-    # `forward` is an output buffer, but the link that carries its values is not recorded
     result = earl_cli(
         "run",
         str(SPECS / "counter"),
@@ -812,6 +813,24 @@ def test_a_plot_that_cannot_be_drawn_makes_the_run_exit_1(tmp_path: Path) -> Non
         "counter/a.relay/ve.forward",
         "--record-links",
         "nothing",
+    )
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert png.is_file()
+
+
+def test_a_plot_that_cannot_be_drawn_makes_the_run_exit_1(tmp_path: Path) -> None:
+    png = tmp_path / "p.png"
+    # the only signal is an optional field the task agent first sends after 8 s
+    result = earl_cli(
+        "run",
+        str(EXAMPLE),
+        "--duration",
+        "1s",
+        "--no-progress",
+        "--plot",
+        str(png),
+        "--signal",
+        "task/a.cs.manipulatorCommand.jointPosSetpoint[*]",
     )
     assert result.returncode == 1, result.stderr
     assert "no plot" in result.stdout + result.stderr and not png.exists()

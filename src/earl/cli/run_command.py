@@ -198,6 +198,7 @@ def _run(arguments: argparse.Namespace) -> int:
         wanted = {a if a.endswith("/a") else f"{a}/a" for a in agents}
         record_memory = [m for m in record_memory if m.split(".", 1)[0] in wanted]
     transport: Any = None
+    plotted_outputs: list[str] = []
     try:
         system = load(path, parameters)
         if arguments.transport == "zenoh":
@@ -217,10 +218,12 @@ def _run(arguments: argparse.Namespace) -> int:
         if arguments.plot:
             # what the plot draws is recorded, and a signal the system does not have is said now
             from earl.model.expand import expand
-            from earl.runtime.plot import memory_to_record
+            from earl.runtime.plot import memory_to_record, outputs_to_record
 
             try:
-                plotted = memory_to_record(expand(system, parameters), list(signals or []))
+                expanded = expand(system, parameters)
+                plotted = memory_to_record(expanded, list(signals or []))
+                plotted_outputs = outputs_to_record(expanded, list(signals or []))
             except ValueError as error:
                 _close(transport)
                 return usage_error(f"--signal {error}")
@@ -235,6 +238,7 @@ def _run(arguments: argparse.Namespace) -> int:
             trace=arguments.trace,
             record_memory=record_memory,
             record_links=arguments.record_links if arguments.record_links is not None else settings.record_links,
+            record_outputs=plotted_outputs,
             realtime=arguments.realtime,
             agents=agents,
             transport=transport,

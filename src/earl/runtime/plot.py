@@ -64,6 +64,22 @@ def memory_to_record(expanded: System, signals: list[str]) -> list[str]:
     return sorted(set(record))
 
 
+def outputs_to_record(expanded: System, signals: list[str]) -> list[str]:
+    """The output buffers (`manip/a.cs.manipulatorState`) `signals` name, whose links a run that plots
+    them must record (`Simulation(record_outputs=…)`); signals are checked by `memory_to_record`."""
+    subsystems = {subsystem_name(a, s): s for a in expanded.agents for s in a.subsystems}
+    longest_first = sorted(subsystems, key=len, reverse=True)
+    found: set[str] = set()
+    for signal in signals:
+        owner = next((name for name in longest_first if signal.startswith(name + ".")), None)
+        if owner is None:
+            continue
+        element = signal_element(signal[len(owner) + 1 :])
+        if element in {o.name for o in subsystems[owner].output_buffers}:
+            found.add(f"{owner}.{element}")
+    return sorted(found)
+
+
 _STEP = re.compile(r"\[(\*|\d+)\]|\.([A-Za-z_]\w*)")
 
 

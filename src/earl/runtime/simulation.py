@@ -83,6 +83,7 @@ class Simulation:
         trace: str | Path | None = None,
         record_memory: list[str] | None = None,
         record_links: list[str] | None = None,
+        record_outputs: list[str] | None = None,
         realtime: bool = False,
         check: bool = True,
         agents: list[str] | None = None,
@@ -144,6 +145,12 @@ class Simulation:
                 record_links,
                 self.network.link_sources,
             )
+            # the links leaving these output buffers (`manip/a.cs.manipulatorState`), whatever record_links
+            # says: what `earl run --plot` draws of an output buffer is the messages on its links
+            wanted = set(record_outputs or [])
+            self.trace.links_also_recorded = {
+                link for link, source in self.network.link_sources.items() if source in wanted
+            }
             self.recorder.add(self.trace)
             self.trace.run_started(
                 {"system": system.name, "seed": seed, "parameters": parameters, "realtime": realtime}

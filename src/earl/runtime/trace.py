@@ -248,6 +248,8 @@ class TraceWriter(Recorder):
         self.memory_types = memory_types
         self.link_patterns = links
         self.link_sources = link_sources or {}
+        #: links recorded whatever the patterns say: those leaving an output buffer a plot draws
+        self.links_also_recorded: set[str] = set()
         #: topic -> channel number; None for a link that is not recorded
         self._channels: dict[str, int | None] = {}
         #: link -> channel number or None, the same as `_channels` without making the topic's name
@@ -316,7 +318,11 @@ class TraceWriter(Recorder):
         return self._sink.writer_of(register)
 
     def _recorded(self, link: str) -> bool:
-        return self.link_patterns is None or any(fnmatchcase(link, p) for p in self.link_patterns)
+        return (
+            self.link_patterns is None
+            or link in self.links_also_recorded
+            or any(fnmatchcase(link, p) for p in self.link_patterns)
+        )
 
     def _link(self, link: str) -> int | None:
         channel = self._links.get(link, -1)
