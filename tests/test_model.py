@@ -286,3 +286,12 @@ def test_earl_check_is_reached_from_import_earl_alone() -> None:
     result = subprocess.run([sys.executable, "-c", code, str(example)], capture_output=True, text=True, timeout=120)
     assert result.returncode == 0, result.stderr
     assert result.stdout.strip() == "True"
+
+
+def test_an_override_of_an_imported_parameter_is_not_printed_as_if_it_held() -> None:
+    """`to_earl()` prints the root file; an override of a parameter of an imported file would be lost
+    on reading the text back, so it is refused; an override of the root file's own parameter prints."""
+    examples = Path(__file__).parent.parent / "examples"
+    with pytest.raises(ValueError, match="`SECTORS`, given a value from outside, is declared in .*types.earl"):
+        earl.load(examples / "mobile_robot", {"SECTORS": 16}).to_earl()
+    assert "param N: int = 3" in earl.load(examples / "pick_and_place", {"N": 3}).to_earl()

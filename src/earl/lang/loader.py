@@ -228,6 +228,7 @@ def set_parameters(system: System, parameters: Mapping[str, ParameterValue]) -> 
             if getattr(parameter.data_type, "name", "") in REAL_TYPES and type(value) is int:
                 value = float(value)  # `N = 3` for a double: the value the runtime would compute
             parameter.value = Literal(value, parameter.value.location)
+            system.overridden.add(parameter.name)
 
 
 def parse_file(path: str | Path) -> System:

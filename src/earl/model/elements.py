@@ -521,6 +521,8 @@ class System:
     source_file: str | None = field(default=None, compare=False, repr=False)
     #: The text of every file read (a `SourceMap`), for quoting lines in diagnostics.
     sources: object | None = field(default=None, compare=False, repr=False)
+    #: The parameters given values from outside the text (`load(path, {"N": 3})`), by name.
+    overridden: set[str] = field(default_factory=set, compare=False, repr=False)
 
     def agent(self, name: str) -> Agent | None:
         return next((a for a in self.agents if a.name == name), None)
