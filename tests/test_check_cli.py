@@ -525,3 +525,17 @@ def test_a_refused_family_range_is_not_followed_by_index_errors_against_it(tmp_p
     with pytest.raises(earl.EarlError) as refused:
         earl.load(spec)
     assert [d.code for d in refused.value.diagnostics] == ["EARL-R016"]  # no R027 against the empty range
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="no /dev/full here")
+def test_an_output_with_no_room_left_is_one_line_not_a_traceback() -> None:
+    with open("/dev/full", "w") as full:
+        result = subprocess.run(
+            [sys.executable, "-m", "earl.cli.main", "check", str(EXAMPLE)],
+            stdout=full,
+            stderr=subprocess.PIPE,
+            text=True,
+            timeout=120,
+        )
+    assert result.returncode == 1
+    assert result.stderr == "earl: cannot write the output: No space left on device\n"

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import errno
 import gc
 import importlib
 import sys
@@ -115,12 +116,30 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 130
     except BrokenPipeError:
         # The reader went away (`earl check … | head`): not an error of ours.
-        import os
+        _stdout_to_devnull()
+        return EXIT_OK
+    except OSError as error:
+        if error.errno not in _OUTPUT_FULL:
+            raise
+        # the output cannot be written (`> /dev/full`, a full disk): one line, not a traceback
+        _stdout_to_devnull()
+        with contextlib.suppress(OSError):
+            sys.stderr.write(f"earl: cannot write the output: {error.strerror}\n")
+        return 1
+    return result
 
+
+#: errors of a write to an output that has no room left
+_OUTPUT_FULL = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EIO})
+
+
+def _stdout_to_devnull() -> None:
+    """Whatever is still buffered for standard output goes nowhere, so that the exit does not fail again."""
+    import os
+
+    with contextlib.suppress(OSError, ValueError):
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
-        return EXIT_OK
-    return result
 
 
 #: True in the `earl` program, a process that ends with its command (not when a test calls `main`)
