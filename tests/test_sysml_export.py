@@ -431,3 +431,19 @@ def test_export_writes_no_model_when_the_library_cannot_be_written(
     assert main(["export", "sysml", str(SMALL), "-o", str(tmp_path / "small.sysml")]) == 2
     assert "cannot write" in capsys.readouterr().err
     assert not (tmp_path / "small.sysml").exists()  # a model naming EARL::… without the library is no use
+
+
+def test_a_name_renamed_for_a_library_feature_gets_no_short_name_that_would_hide_it(tmp_path: Path) -> None:
+    """`param agents` is renamed `agents_2`; a short name `<'agents'>` would be found, by name
+    resolution, where the library's `agents` is meant. A system `EARL` does not take the library's
+    package name."""
+    from earl.export.sysml import export_sysml
+
+    text = SMALL.read_text(encoding="utf-8")
+    system_line = next(line for line in text.splitlines() if line.startswith("system "))
+    spec = tmp_path / "names.earl"
+    spec.write_text(text.replace(system_line, "system EARL\n\nparam agents: int = 1", 1), encoding="utf-8")
+    exported = export_sysml(earl.load(spec))
+    assert "attribute agents_2 : EARL::int = 1;" in exported
+    assert "<'agents'>" not in exported
+    assert "package EARL_system {" in exported

@@ -188,8 +188,13 @@ class _Writer:
         )
 
     def named(self, namespace: Namespace, earl_name: str, preferred: str | None = None) -> _Named:
-        """A readable, unique name, with the EARL name as short name when the two differ."""
+        """A readable, unique name, with the EARL name as short name when the two differ, unless that
+        short name is itself a name of the namespace: SysML resolves short names too, and an owned
+        `<'agents'>` would be found where the library's inherited `agents` is meant."""
+        clashes = namespace.taken(earl_name)
         name = namespace.claim(preferred or readable(earl_name))
+        if clashes and name != earl_name:
+            return _Named(name, name_text(name))
         if name == earl_name:
             return _Named(name, name_text(name))
         return _Named(name, f"<{quoted(earl_name)}> {name_text(name)}")
@@ -200,7 +205,8 @@ class _Writer:
         origin = f" from {source}" if source else ""
         self.emit(f"// SysML v2 text written by earl {__version__} (`earl export sysml`){origin}.")
         self.emit(f"// It needs {LIBRARY_FILE}, the EARL library shipped with earl: export it beside this file.")
-        package = self.system.name
+        # the library is `package EARL`: a system of that name is exported as `EARL_system`
+        package = self.system.name if self.system.name != "EARL" else "EARL_system"
         with self.block(f"package {name_text(package)}"):
             settings = ", ".join(f"{p.name} = {literal(_parameter_value(p))}" for p in self.system.parameters)
             self.doc(

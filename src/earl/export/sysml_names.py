@@ -229,6 +229,10 @@ class Namespace:
     def __init__(self, reserved: tuple[str, ...] = ()) -> None:
         self._taken: set[str] = set(reserved)
 
+    def taken(self, name: str) -> bool:
+        """Whether `name` is given already here, or inherited from the library."""
+        return name in self._taken
+
     def claim(self, preferred: str) -> str:
         name = preferred
         counter = 2
