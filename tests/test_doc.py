@@ -563,3 +563,14 @@ def test_the_agents_table_puts_each_member_in_the_robot_that_lists_it(tmp_path: 
         "| [`worker[2]/a`](#agent-worker-2-a)": "`fleetRobot/r`",
         "| [`worker[3]/a`](#agent-worker-3-a)": "—",
     }
+
+
+def test_a_finding_about_a_robot_links_to_where_the_robots_are_named(tmp_path: Path) -> None:
+    spec = tmp_path / "robot.earl"
+    spec.write_text(
+        EXAMPLE.read_text(encoding="utf-8").replace("    grip/a\n    link task,manip", "    link task,manip")
+    )
+    site = tmp_path / "site"
+    assert main(["doc", str(spec), "-o", str(site)]) == 1  # the document is written; the errors fail the command
+    rows = [line for line in (site / "index.md").read_text(encoding="utf-8").splitlines() if "`EARL-E004`" in line]
+    assert rows and all("[`manipulationRobot/r`](#system)" in row for row in rows)

@@ -159,6 +159,17 @@ class DocumentBuilder:
         return Document(f"{system.name}: an EARL specification", subtitle, sections)
 
     def _owners(self, system: System) -> None:
+        """The elements a finding can link to, by the lines they span: the smallest one that holds the
+        finding's line is its owner (an agent's subsystem before the agent)."""
+        for definition in system.types:  # each has a row of the data types table
+            if definition.location is not None:
+                self.owners.append((definition.location, slug("type", definition.name), definition.name))
+        for link in inter_agent_links(system):  # each has a row of the links table
+            if link.link.location is not None:
+                self.owners.append((link.link.location, slug("aa", link.link.name_text), link.link.name_text))
+        for robot in system.robots:  # robots are named in the overview of the system
+            if robot.location is not None:
+                self.owners.append((robot.location, "system", f"{robot.name}/r"))
         for agent in system.agents:
             if agent.location is not None:
                 self.owners.append((agent.location, slug("agent", agent_name(agent)), agent_name(agent)))
