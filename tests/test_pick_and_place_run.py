@@ -113,3 +113,23 @@ def test_two_runs_with_the_same_seed_write_identical_traces(tmp_path: Path) -> N
         traces.append(path.read_bytes())
     assert len(traces[0]) > 10_000
     assert traces[0] == traces[1]
+
+
+def test_an_opengl_backend_mujoco_cannot_load_stops_only_the_pictures(tmp_path: Path) -> None:
+    """`MUJOCO_GL` naming a backend MuJoCo cannot load failed `import mujoco` itself, and with it the run."""
+    import os
+    import subprocess
+    import sys
+
+    picture = tmp_path / "end.png"
+    result = subprocess.run(
+        [sys.executable, "-m", "earl.cli.main", "run", str(EXAMPLE), "--duration", "0.3s", "--no-progress"],
+        env={**os.environ, "MUJOCO_GL": "nothing", "EARL_SIM_OUTPUT": str(picture)},
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert result.returncode == 0, result.stderr
+    said = " ".join((result.stdout + result.stderr).split())
+    assert "MuJoCo could not load the OpenGL backend MUJOCO_GL=nothing" in said
+    assert "pick-and-place: placed=" in said

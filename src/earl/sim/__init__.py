@@ -40,12 +40,29 @@ if "MUJOCO_GL" not in os.environ and not os.environ.get("DISPLAY") and not MUJOC
     if _knows_gl_context():
         os.environ["MUJOCO_GL"] = "disable"
         try:
-            import mujoco  # noqa: F401
+            import mujoco
         finally:
             del os.environ["MUJOCO_GL"]
         _deferred_backend = "egl"
     else:
         os.environ["MUJOCO_GL"] = "egl"
+
+#: the backend `MUJOCO_GL` named that MuJoCo could not load, and why (None: no such failure). Physics
+#: needs no OpenGL: MuJoCo is then imported with rendering off, and only pictures are refused.
+UNUSABLE_BACKEND: tuple[str, str] | None = None
+if "MUJOCO_GL" in os.environ and "mujoco" not in sys.modules:
+    try:
+        import mujoco
+    except Exception as error:  # PyOpenGL raises AttributeError, ImportError … for a missing library
+        requested = os.environ["MUJOCO_GL"]
+        UNUSABLE_BACKEND = (requested, f"{type(error).__name__}: {error}")
+        for name in [name for name in sys.modules if name == "mujoco" or name.startswith(("mujoco.", "OpenGL"))]:
+            del sys.modules[name]
+        os.environ["MUJOCO_GL"] = "disable"
+        try:
+            import mujoco  # noqa: F401
+        finally:
+            os.environ["MUJOCO_GL"] = requested
 
 
 def use_offscreen_backend() -> None:

@@ -37,6 +37,12 @@ def _advice() -> str:
     import earl.sim
 
     backend = os.environ.get("MUJOCO_GL", "(unset)")
+    if earl.sim.UNUSABLE_BACKEND is not None:
+        requested, why = earl.sim.UNUSABLE_BACKEND
+        return (
+            f"MuJoCo could not load the OpenGL backend MUJOCO_GL={requested} ({why}): the physics runs without it; "
+            "for pictures install its libraries (Debian: libegl1 libgl1 for egl, libosmesa6 for osmesa) or unset MUJOCO_GL"
+        )
     if earl.sim.MUJOCO_IMPORTED_FIRST and backend == "(unset)":
         return (
             "MuJoCo cannot render offscreen here: it was imported before earl.sim and chose a windowed "
@@ -54,6 +60,10 @@ class PlantCamera:
     def __init__(
         self, plant: MujocoPlant, width: int = 640, height: int = 480, camera: str | None = None, shadows: bool = True
     ) -> None:
+        import earl.sim
+
+        if earl.sim.UNUSABLE_BACKEND is not None:
+            raise RenderUnavailable(_advice())
         use_offscreen_backend()
         model = plant.model
         # MuJoCo's offscreen buffer must hold the image; grow it rather than fail.
