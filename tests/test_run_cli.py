@@ -575,6 +575,7 @@ def test_a_run_killed_with_sigkill_still_leaves_a_readable_trace(tmp_path: Path)
     """The trace's own process finishes the file when the run's process disappears."""
     trace = tmp_path / "run.mcap"
     process = realtime_run_under_way(trace)
+    time.sleep(1.5)
     process.kill()
     process.communicate(timeout=30)
     summary = earl_cli("trace", "summary", str(trace))
@@ -586,6 +587,10 @@ def test_a_run_killed_with_sigkill_still_leaves_a_readable_trace(tmp_path: Path)
     assert "counter/a.cs" in summary.stdout
     # the counts are written at the end, which never came: unknown, not 0
     assert "without the run's end (the run was killed)" in summary.stdout
+    # killed 2.5 s after the trace appeared: the batches sent every 0.2 s reached the writer (unflushed,
+    # they waited in this process's 8 KiB pipe buffer and died with it: the trace ended near 0.56 s)
+    ended = re.search(r"the trace ends at ([0-9.]+) s", " ".join(summary.stdout.split()))
+    assert ended is not None and float(ended.group(1)) >= 1.2, summary.stdout
 
 
 @pytest.mark.skipif(not Path("/dev/full").exists(), reason="no /dev/full here")

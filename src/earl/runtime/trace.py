@@ -534,6 +534,8 @@ class BackgroundSink:
         try:
             stdin.write(_LENGTH.pack(len(data)))
             stdin.write(data)
+            # now, not when Python's 8 KiB buffer fills: what is still in this process dies with it (SIGKILL)
+            stdin.flush()
         except (BrokenPipeError, OSError):
             del data
             self._fail()
