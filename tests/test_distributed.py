@@ -546,3 +546,28 @@ def test_pick_and_place_split_over_two_processes_survives_a_killed_task_agent_an
     for joint in range(3):
         positions = [q[joint] for q in holding]
         assert max(positions) - min(positions) < 2e-3, f"joint {joint + 1} moved while task/a was gone"
+
+
+def test_with_a_zenoh_config_the_environment_runs_only_with_every_agent_acting_on_it(tmp_path: Path) -> None:
+    """No deployment file says where run.toml's environment lives: the task agent's process runs no
+    world of its own (it printed a pick-and-place report of a world without an arm), and a process with
+    only some of the acting agents is refused before Zenoh starts."""
+    (port,) = free_ports(1)
+    config = tmp_path / "zenoh.json5"
+    config.write_text(
+        '{mode: "peer", scouting: {multicast: {enabled: false}}, '
+        f'listen: {{endpoints: ["tcp/127.0.0.1:{port}"]}}, connect: {{endpoints: []}}}}'
+    )
+    command = [sys.executable, "-m", "earl.cli.main", "run", str(PICK_AND_PLACE), "--transport", "zenoh"]
+    common = ["--zenoh-config", str(config), "--no-progress"]
+    alone = subprocess.run([*command, "--agents", "manip", *common], capture_output=True, text=True, timeout=120)
+    assert alone.returncode == 2, alone.stdout + alone.stderr
+    assert "this process runs manip/a alone" in " ".join(alone.stderr.split())
+    task = subprocess.run(
+        [*command, "--agents", "task", *common, "--wait-for-peers", "0.2s", "--duration", "0.2s"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert task.returncode == 0, task.stdout + task.stderr
+    assert "pick-and-place:" not in task.stdout + task.stderr

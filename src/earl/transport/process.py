@@ -50,7 +50,7 @@ def open_transport(
     run.toml or --environment names, if any) runs here; `ValueError` for bad options.
 
     The deployment file says where the environment lives (`Deployment.place_environment`); with
-    the user's own --zenoh-config there is none, and the environment runs wherever it is named."""
+    the user's own --zenoh-config it lives in the process that runs every agent acting on it."""
     expanded = expand(system, dict(parameters))
     known = [agent_name(agent) for agent in expanded.agents]
     environment_here = environment is not None
@@ -65,6 +65,18 @@ def open_transport(
         except TransportError as error:
             raise ValueError(str(error)) from None
         where = f"the Zenoh configuration {arguments.zenoh_config}"
+        if environment is not None:
+            # No deployment file says where run.toml's environment lives: it lives with the agents that act
+            # on it, and only where all of them run (each process would simulate a world of its own).
+            acting = acting_agents(expanded)
+            here = [agent for agent in acting if agent in names]
+            if here and len(here) != len(acting):
+                raise ValueError(
+                    f"the environment run.toml names serves {', '.join(acting)}, which act on it; this process "
+                    f"runs {', '.join(here)} alone, and another would need it too (two worlds): run them all in one "
+                    "process, or say where it runs with a deployment file (docs/distributed.md)"
+                )
+            environment_here = bool(here)
     else:
         path = Path(arguments.deployment) if arguments.deployment else spec.parent / DEPLOYMENT_FILE
         if not arguments.deployment and not path.is_file():
