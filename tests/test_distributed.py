@@ -8,6 +8,7 @@ a minute; the others a few seconds each.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import shutil
@@ -571,3 +572,52 @@ def test_with_a_zenoh_config_the_environment_runs_only_with_every_agent_acting_o
     )
     assert task.returncode == 0, task.stdout + task.stderr
     assert "pick-and-place:" not in task.stdout + task.stderr
+
+
+def _ended(pid: int, seconds: float) -> bool:
+    """The process is gone, or a zombie nobody reaps yet (its parent, the supervisor, was killed)."""
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        try:
+            state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+        except (FileNotFoundError, ProcessLookupError, IndexError):
+            return True
+        if state in ("Z", "X"):
+            return True
+        time.sleep(0.1)
+    return False
+
+
+def test_processes_of_a_launch_killed_with_sigkill_stop_themselves(tmp_path: Path, processes: list[Process]) -> None:
+    """SIGKILL cannot be caught: the supervisor cannot stop its children. Each notices it is orphaned and
+    stops itself as on SIGTERM, instead of running on unsupervised, holding its ports."""
+    deploy = deployment(tmp_path, [(["sender/a"], False), (["receiver/a"], False)])
+    launch = Process(
+        tmp_path / "launch.log", [str(PINGPONG), "--deployment", str(deploy), "--duration", "60s"], "launch"
+    )
+    processes.append(launch)
+    launch.wait_for("[receiver/a] earl run: peers sender/a are alive; starting", 60)
+    launch.wait_for("[sender/a  ] earl run: peers receiver/a are alive; starting", 60)
+    pids = _started_pids(launch.output)
+    assert len(pids) == 2
+    launch.child.kill()
+    launch.child.wait(timeout=10)
+    try:
+        assert all(_ended(pid, 15) for pid in pids), launch.output
+    finally:
+        for pid in pids:
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(pid, signal.SIGKILL)
+
+
+def test_launch_says_a_process_failed_as_soon_as_it_ends(tmp_path: Path, processes: list[Process]) -> None:
+    """The sender's code does not compile: it fails at once, while the receiver waits up to 30 s for it.
+    The failure is said then, not when the receiver is done."""
+    spec = tmp_path / "pingpong"
+    shutil.copytree(PINGPONG, spec)
+    (spec / "pingpong" / "sender.py").write_text("def broken(:\n")
+    deploy = deployment(tmp_path, [(["sender/a"], False), (["receiver/a"], False)])
+    launch = Process(tmp_path / "launch.log", [str(spec), "--deployment", str(deploy), "--duration", "3s"], "launch")
+    processes.append(launch)
+    launch.wait_for("] failed with exit code 1", 25)
+    assert launch.child.poll() is None, launch.output  # the receiver is still waiting for its peer

@@ -91,3 +91,28 @@ def refuse_to_overwrite_inputs(output: Path, sources: object) -> None:
         return
     if target in read:
         raise UsageError(f"cannot write {output}: it is a file of the specification itself; choose another name")
+
+
+#: set by `earl launch` for each child: the supervisor's pid, which the child watches (`watch_supervisor`)
+SUPERVISOR_VARIABLE = "EARL_LAUNCH_SUPERVISOR"
+
+
+def watch_supervisor() -> None:
+    """In a process `earl launch` started: should the supervisor die without stopping it (SIGKILL, which
+    it cannot catch), the process is re-parented; it then stops itself as on SIGTERM (in order, its trace
+    finished) instead of running on unsupervised, holding its ports."""
+    import os
+    import signal
+    import threading
+    import time
+
+    supervisor = os.environ.get(SUPERVISOR_VARIABLE, "")
+    if not supervisor.isdigit() or os.getppid() != int(supervisor):
+        return  # not started by a supervisor that is still there (a test, a user's own script)
+
+    def watch() -> None:
+        while os.getppid() == int(supervisor):
+            time.sleep(0.5)
+        os.kill(os.getpid(), signal.SIGTERM)
+
+    threading.Thread(target=watch, name="earl-supervisor-watch", daemon=True).start()

@@ -23,7 +23,7 @@ import time
 from pathlib import Path
 from typing import IO, Any
 
-from earl.cli.common import UsageError, spec_path, usage_error
+from earl.cli.common import SUPERVISOR_VARIABLE, UsageError, spec_path, usage_error
 from earl.cli.output import print_diagnostics
 from earl.cli.run_command import handling_stop_signals
 from earl.diagnostics import EarlError
@@ -158,6 +158,9 @@ class _Supervisor:
     def __init__(self, labels: list[str]) -> None:
         self.children: list[tuple[str, subprocess.Popen[bytes]]] = []
         self.copiers: list[threading.Thread] = []
+        self.copier_of: dict[int, threading.Thread] = {}
+        #: children whose failure was said as it happened
+        self.reported: set[int] = set()
         self.lock = threading.Lock()
         self.width = max((len(label) for label in labels), default=0)
         self.signals = 0
@@ -184,13 +187,15 @@ class _Supervisor:
             stdin=subprocess.DEVNULL,
             # a session of its own: Ctrl-C reaches the supervisor, which stops the children in order
             start_new_session=True,
-            env={**os.environ, "PYTHONUNBUFFERED": "1", "COLUMNS": str(columns)},
+            # the child stops itself (as on SIGTERM) should this supervisor die without stopping it (SIGKILL)
+            env={**os.environ, "PYTHONUNBUFFERED": "1", "COLUMNS": str(columns), SUPERVISOR_VARIABLE: str(os.getpid())},
         )
         self.children.append((label, child))
         assert child.stdout is not None
         copier = threading.Thread(target=self._copy, args=(label, child.stdout), daemon=True)
         copier.start()
         self.copiers.append(copier)
+        self.copier_of[child.pid] = copier
         self.say(label, f"started (pid {child.pid}): earl {' '.join(command[3:])}")
 
     def _copy(self, label: str, stream: IO[bytes]) -> None:
@@ -213,6 +218,7 @@ class _Supervisor:
             time.sleep(0.1)
             if _reader_gone():
                 self.output_closed = True
+            self._report_failures()
         if self.stop_requested:
             self.stop_all()
             self._join()
@@ -222,10 +228,22 @@ class _Supervisor:
                 return EXIT_FAILED
             return EXIT_INTERRUPTED
         self._join()
-        failed = [(label, child.returncode) for label, child in self.children if child.returncode != 0]
-        for label, code in failed:
-            self.say(label, f"failed with {_exit_status(code)}")
+        self._report_failures()
+        failed = [label for label, child in self.children if child.returncode != 0]
         return EXIT_FAILED if failed else EXIT_OK
+
+    def _report_failures(self) -> None:
+        """A process that failed is said as soon as it ends (after its last lines), not after the others:
+        they may run for a long while yet."""
+        for label, child in self.children:
+            code = child.poll()
+            if code is None or code == 0 or child.pid in self.reported:
+                continue
+            self.reported.add(child.pid)
+            copier = self.copier_of.get(child.pid)
+            if copier is not None:
+                copier.join(timeout=2.0)
+            self.say(label, f"failed with {_exit_status(code)}")
 
     def stop_all(self) -> None:
         """SIGTERM to each (they close their traces and exit 130), then SIGKILL after a bounded wait, or at

@@ -150,7 +150,10 @@ def run(arguments: argparse.Namespace) -> int:
 
 
 def _run(arguments: argparse.Namespace) -> int:
+    from earl.cli.common import watch_supervisor
     from earl.lang.loader import load
+
+    watch_supervisor()
     from earl.runtime.durations import parse_duration
     from earl.runtime.simulation import Simulation, read_run_settings
 
