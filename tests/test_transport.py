@@ -214,6 +214,14 @@ def test_an_environment_that_would_run_twice_or_apart_from_its_effectors_is_refu
             "[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:7'\n[[process]]\nagents = ['b']\nlisten = 'tcp/localhost:7'\n",
             "`tcp/localhost:7` is the same endpoint as process 1's",
         ),
+        (
+            "[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:7451'\n[[process]]\nagents = ['b']\nlisten = 'tcp/127.0.0.1:07451'\n",
+            "the same endpoint as process 1's",
+        ),
+        (
+            "[[process]]\nagents = ['a']\nlisten = 'tpc/127.0.0.1:7451'\n",
+            "`tpc` is not a protocol of Zenoh; did you mean `tcp`",
+        ),
         ("[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:notaport'\n", "`notaport` is not a port"),
         ("[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:99999'\n", "`99999` is not a port"),
         ("[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1'\n", "write it as tcp/HOST:PORT"),
@@ -536,7 +544,13 @@ def test_a_stale_input_reads_as_timed_out_until_its_sender_returns() -> None:
         (
             "[[process]]\nagents = ['sender', 'receiver']\nlisten = 'tcp/192.0.2.1:1'\nhost = 'elsewhere.invalid'\n",
             1,
-            "has no process for this host",
+            "has no process for this host, `",
+        ),
+        (
+            "[[process]]\nagents = ['sender']\nlisten = 'tcp/127.0.0.1:1'\nargs = ['--trace', 'same.mcap']\n"
+            "[[process]]\nagents = ['receiver']\nlisten = 'tcp/127.0.0.1:2'\nargs = ['--trace=same.mcap']\n",
+            1,
+            "receiver/a writes same.mcap (--trace), as sender/a does",
         ),
     ],
 )
@@ -703,3 +717,13 @@ def test_a_zenoh_configuration_zenoh_refuses_is_explained_without_rust_source_li
     message = str(refused.value)
     assert message.startswith(f"cannot use the Zenoh configuration {wrong}: ")
     assert ".rs:" not in message
+
+
+def test_this_host_is_known_by_its_name_in_any_case_and_by_its_addresses() -> None:
+    import socket
+
+    from earl.transport.deployment import is_this_host
+
+    name = socket.gethostname()
+    assert is_this_host(name.upper()) and is_this_host(name + ".") and is_this_host("127.0.1.1")
+    assert not is_this_host("no-such-host.invalid")

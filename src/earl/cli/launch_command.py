@@ -103,7 +103,18 @@ def run(arguments: argparse.Namespace) -> int:
         return EXIT_FAILED
     local = [process for process in deployment.processes if process.is_local]
     if not local:
-        print(f"earl launch: {deployment_path} has no process for this host", file=sys.stderr)
+        from earl.transport.deployment import this_host_name
+
+        hosts = ", ".join(sorted({process.host for process in deployment.processes}))
+        print(
+            f"earl launch: {deployment_path} has no process for this host, `{this_host_name()}` "
+            f"(its processes run on {hosts})",
+            file=sys.stderr,
+        )
+        return EXIT_FAILED
+    shared = _shared_output(local)
+    if shared is not None:
+        print(f"earl launch: {deployment_path}: {shared}; nothing was started", file=sys.stderr)
         return EXIT_FAILED
     if arguments.duration:
         from earl.runtime.durations import parse_duration
@@ -145,6 +156,28 @@ def _agents(spec: Path, parameters: list[str]) -> tuple[list[str], list[str]]:
     values = parse_parameters(parameters)
     expanded = expand(load(spec, values), values)
     return [agent_name(agent) for agent in expanded.agents], acting_agents(expanded)
+
+
+def _shared_output(processes: list[Any]) -> str | None:
+    """Two processes whose `args` name one file for `--trace` or `--plot`: the later would refuse it (an
+    existing file) or, started at the same moment, overwrite the other's."""
+    written: dict[Path, str] = {}
+    for process in processes:
+        arguments = list(process.args)
+        for position, argument in enumerate(arguments):
+            for option in ("--trace", "--plot"):
+                value = None
+                if argument == option and position + 1 < len(arguments):
+                    value = arguments[position + 1]
+                elif argument.startswith(option + "="):
+                    value = argument.split("=", 1)[1]
+                if value is None:
+                    continue
+                target = Path(value).resolve()
+                if target in written:
+                    return f"{process.label} writes {value} ({option}), as {written[target]} does: give each its own file"
+                written[target] = process.label
+    return None
 
 
 class _Supervisor:

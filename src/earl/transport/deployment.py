@@ -23,11 +23,15 @@ for the process whose agents have Real Effectors or Receptors (the first process
 
 from __future__ import annotations
 
+import contextlib
+import functools
 import socket
 import tomllib
 from collections.abc import Collection
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+
+from earl.diagnostics import did_you_mean
 
 LOCAL_HOSTS = frozenset({"localhost", "127.0.0.1", "::1"})
 
@@ -58,7 +62,28 @@ class ProcessGroup:
 
     @property
     def is_local(self) -> bool:
-        return self.host in LOCAL_HOSTS or self.host in {socket.gethostname(), socket.getfqdn()}
+        return is_this_host(self.host)
+
+
+def is_this_host(host: str) -> bool:
+    """Whether `host` names this machine: `localhost`, a loopback address, its name or full name (in any
+    case, with or without the final dot), or one of the addresses its name resolves to."""
+    name = host.strip().rstrip(".").lower().strip("[]")
+    if name in LOCAL_HOSTS or name.startswith("127."):
+        return True
+    return name in _this_host_names()
+
+
+@functools.cache
+def _this_host_names() -> frozenset[str]:
+    names = {socket.gethostname().lower(), socket.getfqdn().lower().rstrip(".")}
+    with contextlib.suppress(OSError):
+        names |= {address.lower() for address in socket.gethostbyname_ex(socket.gethostname())[2]}
+    return frozenset(names)
+
+
+def this_host_name() -> str:
+    return socket.gethostname()
 
 
 @dataclass(frozen=True)
@@ -165,12 +190,20 @@ def normalise_agent(name: str) -> str:
 _NETWORK_PROTOCOLS = frozenset({"tcp", "udp", "tls", "quic", "ws"})
 
 
+#: Zenoh's other link protocols, whose addresses are Zenoh's own to check
+_OTHER_PROTOCOLS = frozenset({"unixsock-stream", "unixpipe", "serial", "vsock"})
+
+
 def endpoint_problem(endpoint: str) -> str | None:
     """What is wrong with a `listen` endpoint of the network protocols, checked before anything starts
     (Zenoh would say it only as the process opens, in its own words); None when it looks right."""
     protocol, _, address = endpoint.partition("/")
+    if protocol in _OTHER_PROTOCOLS:
+        return None
     if protocol not in _NETWORK_PROTOCOLS:
-        return None  # unixsock-stream/…, serial/…: Zenoh's own to check
+        known = sorted(_NETWORK_PROTOCOLS | _OTHER_PROTOCOLS)
+        hint = did_you_mean(protocol, known) or f"Zenoh's protocols: {', '.join(known)}"
+        return f"`{protocol}` is not a protocol of Zenoh; {hint}"
     address = address.split("#", 1)[0].split("?", 1)[0]  # Zenoh's endpoint metadata and configuration
     host, colon, port = address.rpartition(":")
     if not colon or not host:
@@ -187,6 +220,8 @@ def _endpoint_key(endpoint: str) -> tuple[str, str, str]:
     host = host.strip("[]")
     if host in LOCAL_HOSTS or host in {"0.0.0.0", "::"}:
         host = "this host"
+    if port.isdigit():
+        port = str(int(port))  # `017451` is port 17451
     return (protocol, host, port) if port else (protocol, address, "")
 
 
