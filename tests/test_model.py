@@ -295,3 +295,32 @@ def test_an_override_of_an_imported_parameter_is_not_printed_as_if_it_held() -> 
     with pytest.raises(ValueError, match=r"`SECTORS`, given a value from outside, is declared in .*types\.earl"):
         earl.load(examples / "mobile_robot", {"SECTORS": 16}).to_earl()
     assert "param N: int = 3" in earl.load(examples / "pick_and_place", {"N": 3}).to_earl()
+
+
+def test_a_value_of_the_wrong_type_in_a_model_built_in_python_is_named_where_it_is() -> None:
+    """`tc = Literal(True)` where a Predicate belongs, `data_type="boolean"`, a state naming its behaviour
+    by an ElementReference: the printer and the checker say which value, not `'Literal' object has no
+    attribute 'expression'` from deep inside."""
+    from earl.check import check
+    from earl.model.expressions import ElementReference, Literal
+    from earl.model.kinds import Kind
+    from earl.model.validate import ModelTypeError
+
+    def counter() -> Any:
+        system = earl.load(Path(__file__).parent / "runtime_specs" / "counter")
+        return system, system.agent("counter").control_subsystem
+
+    system, cs = counter()
+    cs.basic_behaviours[0].terminal_condition = Literal(True)
+    with pytest.raises(ModelTypeError, match=r"\.basic_behaviours\[0\]\.terminal_condition: expected Predicate"):
+        system.to_earl()
+    system, cs = counter()
+    cs.memories[0].data_type = "int"
+    with pytest.raises(ModelTypeError, match=r'\.memories\[0\]\.data_type: .*write `PrimitiveType\("int"\)`'):
+        system.to_earl()
+    system, cs = counter()
+    cs.fsm.states[0].behaviour = ElementReference("count", Kind.BASIC_BEHAVIOUR)
+    with pytest.raises(ModelTypeError, match=r"\.fsm\.states\[0\]\.behaviour: expected str, got ElementReference"):
+        check(system)
+    system, _ = counter()
+    assert system.to_earl() and not [d for d in check(system) if d.severity.name == "ERROR"]

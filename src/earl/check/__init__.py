@@ -40,12 +40,17 @@ def check(system: System, parameters: Mapping[str, bool | int | float | str] | N
     if unknown:
         return unknown
     with collector_paused():
-        # A system built or edited in Python never met the reader: its names are resolved here, as
-        # `load` resolves a file's (a transition to a state that does not exist, a duplicate agent …).
-        unresolved = [d for d in resolve(system, parameters or {}) if d.severity is Severity.ERROR]
-        if unresolved:
-            return unresolved
-        return check_context(context_for(system, parameters))
+        try:
+            # A system built or edited in Python never met the reader: its names are resolved here, as
+            # `load` resolves a file's (a transition to a state that does not exist, a duplicate agent …).
+            unresolved = [d for d in resolve(system, parameters or {}) if d.severity is Severity.ERROR]
+            if unresolved:
+                return unresolved
+            return check_context(context_for(system, parameters))
+        except (AttributeError, TypeError, KeyError) as error:  # a value of the wrong type, built in Python
+            from earl.model.validate import explained
+
+            raise explained(system, error) from error
 
 
 def unknown_parameters(system: System, parameters: Mapping[str, object]) -> list[Diagnostic]:

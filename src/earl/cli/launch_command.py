@@ -175,7 +175,9 @@ def _shared_output(processes: list[Any]) -> str | None:
                     continue
                 target = Path(value).resolve()
                 if target in written:
-                    return f"{process.label} writes {value} ({option}), as {written[target]} does: give each its own file"
+                    return (
+                        f"{process.label} writes {value} ({option}), as {written[target]} does: give each its own file"
+                    )
                 written[target] = process.label
     return None
 

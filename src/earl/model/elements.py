@@ -537,4 +537,9 @@ class System:
         """This system as canonical `.earl` text (what `earl fmt` prints)."""
         from earl.lang.formatter import format_system  # the model itself imports no reader
 
-        return format_system(self)
+        try:
+            return format_system(self)
+        except (AttributeError, TypeError, KeyError) as error:  # a model built in Python with a wrong value
+            from earl.model.validate import explained
+
+            raise explained(self, error) from error
