@@ -361,39 +361,27 @@ class ElementBuilder:
     def duration(self, meta: Meta, children: list[Token]) -> Duration:
         number = _number(children[0], self.path)
         if number <= 0:
-            raise SpecificationSyntaxError(
-                Diagnostic(
-                    Severity.ERROR,
-                    f"a duration must be positive, not {children[0]}",
-                    self._loc(children[0]),
-                    code="EARL-S012",
-                )
-            )
+            raise self._duration_error(children[0], f"a duration must be positive, not {children[0]}")
         duration = Duration(number, str(children[1]))
         try:
             too_long = not duration.seconds <= Duration.MAX_SECONDS
         except OverflowError:  # an int of hundreds of digits, times a float
             too_long = True
         if too_long:
-            raise SpecificationSyntaxError(
-                Diagnostic(
-                    Severity.ERROR,
-                    f"a duration is at most {Duration.MAX_SECONDS:,.0f} s (about 31 years), not {_number_text(children[0])} "
-                    f"{children[1]}",
-                    self._loc(children[0]),
-                    code="EARL-S012",
-                )
+            raise self._duration_error(
+                children[0],
+                f"a duration is at most {Duration.MAX_SECONDS:,.0f} s (about 31 years), not "
+                f"{_number_text(children[0])} {children[1]}",
             )
         if duration.seconds < 1e-9:  # time is kept in whole nanoseconds: it would round to 0, an instant for ever
-            raise SpecificationSyntaxError(
-                Diagnostic(
-                    Severity.ERROR,
-                    f"a duration is at least 1 ns (earl keeps time in whole nanoseconds), not {children[0]} {children[1]}",
-                    self._loc(children[0]),
-                    code="EARL-S012",
-                )
+            raise self._duration_error(
+                children[0],
+                f"a duration is at least 1 ns (earl keeps time in whole nanoseconds), not {children[0]} {children[1]}",
             )
         return duration
+
+    def _duration_error(self, number: Token, message: str) -> SpecificationSyntaxError:
+        return SpecificationSyntaxError(Diagnostic(Severity.ERROR, message, self._loc(number), code="EARL-S012"))
 
     def input_buffer(self, meta: Meta, children: list[Any]) -> InputBuffer:
         declared: _DeclaredName = children[0]
