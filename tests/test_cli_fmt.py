@@ -193,3 +193,10 @@ def test_fmt_reads_a_pipe_once(tmp_path: Path) -> None:
     result = subprocess.run([bash, "-c", command], capture_output=True, text=True, timeout=60)
     assert result.returncode == 0, result.stderr
     assert result.stdout == CANONICAL
+
+
+def test_fmt_keeps_the_blank_lines_between_the_header_s_comment_blocks(tmp_path: Path) -> None:
+    spec = tmp_path / "h.earl"
+    text = "// licence\n\n// what this file is\nsystem h\n\nparam N: int = 1\n"
+    spec.write_text(text)
+    assert main(["fmt", "--check", str(spec)]) == 0

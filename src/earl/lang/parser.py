@@ -175,10 +175,26 @@ def parse_text(text: str, path: str = "<text>", sources: SourceMap | None = None
     comments = _collector.comments
     if parsed.system_location is not None:
         header_line = parsed.system_location.line
-        parsed.header_comments = [str(c) for c in comments if (c.line or 1) <= header_line]
+        parsed.header_comments = _with_blank_lines([c for c in comments if (c.line or 1) <= header_line], header_line)
         comments = [c for c in comments if (c.line or 1) > header_line]
     parsed.closing_comments = attach_comments(parsed.declarations, comments, path)
     return parsed
+
+
+def _with_blank_lines(comments: list[Token], before_line: int) -> list[str]:
+    """The header's comments, with "" where a blank line kept two blocks apart (a licence, then what
+    the file is), and before the `system` line when one kept them from it."""
+    lines: list[str] = []
+    previous_end: int | None = None
+    for comment in comments:
+        line = comment.line or 1
+        if previous_end is not None and line > previous_end + 1:
+            lines.append("")
+        lines.append(str(comment))
+        previous_end = comment.end_line or line
+    if previous_end is not None and previous_end < before_line - 1:
+        lines.append("")
+    return lines
 
 
 def _explain(error: UnexpectedInput, path: str, text: str) -> Diagnostic:
