@@ -30,7 +30,8 @@ EXAMPLES = ROOT / "examples"
 LANGUAGE = ROOT / "docs" / "language.md"
 
 SYSTEMS = sorted(EXAMPLES.rglob("system.earl"))
-EARL_FILES = sorted(EXAMPLES.rglob("*.earl"))
+#: the examples' files, and the test suite's own specs (tests/*_specs/), which are canonical too
+EARL_FILES = sorted(EXAMPLES.rglob("*.earl")) + sorted(ROOT.glob("tests/*_specs/**/*.earl"))
 
 
 def _name(path: Path) -> str:
