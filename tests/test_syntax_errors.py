@@ -463,6 +463,22 @@ SYNTAX = [
         "a duration is at most 1,000,000,000 s",
     ),
     Malformed(
+        "block_comment_after_a_value",
+        "system s\n\nparam N: int = 1\n\n/* a block */\nparam M: int = 2\n",
+        5,
+        1,
+        "EARL-S006",
+        "`/*` does not start a comment: EARL has line comments only",
+    ),
+    Malformed(
+        "block_comment_after_the_system_line",
+        "system s\n/* a block */\n",
+        2,
+        1,
+        "EARL-S006",
+        "`/*` does not start a comment",
+    ),
+    Malformed(
         "duration_below_a_nanosecond",
         _in_cs("        period 0.0001 us\n"),
         9,

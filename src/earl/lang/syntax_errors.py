@@ -246,6 +246,15 @@ def _unexpected_token(
             return SourceLocation(path, 1, 1, 1, 2)
         return SourceLocation(path, end[0], end[1], end[0], end[1] + 1)
 
+    start = getattr(token, "start_pos", None)
+    if token.type == "SLASH" and start is not None and text.startswith("/*", start):
+        return Diagnostic(
+            Severity.ERROR,
+            "`/*` does not start a comment: EARL has line comments only",
+            _token_location(path, token),
+            code="EARL-S006",
+            hint="write `//` at the start of each line of the comment",
+        )
     if token.type == "$END" or not token.line:
         location = after_previous()
     elif (
