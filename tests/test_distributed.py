@@ -621,3 +621,30 @@ def test_launch_says_a_process_failed_as_soon_as_it_ends(tmp_path: Path, process
     processes.append(launch)
     launch.wait_for("] failed with exit code 1", 25)
     assert launch.child.poll() is None, launch.output  # the receiver is still waiting for its peer
+
+
+def test_wait_for_peers_0_starts_at_once_and_a_missing_deployment_file_is_a_usage_error(tmp_path: Path) -> None:
+    deploy = deployment(tmp_path, [(["sender/a"], False), (["receiver/a"], False)])
+    command = [
+        sys.executable,
+        "-m",
+        "earl.cli.main",
+        "run",
+        str(PINGPONG),
+        "--transport",
+        "zenoh",
+        "--agents",
+        "sender",
+    ]
+    alone = subprocess.run(
+        [*command, "--deployment", str(deploy), "--wait-for-peers", "0", "--duration", "0.2s", "--no-progress"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert alone.returncode == 0, alone.stderr
+    assert "waiting up to" not in alone.stderr and "starting without receiver/a" in alone.stderr
+    missing = subprocess.run(
+        [*command, "--deployment", str(tmp_path / "none.toml")], capture_output=True, text=True, timeout=120
+    )
+    assert missing.returncode == 2 and "none.toml does not exist" in missing.stderr

@@ -132,7 +132,7 @@ def register(commands: Any) -> None:
         metavar="TIME",
         default="30s",
         help="with --transport zenoh: wait at most this long for the agents of other processes before starting "
-        "(default 30s); missing ones start out stale",
+        "(default 30s; 0: start at once); missing ones start out stale",
     )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.set_defaults(run=run)
@@ -188,10 +188,16 @@ def _run(arguments: argparse.Namespace) -> int:
     if arguments.transport == "zenoh":
         if not agents:
             return usage_error("--transport zenoh needs --agents: the agents this process runs, e.g. task/a")
+        from earl.transport.process import peers_wait  # Zenoh is imported only for a distributed run
+
         try:
-            parse_duration(arguments.wait_for_peers)
+            peers_wait(arguments.wait_for_peers)
         except ValueError as error:
             return usage_error(f"--wait-for-peers: {error}")
+        if arguments.deployment and not Path(arguments.deployment).is_file():
+            # as `earl launch` says it: a file named on the command line that is not there is a usage error
+            kind = "is a directory; name its file" if Path(arguments.deployment).is_dir() else "does not exist"
+            return usage_error(f"--deployment {arguments.deployment} {kind}")
         arguments.realtime = True  # distribution runs in real time only (docs/distributed.md)
     elif arguments.zenoh_config or arguments.deployment:
         return usage_error("--zenoh-config and --deployment go with --transport zenoh")

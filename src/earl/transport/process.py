@@ -122,13 +122,20 @@ def agents_of(system: System, parameters: Mapping[str, Any], agents: list[str]) 
     return names
 
 
-def wait_for_peers(transport: ZenohTransport, arguments: argparse.Namespace) -> None:
-    """Start when the agents our links talk to are there, so that no first message is lost."""
+def peers_wait(text: str) -> float:
+    """`--wait-for-peers`: a duration, or 0 for none (start at once, whoever is there)."""
     from earl.runtime.durations import parse_duration
 
-    seconds = parse_duration(arguments.wait_for_peers)
+    if text.strip() in ("0", "0s", "0 s", "0ms", "0 ms"):
+        return 0.0
+    return parse_duration(text)
+
+
+def wait_for_peers(transport: ZenohTransport, arguments: argparse.Namespace) -> None:
+    """Start when the agents our links talk to are there, so that no first message is lost."""
+    seconds = peers_wait(arguments.wait_for_peers)
     missing = transport.missing_peers()
-    if missing:
+    if missing and seconds > 0:
         log(f"earl run: waiting up to {seconds:g} s for {', '.join(missing)}")
         missing = transport.wait_for_peers(seconds)
     if missing:
