@@ -132,7 +132,7 @@ class Simulation:
         unknown = sorted(memory - set(self.network.by_name))
         if unknown:
             raise ValueError(
-                f"--record-memory names no subsystem of this run: {', '.join(unknown)} "
+                f"record_memory (--record-memory, run.toml's record_memory) names no subsystem of this run: {', '.join(unknown)} "
                 f"(subsystems are named like {next(iter(self.network.by_name), 'manip/a.cs')})"
             )
         self.trace: TraceWriter | None = None
