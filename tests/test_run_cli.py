@@ -903,3 +903,21 @@ def test_a_report_that_calls_sys_exit_does_not_choose_the_exit_code(tmp_path: Pa
     result = earl_cli("run", str(example), "--duration", "20ms", "--no-progress")
     assert result.returncode == 0, result.stderr
     assert "the report `closing:summary` called sys.exit(5)" in result.stdout + result.stderr
+
+
+def test_a_stop_before_the_run_never_removes_a_file_this_command_did_not_create(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Ctrl-C while the spec is read: a file --trace names that was there before stays as it was."""
+    import earl.lang.loader
+    from earl.cli.main import main
+
+    def interrupted(*_: object, **__: object) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(earl.lang.loader, "load", interrupted)
+    victim = tmp_path / "notes.txt"
+    victim.write_text("precious")
+    assert main(["run", str(SPECS / "counter"), "--trace", str(victim)]) == 130
+    assert victim.read_text() == "precious"
+    assert "interrupted before the run started; nothing was executed\n" in capsys.readouterr().err

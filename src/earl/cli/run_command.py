@@ -179,6 +179,8 @@ def _run(arguments: argparse.Namespace) -> int:
         arguments.trace = str(Path(arguments.plot).with_suffix(".mcap"))
     if arguments.plot and Path(arguments.plot).resolve() == Path(arguments.trace).resolve():
         return usage_error(f"--trace and --plot both name {arguments.plot}: the plot would replace the trace")
+    # only a trace file this command creates may be removed, should a stop signal come before the run
+    trace_was_there = arguments.trace is not None and os.path.lexists(arguments.trace)
     environment = arguments.environment or settings.environment
     if environment == "none":
         environment = None
@@ -255,10 +257,11 @@ def _run(arguments: argparse.Namespace) -> int:
     except KeyboardInterrupt:  # a stop signal while the spec was read and the run set up
         _close(transport)
         said = "nothing was executed"
-        if arguments.trace and Path(arguments.trace).exists():
-            # created by this command a moment ago (an existing file is refused), holding no run
+        trace = Path(arguments.trace) if arguments.trace else None
+        if trace is not None and not trace_was_there and trace.is_file() and not trace.is_symlink():
+            # created by this command a moment ago, holding no run
             with contextlib.suppress(OSError):
-                Path(arguments.trace).unlink()
+                trace.unlink()
                 said += f"; no trace was written to {arguments.trace}"
         print(f"earl run: interrupted before the run started; {said}", file=sys.stderr)
         return EXIT_INTERRUPTED
