@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import pytest
@@ -200,3 +201,22 @@ def test_fmt_keeps_the_blank_lines_between_the_header_s_comment_blocks(tmp_path:
     text = "// licence\n\n// what this file is\nsystem h\n\nparam N: int = 1\n"
     spec.write_text(text)
     assert main(["fmt", "--check", str(spec)]) == 0
+
+
+def test_fmt_diff_of_a_file_with_cr_line_ends_is_a_patch_that_applies(tmp_path: Path) -> None:
+    """A `\\r` ends no line for `diff` and `patch`: the diff marks only the real last line."""
+    import shutil
+    import subprocess
+
+    patch = shutil.which("patch")
+    if patch is None:
+        pytest.skip("no patch here")
+    spec = tmp_path / "cr.earl"
+    spec.write_bytes(CANONICAL.replace("\n", "\r").encode())
+    # bytes: text mode would read each `\r` as a line end
+    diff = subprocess.run(
+        [sys.executable, "-m", "earl.cli.main", "fmt", "--diff", str(spec)], capture_output=True, timeout=60
+    ).stdout
+    assert diff.count(b"\\ No newline at end of file") == 1
+    subprocess.run([patch, "-s", str(spec)], input=diff, check=True, timeout=60)
+    assert spec.read_text() == CANONICAL

@@ -552,6 +552,12 @@ def test_a_stale_input_reads_as_timed_out_until_its_sender_returns() -> None:
             1,
             "receiver/a writes same.mcap (--trace), as sender/a does",
         ),
+        (
+            "[[process]]\nagents = ['sender']\nlisten = 'tcp/127.0.0.1:1'\nargs = ['--tra', 'p.mcap']\n"
+            "[[process]]\nagents = ['receiver']\nlisten = 'tcp/127.0.0.1:2'\nargs = ['--plot', 'p.png']\n",
+            1,
+            "receiver/a writes p.mcap (--plot's trace), as sender/a does",
+        ),
     ],
 )
 def test_launch_refuses_a_deployment_it_cannot_run_before_starting_anything(

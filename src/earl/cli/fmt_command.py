@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import difflib
+import re
 import sys
 from typing import Any
 
@@ -69,8 +70,8 @@ def run(arguments: argparse.Namespace) -> int:
                 sys.stderr.write(f"{path}: reformatted\n")
         elif arguments.diff:
             diff = difflib.unified_diff(
-                original.splitlines(keepends=True),
-                canonical.splitlines(keepends=True),
+                _lines(original),
+                _lines(canonical),
                 str(path),
                 f"{path} (canonical)",
             )
@@ -99,3 +100,9 @@ def _reads_back_differently(system: Any, canonical: str, path: str) -> str | Non
     if again != system:
         return "its canonical text would read back as a different specification"
     return None
+
+
+def _lines(text: str) -> list[str]:
+    """The lines as `diff` and `patch` count them: ended by `\\n` only (a `\\r`, a form feed or U+2028
+    inside a line is part of it; `str.splitlines` would end lines there)."""
+    return re.findall(r"[^\n]*\n|[^\n]+$", text)

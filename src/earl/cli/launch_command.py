@@ -159,26 +159,27 @@ def _agents(spec: Path, parameters: list[str]) -> tuple[list[str], list[str]]:
 
 
 def _shared_output(processes: list[Any]) -> str | None:
-    """Two processes whose `args` name one file for `--trace` or `--plot`: the later would refuse it (an
-    existing file) or, started at the same moment, overwrite the other's."""
+    """Two processes whose `args` write one file: a `--trace`, a `--plot`, or the trace a `--plot`
+    implies (`p.png` → `p.mcap`). The later would refuse it (an existing file) or, started at the same
+    moment, overwrite the other's. The args are read as `earl run` reads them (abbreviations too)."""
+    reader = argparse.ArgumentParser(add_help=False, exit_on_error=False)
+    reader.add_argument("--trace")
+    reader.add_argument("--plot")
     written: dict[Path, str] = {}
     for process in processes:
-        arguments = list(process.args)
-        for position, argument in enumerate(arguments):
-            for option in ("--trace", "--plot"):
-                value = None
-                if argument == option and position + 1 < len(arguments):
-                    value = arguments[position + 1]
-                elif argument.startswith(option + "="):
-                    value = argument.split("=", 1)[1]
-                if value is None:
-                    continue
-                target = Path(value).resolve()
-                if target in written:
-                    return (
-                        f"{process.label} writes {value} ({option}), as {written[target]} does: give each its own file"
-                    )
-                written[target] = process.label
+        try:
+            options, _ = reader.parse_known_args(list(process.args))
+        except (argparse.ArgumentError, SystemExit):
+            continue  # `earl run` says what is wrong with them, in the process's own output
+        files = [("--plot", options.plot)] if options.plot else []
+        trace = options.trace or (str(Path(options.plot).with_suffix(".mcap")) if options.plot else None)
+        if trace:
+            files.append(("--trace" if options.trace else "--plot's trace", trace))
+        for option, value in files:
+            target = Path(value).resolve()
+            if target in written:
+                return f"{process.label} writes {value} ({option}), as {written[target]} does: give each its own file"
+            written[target] = process.label
     return None
 
 
