@@ -222,3 +222,15 @@ arm/a {
         earl.loads(text.replace("param OFFSET: double = 0.25 * K", "param OFFSET: string = K"), "gains.earl")
     (problem,) = refused.value.diagnostics
     assert problem.code == "EARL-R005" and "where K = 1" in problem.message
+    # a whole number, a Boolean or a string computed from a real that differs per member
+    for declared in ("param H: int = GAIN * 2", "param B: boolean = GAIN"):
+        with pytest.raises(earl.EarlError) as refused:
+            earl.loads(
+                text.replace(
+                    "        param OFFSET: double = 0.25 * K\n",
+                    f"        param OFFSET: double = 0.25 * K\n        {declared}\n",
+                ),
+                "gains.earl",
+            )
+        (problem,) = refused.value.diagnostics
+        assert problem.code == "EARL-R005" and "computed from `GAIN`, a `double`" in problem.message

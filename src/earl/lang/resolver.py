@@ -86,6 +86,8 @@ class PerMember:
 
 Scope = dict[str, "Value | IndexRange | PerMember"]
 
+_REAL_TYPES = frozenset({"double", "float32", "float64"})
+
 
 @dataclass
 class _Declared:
@@ -184,6 +186,17 @@ class Resolver:
                 value: Value = overrides[parameter.name]
             elif any(isinstance(scope.get(n.name), IndexRange | PerMember) for n in _names(parameter.value)):
                 # `param joint: int = K` differs per family member: check every member's value.
+                reals = sorted(n.name for n in _names(parameter.value) if isinstance(scope.get(n.name), PerMember))
+                if reals and type_name not in _REAL_TYPES:
+                    # computed from a real that differs per member: no whole number, Boolean or string
+                    self.error(
+                        f"parameter `{parameter.name}` is `{type_name}` but its value is computed from "
+                        f"`{reals[0]}`, a `{scope[reals[0]].type_name}` that differs per family member",  # type: ignore[union-attr]
+                        parameter.value.location or parameter.location,
+                        "EARL-R005",
+                    )
+                    scope[parameter.name] = PerMember(type_name)  # in scope, so that its uses say nothing more
+                    continue
                 if type_name in _INTEGER_TYPES:
                     values = self.index_values(parameter.value, scope)
                     if values is not None and values:
@@ -225,7 +238,7 @@ class Resolver:
         family is expanded."""
         names = {n.name for n in _names(parameter.value)}
         if any(isinstance(scope.get(name), PerMember) for name in names):
-            return
+            return  # a real computed from a real: whatever it is, a real (expansion computes each value)
         ranged = sorted(name for name in names if isinstance(scope.get(name), IndexRange))
         ranges = [scope[name].values() for name in ranged]  # type: ignore[union-attr]
         if _product_size(ranges) > 10_000:
@@ -406,6 +419,14 @@ class Resolver:
             if name.name not in scope:
                 self.unknown_name(name, scope)
                 return None
+        reals = sorted({n.name for n in _names(expression) if isinstance(scope.get(n.name), PerMember)})
+        if reals:
+            self.error(
+                f"an index must be a whole number; `{reals[0]}` is a `{scope[reals[0]].type_name}`",  # type: ignore[union-attr]
+                expression.location,
+                "EARL-R014",
+            )
+            return None
         ranged = sorted({n.name for n in _names(expression) if isinstance(scope.get(n.name), IndexRange)})
         ranges = [scope[name].values() for name in ranged]  # type: ignore[union-attr]
         if any(len(r) == 0 for r in ranges):
