@@ -398,6 +398,7 @@ def test_the_command_refuses_an_invalid_spec(tmp_path: Path, capsys: pytest.Capt
         (["export", "sysml", str(SMALL), "--param", "N"], "NAME=VALUE"),
         (["export", "uml", str(SMALL)], "invalid choice"),
         (["export", "sysml", str(SMALL), "-o", "/tmp/EARL.sysml"], "is where the library EARL.sysml goes"),
+        (["export", "sysml", str(SMALL), "-o", "/tmp/earl.sysml"], "is where the library EARL.sysml goes"),
     ],
 )
 def test_the_command_reports_usage_errors(
@@ -447,3 +448,5 @@ def test_a_name_renamed_for_a_library_feature_gets_no_short_name_that_would_hide
     assert "attribute agents_2 : EARL::int = 1;" in exported
     assert "<'agents'>" not in exported
     assert "package EARL_system {" in exported
+    spec.write_text(text.replace(system_line, "system ScalarValues", 1), encoding="utf-8")
+    assert "package ScalarValues_system {" in export_sysml(earl.load(spec))

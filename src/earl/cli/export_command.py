@@ -68,7 +68,11 @@ def run(arguments: argparse.Namespace) -> int:
     if output is None:
         sys.stdout.write(text)
         return 0
-    if not arguments.no_library and (output.parent / LIBRARY_FILE).resolve() == output.resolve():
+    # compared without case too: on a file system that ignores it (macOS, Windows) `earl.sysml` is the library
+    library_place = (output.parent / LIBRARY_FILE).resolve()
+    if not arguments.no_library and (
+        library_place == output.resolve() or str(library_place).lower() == str(output.resolve()).lower()
+    ):
         return usage_error(
             f"-o {output} is where the library {LIBRARY_FILE} goes, beside the export: name the export otherwise "
             f"(e.g. -o {output.parent / (system.name + '.sysml')}), or leave the library out with --no-library"

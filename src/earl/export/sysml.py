@@ -76,6 +76,10 @@ def library_text() -> str:
     return resources.files("earl.export").joinpath(LIBRARY_FILE).read_text(encoding="utf-8")
 
 
+#: the packages the export and its library `EARL.sysml` import: a system of one of these names is renamed
+LIBRARY_PACKAGES = frozenset({"EARL", "ScalarValues", "ISQ", "SequenceFunctions", "SI"})
+
+
 def export_sysml(system: System, parameters: Mapping[str, Value] | None = None) -> str:
     """`system` as SysML v2 text, every family expanded with `parameters` (the system's own values by default)."""
     return _Writer(system, check_context_for(system, parameters or {})).write()
@@ -205,8 +209,10 @@ class _Writer:
         origin = f" from {source}" if source else ""
         self.emit(f"// SysML v2 text written by earl {__version__} (`earl export sysml`){origin}.")
         self.emit(f"// It needs {LIBRARY_FILE}, the EARL library shipped with earl: export it beside this file.")
-        # the library is `package EARL`: a system of that name is exported as `EARL_system`
-        package = self.system.name if self.system.name != "EARL" else "EARL_system"
+        # a system named as a package the export or its library imports (`EARL`, `ScalarValues`, …) would
+        # hide it: it is exported as `EARL_system`
+        taken = self.system.name in LIBRARY_PACKAGES
+        package = f"{self.system.name}_system" if taken else self.system.name
         with self.block(f"package {name_text(package)}"):
             settings = ", ".join(f"{p.name} = {literal(_parameter_value(p))}" for p in self.system.parameters)
             self.doc(
