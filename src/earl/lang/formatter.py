@@ -95,17 +95,22 @@ def link_end_text(end: LinkEnd) -> str:
 def format_system(system: System) -> str:
     """The whole system as canonical text, imports kept as `import` lines.
 
-    A parameter of an imported file given a value from outside (`load(path, {"N": 3})`) cannot be
-    printed: the text holds the root file alone, and would read back with the imported file's value.
+    A parameter of an imported file given another value since it was read (`load(path, {"N": 3})`, or
+    an edit in Python) cannot be printed: the text holds the root file alone, and would read back with
+    the imported file's value.
     That is a ValueError, never a text that silently means another system."""
-    elsewhere = sorted(p.name for p in system.parameters if p.name in system.overridden and not _from_root(system, p))
+    elsewhere = sorted(
+        p.name
+        for p in system.parameters
+        if p.name in system.imported_values and p.value != system.imported_values[p.name] and not _from_root(system, p)
+    )
     if elsewhere:
         where = next(
             (p.location.file for p in system.parameters if p.name == elsewhere[0] and p.location is not None),
             "an import",
         )
         raise ValueError(
-            f"to_earl() prints the root file alone, and `{elsewhere[0]}`, given a value from outside, is declared in "
+            f"to_earl() prints the root file alone, and `{elsewhere[0]}`, given another value, is declared in "
             f"{where}, which it imports: the text would read back with that file's value. Give the value when the text "
             f"is read (`earl.loads(text, path, {{{elsewhere[0]!r}: …}})`, `--param {elsewhere[0]}=…`), or change it there"
         )

@@ -214,8 +214,18 @@ def load(path: str | Path, parameters: Mapping[str, ParameterValue] | None = Non
     if errors:
         raise EarlError(errors, sources)
     system.sources = sources
+    _remember_imported_values(system)
     set_parameters(system, parameters or {})
     return system
+
+
+def _remember_imported_values(system: System) -> None:
+    """The values, as read, of the parameters imported files declare (`System.imported_values`)."""
+    system.imported_values = {
+        parameter.name: parameter.value
+        for parameter in system.parameters
+        if parameter.location is not None and parameter.location.file != system.source_file
+    }
 
 
 def set_parameters(system: System, parameters: Mapping[str, ParameterValue]) -> None:
@@ -228,7 +238,6 @@ def set_parameters(system: System, parameters: Mapping[str, ParameterValue]) -> 
             if getattr(parameter.data_type, "name", "") in REAL_TYPES and type(value) is int:
                 value = float(value)  # `N = 3` for a double: the value the runtime would compute
             parameter.value = Literal(value, parameter.value.location)
-            system.overridden.add(parameter.name)
 
 
 def parse_file(path: str | Path) -> System:
@@ -324,5 +333,6 @@ def _loads(text: str, path: str, parameters: Mapping[str, ParameterValue] | None
     if errors:
         raise EarlError(errors, sources)
     system.sources = sources
+    _remember_imported_values(system)
     set_parameters(system, parameters or {})
     return system

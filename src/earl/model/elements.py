@@ -521,8 +521,9 @@ class System:
     source_file: str | None = field(default=None, compare=False, repr=False)
     #: The text of every file read (a `SourceMap`), for quoting lines in diagnostics.
     sources: object | None = field(default=None, compare=False, repr=False)
-    #: The parameters given values from outside the text (`load(path, {"N": 3})`), by name.
-    overridden: set[str] = field(default_factory=set, compare=False, repr=False)
+    #: The values of the parameters imported files declare, as read: `to_earl()` prints the root file
+    #: alone, and must not print a system whose imported parameter was given another value since.
+    imported_values: dict[str, object] = field(default_factory=dict, compare=False, repr=False)
 
     def agent(self, name: str) -> Agent | None:
         return next((a for a in self.agents if a.name == name), None)
