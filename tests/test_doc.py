@@ -574,3 +574,13 @@ def test_a_finding_about_a_robot_links_to_where_the_robots_are_named(tmp_path: P
     assert main(["doc", str(spec), "-o", str(site)]) == 1  # the document is written; the errors fail the command
     rows = [line for line in (site / "index.md").read_text(encoding="utf-8").splitlines() if "`EARL-E004`" in line]
     assert rows and all("[`manipulationRobot/r`](#system)" in row for row in rows)
+
+
+def test_the_agents_table_names_every_robot_a_family_drawn_once_belongs_to(tmp_path: Path) -> None:
+    spec = tmp_path / "system.earl"
+    fleet = (Path(__file__).parent / "doc_specs" / "fleet" / "system.earl").read_text(encoding="utf-8")
+    assert "    worker[2]/a\n}\n" in fleet
+    spec.write_text(fleet.replace("    worker[2]/a\n}\n", "    worker[2]/a\n}\n\notherRobot/r {\n    worker[3]/a\n}\n"))
+    assert main(["doc", str(spec), "-o", str(tmp_path / "site")]) == 0
+    markdown = (tmp_path / "site" / "index.md").read_text(encoding="utf-8")
+    assert "| [`worker[K]/a`](#agent-worker-K-a) | `fleetRobot/r, otherRobot/r` |" in markdown

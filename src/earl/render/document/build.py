@@ -225,7 +225,12 @@ class DocumentBuilder:
         robot_of = robot_numbers(system)
         for agent in system.agents:
             name = agent_name(agent)
-            robot = f"{system.robots[robot_of[id(agent)]].name}/r" if id(agent) in robot_of else "—"
+            if agent.family is not None and agent.index is None:
+                # a family drawn once: every robot that lists one of its members (or all of them)
+                robots = [f"{r.name}/r" for r in system.robots if any(a.name == agent.name for a in r.agents)]
+                robot = ", ".join(robots) or "—"
+            else:
+                robot = f"{system.robots[robot_of[id(agent)]].name}/r" if id(agent) in robot_of else "—"
             row = self.subject.agent_type(agent)
             instances = context.instances(agent) or [agent]
             first = instances[0]
