@@ -921,3 +921,14 @@ def test_a_stop_before_the_run_never_removes_a_file_this_command_did_not_create(
     assert main(["run", str(SPECS / "counter"), "--trace", str(victim)]) == 130
     assert victim.read_text() == "precious"
     assert "interrupted before the run started; nothing was executed\n" in capsys.readouterr().err
+
+
+def test_a_trace_cut_before_its_first_whole_record_says_so(tmp_path: Path) -> None:
+    trace = tmp_path / "run.mcap"
+    assert earl_cli("run", str(SPECS / "counter"), "--duration", "300ms", "--trace", str(trace)).returncode == 0
+    for length in (12, 2000):
+        cut = tmp_path / f"cut{length}.mcap"
+        cut.write_bytes(trace.read_bytes()[:length])
+        summary = earl_cli("trace", "summary", str(cut))
+        assert summary.returncode == 1
+        assert "cut short (or damaged) before its first whole record" in summary.stderr, summary.stderr

@@ -87,7 +87,7 @@ def _messages(
     except ValueError as error:  # a message that is not JSON (or not UTF-8): damage, not a cut
         raise _unreadable(path, error) from None
     if not seen_channel:  # not an MCAP file at all, or nothing before the damage
-        raise _unreadable(path, failure) from None
+        raise _nothing_readable(path, failure) from None
 
 
 def _records_up_to_the_cut(path: Path) -> Iterator[tuple[Channel, Message | None]]:
@@ -106,6 +106,24 @@ def _records_up_to_the_cut(path: Path) -> Iterator[tuple[Channel, Message | None
                 yield record, None
             elif isinstance(record, Message) and record.channel_id in channels:
                 yield channels[record.channel_id], record
+
+
+_MAGIC = b"\x89MCAP0\r\n"
+
+
+def _nothing_readable(path: Path, error: BaseException) -> TraceError:
+    """An MCAP file cut before its first whole record says so; anything else is `_unreadable`."""
+    try:
+        with open(path, "rb") as stream:
+            start = stream.read(len(_MAGIC))
+    except OSError:
+        start = b""
+    if start == _MAGIC:
+        return TraceError(
+            f"{path} is not a readable MCAP trace: it was cut short (or damaged) before its first whole "
+            "record (a run killed in its first 0.2 s, or a copy cut short)"
+        )
+    return _unreadable(path, error)
 
 
 def _unreadable(path: Path, error: BaseException) -> TraceError:
@@ -209,7 +227,7 @@ def topics(path: Path) -> dict[str, dict[str, str]]:
         channel.topic: dict(channel.metadata) for channel, message in _records_up_to_the_cut(path) if message is None
     }
     if not found and failure is not None:
-        raise _unreadable(path, failure) from None
+        raise _nothing_readable(path, failure) from None
     return found
 
 
