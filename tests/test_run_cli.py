@@ -926,7 +926,7 @@ def test_a_stop_before_the_run_never_removes_a_file_this_command_did_not_create(
 def test_a_trace_cut_before_its_first_whole_record_says_so(tmp_path: Path) -> None:
     trace = tmp_path / "run.mcap"
     assert earl_cli("run", str(SPECS / "counter"), "--duration", "300ms", "--trace", str(trace)).returncode == 0
-    for length in (12, 2000):
+    for length in (12, 40):
         cut = tmp_path / f"cut{length}.mcap"
         cut.write_bytes(trace.read_bytes()[:length])
         summary = earl_cli("trace", "summary", str(cut))
