@@ -131,5 +131,5 @@ def test_an_opengl_backend_mujoco_cannot_load_stops_only_the_pictures(tmp_path: 
     )
     assert result.returncode == 0, result.stderr
     said = " ".join((result.stdout + result.stderr).split())
-    assert "MuJoCo could not load the OpenGL backend MUJOCO_GL=nothing" in said
+    assert "MUJOCO_GL=nothing names no OpenGL backend of MuJoCo" in said
     assert "pick-and-place: placed=" in said

@@ -484,7 +484,7 @@ SYNTAX = [
         9,
         16,
         "EARL-S012",
-        "a duration is at least 1 ns (earl keeps time in whole nanoseconds), not 0.0001 us",
+        "a duration is at least 1 ns (earl keeps time in whole nanoseconds), not `0.0001` us",
     ),
     Malformed(
         "duration_of_centuries",

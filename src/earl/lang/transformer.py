@@ -376,7 +376,8 @@ class ElementBuilder:
         if duration.seconds < 1e-9:  # time is kept in whole nanoseconds: it would round to 0, an instant for ever
             raise self._duration_error(
                 children[0],
-                f"a duration is at least 1 ns (earl keeps time in whole nanoseconds), not {children[0]} {children[1]}",
+                f"a duration is at least 1 ns (earl keeps time in whole nanoseconds), not {_number_text(children[0])} "
+                f"{children[1]}",
             )
         return duration
 

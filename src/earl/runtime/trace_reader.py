@@ -314,6 +314,7 @@ def read_signals(path: Path, names: list[str]) -> Signals:
             raise _not_from_earl(path, topic) from None
     series: list[Series] = []
     empty: list[str] = []
+    leaf_hints: list[str] = []
     for name, subsystem, inner in owners:
         pattern = re.compile(re.escape(inner).replace(r"\[\*\]", r"\[\d+\]") + "$")
         matched = [
@@ -326,7 +327,10 @@ def read_signals(path: Path, names: list[str]) -> Signals:
             same = sorted({leaf for (owner, leaf) in leaves if owner == subsystem and signal_element(leaf) == element})
             if same:
                 hint = f"the trace has {', '.join(f'`{leaf}`' for leaf in same[:6])}{' …' if len(same) > 6 else ''}"
-                empty.append(f"`{name}` had no value in this run ({hint})")
+                # the element is in the trace, this part of it never had a value: an optional field never
+                # sent, an array sent empty; or a misspelt part, which the leaves found show
+                empty.append(f"`{name}` had no value in this run (an optional field never sent, or an empty array)")
+                leaf_hints.append(f"`{name}` had no value in this run ({hint})")
                 continue
             if f"{subsystem}/memory" not in available:
                 hint = (
@@ -345,7 +349,7 @@ def read_signals(path: Path, names: list[str]) -> Signals:
         for subsystem, changes in stays.items()
     }
     if not series:
-        raise TraceError(f"no signal has a value in this trace: {'; '.join(empty)}")
+        raise TraceError(f"no signal has a value in this trace: {'; '.join(leaf_hints)}")
     return Signals(series, bands, end, empty, bool(cut))
 
 

@@ -39,6 +39,11 @@ def _advice() -> str:
     backend = os.environ.get("MUJOCO_GL", "(unset)")
     if earl.sim.UNUSABLE_BACKEND is not None:
         requested, why = earl.sim.UNUSABLE_BACKEND
+        if requested not in ("egl", "osmesa", "glfw"):
+            return (
+                f"MUJOCO_GL={requested} names no OpenGL backend of MuJoCo (egl, osmesa, glfw): the physics runs "
+                "without one; for pictures set MUJOCO_GL=egl or osmesa, or unset it"
+            )
         return (
             f"MuJoCo could not load the OpenGL backend MUJOCO_GL={requested} ({why}): the physics runs without it; "
             "for pictures install its libraries (Debian: libegl1 libgl1 for egl, libosmesa6 for osmesa) or unset MUJOCO_GL"
