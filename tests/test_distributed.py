@@ -336,9 +336,8 @@ def test_an_agent_started_in_two_processes_is_reported(tmp_path: Path, processes
     again.wait_for("sender/a runs here and in another process", 30)
 
 
-def test_launch_starts_each_process_prefixes_its_output_and_stops_them_all_on_ctrl_c(
-    tmp_path: Path, processes: list[Process]
-) -> None:
+def pingpong_launched(tmp_path: Path, processes: list[Process]) -> Process:
+    """`earl launch` of the ping-pong example in two processes for a minute, once both run."""
     deploy = deployment(tmp_path, [(["sender/a"], False), (["receiver/a"], False)])
     launch = Process(
         tmp_path / "launch.log", [str(PINGPONG), "--deployment", str(deploy), "--duration", "60s"], "launch"
@@ -347,6 +346,13 @@ def test_launch_starts_each_process_prefixes_its_output_and_stops_them_all_on_ct
     # the labels are padded to the longest, so the columns line up
     launch.wait_for("[receiver/a] earl run: peers sender/a are alive; starting", 60)
     launch.wait_for("[sender/a  ] earl run: peers receiver/a are alive; starting", 60)
+    return launch
+
+
+def test_launch_starts_each_process_prefixes_its_output_and_stops_them_all_on_ctrl_c(
+    tmp_path: Path, processes: list[Process]
+) -> None:
+    launch = pingpong_launched(tmp_path, processes)
     time.sleep(0.5)
     launch.child.send_signal(signal.SIGINT)  # what Ctrl-C sends
     assert launch.finish(30) == 130, launch.output
@@ -591,13 +597,7 @@ def _ended(pid: int, seconds: float) -> bool:
 def test_processes_of_a_launch_killed_with_sigkill_stop_themselves(tmp_path: Path, processes: list[Process]) -> None:
     """SIGKILL cannot be caught: the supervisor cannot stop its children. Each notices it is orphaned and
     stops itself as on SIGTERM, instead of running on unsupervised, holding its ports."""
-    deploy = deployment(tmp_path, [(["sender/a"], False), (["receiver/a"], False)])
-    launch = Process(
-        tmp_path / "launch.log", [str(PINGPONG), "--deployment", str(deploy), "--duration", "60s"], "launch"
-    )
-    processes.append(launch)
-    launch.wait_for("[receiver/a] earl run: peers sender/a are alive; starting", 60)
-    launch.wait_for("[sender/a  ] earl run: peers receiver/a are alive; starting", 60)
+    launch = pingpong_launched(tmp_path, processes)
     pids = _started_pids(launch.output)
     assert len(pids) == 2
     launch.child.kill()
