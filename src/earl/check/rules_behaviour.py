@@ -10,7 +10,7 @@ from earl.check.expression_types import BOOLEAN, ExpressionTyper
 from earl.check.registry import Finding, rule
 from earl.diagnostics import Severity
 from earl.model.elements import BasicBehaviour, Subsystem
-from earl.model.expressions import ElementReference, Expression, Read, reads
+from earl.model.expressions import Call, ElementReference, Expression, Read, reads, walk
 from earl.model.kinds import Kind
 from earl.model.location import SourceLocation
 from earl.model.text import expression_text, reference_text
@@ -415,4 +415,46 @@ def unused_functions(context: CheckContext) -> Iterator[Finding]:
                         f"partial transition function `{function.name}/pf` is not used by any behaviour",
                         function.location,
                         "compose it into a `tf`, or remove it",
+                    )
+
+
+@rule("EARL-W043", Severity.WARNING, "every subsystem has an FSM", "§2.2, Figure 3")
+def subsystems_have_an_fsm(context: CheckContext) -> Iterator[Finding]:
+    """A subsystem's behaviour is chosen by its FSM (Figure 3). One without an `fsm` is drawn and checked,
+    but never behaves: `earl run` refuses it (EARL-X011)."""
+    for agent in context.declared.agents:
+        for subsystem in agent.subsystems:
+            if subsystem.fsm is None:
+                behaviour = subsystem.basic_behaviours[0].name if subsystem.basic_behaviours else "b"
+                yield Finding(
+                    f"{subsystem_name(agent, subsystem)} has no `fsm`: it never runs a behaviour, and `earl run` "
+                    "refuses it",
+                    subsystem.location,
+                    f"add one: `fsm {{ initial {behaviour}  state {behaviour}: {behaviour}/bb }}`",
+                )
+
+
+@rule("EARL-W044", Severity.WARNING, "a `timeout` can come true", "§2.2, Figure 5b")
+def timeouts_that_can_happen(context: CheckContext) -> Iterator[Finding]:
+    """`timeout(x/ib)` is true when the obligatory `x/ib` of the current state did not come before the
+    state's timeout. A buffer that no state makes obligatory never times out: such a watchdog never fires."""
+    for agent in context.declared.agents:
+        for subsystem in agent.subsystems:
+            if subsystem.fsm is None:
+                continue
+            waited = {reference.name for state in subsystem.fsm.states for reference in state.obligatory}
+            for predicate in subsystem.primitive_predicates:
+                for node in walk(predicate.expression):
+                    if not (isinstance(node, Call) and node.function == "timeout" and node.arguments):
+                        continue
+                    argument = node.arguments[0]
+                    target = argument.target if isinstance(argument, Read) else None
+                    if target is None or target.name in waited:
+                        continue
+                    yield Finding(
+                        f"`timeout({reference_text(target)})` in `{predicate.name}/pp` is never true: "
+                        f"`{target.name}/ib` is obligatory in no state of {subsystem_name(agent, subsystem)}",
+                        node.location or predicate.location,
+                        f"make it obligatory where it is awaited: `state S: B/bb {{ obligatory {target.name}/ib "
+                        "timeout 50 ms }`",
                     )

@@ -313,7 +313,13 @@ def _behaviour(
     fsm = subsystem.fsm
     if fsm is None:
         problems.append(
-            Diagnostic(Severity.ERROR, f"{engine.name} has no `fsm`, so it cannot run", subsystem.location, "EARL-X011")
+            Diagnostic(
+                Severity.ERROR,
+                f"{engine.name} has no `fsm`, so it cannot run",
+                subsystem.location,
+                "EARL-X011",
+                hint="give it one, naming one of its behaviours: `fsm { initial s  state s: b/bb }`",
+            )
         )
         return
     for state in fsm.states:
