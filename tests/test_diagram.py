@@ -383,3 +383,10 @@ def test_the_only_fsm_is_drawn_without_a_target_in_every_format(capsys: pytest.C
     system = earl.loads(PRIMITIVES_ONLY, "prim.earl")
     assert build_diagram(system, "fsm").header == "stm [FSM] a/a.cs.fsm"
     assert "title: stm [FSM] a/a.cs.fsm" in mermaid_of(Subject(system), "fsm", None)
+
+
+def test_the_fsm_view_shows_what_each_state_waits_for_and_how_long(system: System) -> None:
+    """A state's buffer group (obligatory and optional buffers, timeout) is how it is paced: the
+    diagram, and the document that shows it, say it under the state's behaviour."""
+    drawn = svg_text(build_diagram(system, "fsm", "manip/a.cs").svg())
+    assert "obligatory motorControllerState[*]/ib;" in drawn and "timeout 4 ms" in drawn

@@ -9,8 +9,8 @@ from each state, as the checker and the runtime see it.
 
 from __future__ import annotations
 
-from earl.model.elements import FSM, Subsystem, Transition
-from earl.model.text import expression_text
+from earl.model.elements import FSM, State, Subsystem, Transition
+from earl.model.text import expression_text, literal_text, reference_text
 from earl.render.diagram import Diagram
 from earl.render.dot import Graph, html, wrapped
 from earl.render.names import slug
@@ -26,8 +26,19 @@ def transition_label(transition: Transition) -> str:
     return f"<{text}>"
 
 
-def _state_label(name: str, behaviour: str, subsystem: Subsystem | None, initial: bool) -> str:
+def _state_label(state: State, subsystem: Subsystem | None, initial: bool) -> str:
+    name, behaviour = state.name, state.behaviour
     rows = [f"<tr><td><b>{html(name)}</b></td></tr>", "<hr/>", f"<tr><td>do / {html(behaviour)}/bb</td></tr>"]
+    # the state's buffer group: what its receive waits for, and for how long (FABRIC's buffer groups)
+    group = []
+    if state.obligatory:
+        group.append("obligatory " + ", ".join(reference_text(r) for r in state.obligatory))
+    if state.optional:
+        group.append("optional " + ", ".join(reference_text(r) for r in state.optional))
+    if state.timeout is not None:
+        group.append(f"timeout {literal_text(state.timeout.value)} {state.timeout.unit}")
+    for line in wrapped("; ".join(group), 40) if group else []:
+        rows.append(f'<tr><td><font point-size="9" color="#1f4e79">{html(line)}</font></td></tr>')
     found = subsystem.basic_behaviour(behaviour) if subsystem is not None else None
     if found is not None:
         terminal = wrapped(f"tc: {expression_text(found.terminal_condition.expression)}", 40)
@@ -53,7 +64,7 @@ def fsm_view(fsm: FSM, owner: str, subsystem: Subsystem | None = None, expand: b
     graph.add('initial [shape="circle", style="filled", fillcolor="black", label="", width="0.18", fixedsize="true"];')
     for state in fsm.states:
         names += [state.name, f"{state.behaviour}/bb"]
-        label = _state_label(state.name, state.behaviour, subsystem, state.name == fsm.initial)
+        label = _state_label(state, subsystem, state.name == fsm.initial)
         graph.add(f'{node_id("state", state.name)} [shape="plain", label={label}, tooltip="{html(state.name)}"];')
     if fsm.state_named(fsm.initial) is not None:
         graph.add(f"initial -> {node_id('state', fsm.initial)};")
