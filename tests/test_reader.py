@@ -234,3 +234,30 @@ arm/a {
             )
         (problem,) = refused.value.diagnostics
         assert problem.code == "EARL-R005" and "computed from `GAIN`, a `double`" in problem.message
+
+
+def test_an_undeclared_false_pp_says_how_to_declare_it_or_to_write_the_constant() -> None:
+    text = """\
+system f
+
+a/a {
+    cs {
+        period 1 ms
+        x/m: int = 0
+        f/pf(x/mi -> x/mo)
+        run/bb {
+            tf = {f/pf}
+            tc = false/pp
+        }
+        fsm {
+            initial run
+            state run: run/bb
+        }
+    }
+}
+"""
+    with pytest.raises(earl.EarlError) as refused:
+        earl.loads(text, "f.earl")
+    (problem,) = refused.value.diagnostics
+    assert problem.code == "EARL-R022"
+    assert problem.hint == "declare `false/pp = false`, or write the constant itself: `false`"

@@ -697,6 +697,9 @@ class Resolver:
                         if kind in allowed
                         else f"there is `{reference.name}/{other[0].value}`, but that cannot be {role}"
                     )
+            if hint is None and reference.kind is Kind.PRIMITIVE_PREDICATE and reference.name in ("true", "false"):
+                # the manual's Table 5 writes `false/pp`; its examples declare it first
+                hint = f"declare `{reference.name}/pp = {reference.name}`, or write the constant itself: `{reference.name}`"
             title = KIND_TITLES[
                 Kind.MEMORY if reference.kind in (Kind.MEMORY_INPUT, Kind.MEMORY_OUTPUT) else reference.kind
             ]
