@@ -847,6 +847,11 @@ def test_a_plot_that_cannot_be_drawn_makes_the_run_exit_1(tmp_path: Path) -> Non
         ("manip/a.cs.currentJointPos[9]", "`currentJointPos` has elements 0 to 5 where the signal indexes it, not 9"),
         ("manip/a.cs.windingCurrent[7]", "`windingCurrent` has members 1..6"),
         ("manip/a.cs.currentJointPos.x", "`currentJointPos` has no field `x` where the signal names it"),
+        (
+            "manip/a.motorController[*]/ve.motorControllerState.currentMotorPos",
+            "a signal names one subsystem; name each member of the family: "
+            "`manip/a.motorController[1]/ve.motorControllerState.currentMotorPos`",
+        ),
     ],
 )
 def test_run_plot_refuses_an_index_or_field_the_signal_s_element_lacks_before_the_run(

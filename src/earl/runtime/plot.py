@@ -42,6 +42,17 @@ def memory_to_record(expanded: System, signals: list[str]) -> list[str]:
     for signal in signals:
         owner = next((name for name in longest_first if signal.startswith(name + ".")), None)
         if owner is None:
+            family = re.match(r"(.+?)\[(\*|[A-Za-z_]\w*)\](/[a-z]+)\.(.+)", signal)
+            if family is not None:
+                # `eye[*]/rr.blocked`: a subsystem family is plotted member by member
+                head, kind, rest = family.group(1), family.group(3), family.group(4)
+                members = [n for n in subsystems if re.fullmatch(re.escape(head) + r"\[\d+\]" + re.escape(kind), n)]
+                if members:
+                    listed = ", ".join(f"`{member}.{rest}`" for member in members[:4])
+                    raise ValueError(
+                        f"`{signal}`: a signal names one subsystem; name each member of the family: {listed}"
+                        + (" …" if len(members) > 4 else "")
+                    )
             prefix = signal.rsplit(".", 1)[0]
             suggestion = did_you_mean(prefix, list(subsystems)) or f"a subsystem such as `{next(iter(subsystems), '')}`"
             raise ValueError(f"`{signal}` does not start with a subsystem of this system; {suggestion}")
