@@ -163,6 +163,8 @@ def test_a_failing_function_makes_the_error_condition_true_and_the_fsm_recovers(
         assert "the probe trips on purpose" in fault.traceback
     if kind in ("undeclared-write", "type"):
         assert fault.traceback == ""  # found after the call returned: the message names function and write
+    if kind == "type":  # earl refused what the function wrote: the function raised nothing
+        assert fault.message.startswith("`trip/pf` wrote a value of the wrong type: "), fault.message
     assert [(t, a, b) for t, _, a, b in events.states] == [
         (0, None, "work"),
         (2 * MS, "work", "recover"),

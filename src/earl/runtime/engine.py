@@ -200,7 +200,11 @@ class SubsystemEngine:
         else:
             kind = "exception"
         trace = _user_traceback(raised)
-        self.report_fault(time, kind, f"`{function}/pf` raised {exception_text(error)}", function, trace)
+        if kind == "type":  # raised by earl as the function wrote: the function itself raised nothing
+            said = f"`{function}/pf` wrote a value of the wrong type: {error}"
+        else:
+            said = f"`{function}/pf` raised {exception_text(error)}"
+        self.report_fault(time, kind, said, function, trace)
         # Faults section of docs/semantics.md: the behaviour's error condition becomes true
         self._error_in_iteration = True
 
