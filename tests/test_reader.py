@@ -261,3 +261,26 @@ a/a {
     (problem,) = refused.value.diagnostics
     assert problem.code == "EARL-R022"
     assert problem.hint == "declare `false/pp = false`, or write the constant itself: `false`"
+
+
+def test_a_reversed_link_end_is_said_to_be_reversed_before_a_similar_name_is_suggested() -> None:
+    """`eyes` is an Output Buffer of the destination, and it has an Input Buffer `eye`: the link runs the
+    wrong way, which says more than "did you mean eye?"."""
+    text = """\
+system r
+
+a/a {
+    cs {
+        out/ob: double
+    }
+    d/vr {
+        eye/ib: double
+        eyes/ob: double
+    }
+    link cs,d: cs.out -> d/vr.eyes
+}
+"""
+    with pytest.raises(earl.EarlError) as refused:
+        earl.loads(text, "r.earl")
+    (problem,) = [d for d in refused.value.diagnostics if d.code == "EARL-R054"]
+    assert problem.hint == "`eyes` is an Output Buffer there; a link runs from an Output Buffer to an Input Buffer"

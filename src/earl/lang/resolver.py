@@ -949,9 +949,12 @@ class Resolver:
             return  # the buffer may be the other declaration's: EARL-R002 already says what to fix
         if declared is None:
             other = Kind.INPUT_BUFFER if kind is Kind.OUTPUT_BUFFER else Kind.OUTPUT_BUFFER
-            hint = did_you_mean(end.buffer.name, buffers)
-            if hint is None and end.buffer.name in sub_table.lookup(other):
-                hint = f"`{end.buffer.name}` is an {KIND_TITLES[other]} there; a link runs from an Output Buffer to an Input Buffer"
+            # the buffer there in the other direction says more than a similar name: the link is reversed
+            hint = (
+                f"`{end.buffer.name}` is an {KIND_TITLES[other]} there; a link runs from an Output Buffer to an Input Buffer"
+                if end.buffer.name in sub_table.lookup(other)
+                else did_you_mean(end.buffer.name, buffers)
+            )
             where = f"{table.agent.name}/a.{reference_text(end.subsystem)}"
             self.error(
                 f"`{where}` has no {KIND_TITLES[kind]} `{end.buffer.name}`", end.buffer.location, "EARL-R054", hint
