@@ -1289,3 +1289,13 @@ def test_a_quantifier_whose_body_is_not_boolean_is_said_once_as_written() -> Non
     assert [d.message for d in findings(text, "EARL-E030")] == [
         "the body of `any(K in …: …)` must be a boolean, but `K` is a number"
     ]
+
+
+def test_a_family_of_receptors_off_the_chain_is_said_once_with_its_range() -> None:
+    """Every member is off the chain: one finding names them all (`cam[1..2]/rr`), not the first alone."""
+    text = add(
+        "a4/a {\n    cs {\n        data/ib: double\n    }\n    s/vr {\n        raw/ib: double\n        data/ob: double\n"
+        "    }\n    cam[K in 1..2]/rr {\n        raw/ob: double\n    }\n    link s,cs: s/vr.data -> cs.data\n}\n"
+    )
+    found = findings(text, "EARL-E015")
+    assert [d.message for d in found] == ["`a4/a.cam[1..2]/rr` is not on a chain rr → vr → cs"]

@@ -125,23 +125,15 @@ def _ends_of_chains(links: list[ResolvedLink], middle: Kind, towards_real: bool)
 def effector_chain(context: CheckContext) -> Iterator[Finding]:
     """The commands produced by the Control Subsystem, transformed by a Virtual Effector, must reach every
     Real Effector."""
-    yield from _dedupe(_chain(context, Kind.VIRTUAL_EFFECTOR, Kind.REAL_EFFECTOR, towards_real=True))
+    # every member is said: the family's members that share the problem are merged into one finding
+    # (`motor[1..6]/re`, check/merging.py), where keeping only the first would name `motor[1]` alone
+    yield from _chain(context, Kind.VIRTUAL_EFFECTOR, Kind.REAL_EFFECTOR, towards_real=True)
 
 
 @rule("EARL-E015", Severity.ERROR, "every Real Receptor reports through rr → vr → cs", "§2.3, Figure 7")
 def receptor_chain(context: CheckContext) -> Iterator[Finding]:
     """The data of every Real Receptor passes through a Virtual Receptor to the Control Subsystem."""
-    yield from _dedupe(_chain(context, Kind.VIRTUAL_RECEPTOR, Kind.REAL_RECEPTOR, towards_real=False))
-
-
-def _dedupe(findings: Iterator[Finding]) -> Iterator[Finding]:
-    """Members of one family share a declaration: report each declaration once."""
-    seen: set[tuple[str, object]] = set()
-    for finding in findings:
-        key = (finding.message.split("`")[0], finding.location)
-        if key not in seen:
-            seen.add(key)
-            yield finding
+    yield from _chain(context, Kind.VIRTUAL_RECEPTOR, Kind.REAL_RECEPTOR, towards_real=False)
 
 
 @rule("EARL-W010", Severity.WARNING, "link names join source and destination", "§2.1, §2.5")
