@@ -672,3 +672,35 @@ def test_a_period_built_in_python_that_time_could_not_follow_is_refused(duration
     with pytest.raises(earl.EarlError) as refused:
         earl.simulate(system, check=False)
     assert [(d.code, fragment in d.message) for d in refused.value.diagnostics] == [("EARL-X014", True)]
+
+
+def test_code_that_cannot_be_bound_is_said_once_for_a_family_of_subsystems(tmp_path: Path) -> None:
+    spec = tmp_path / "system.earl"
+    spec.write_text(
+        """\
+system fam
+
+a/a {
+    cs {
+        period 1 ms
+    }
+    m[K in 1..3]/ve {
+        period 1 ms
+        x/m: int = 0
+        f/pf(x/mi -> x/mo) = python "helpers:missing"
+        run/bb {
+            tf = {f/pf}
+            tc = false
+        }
+        fsm {
+            initial run
+            state run: run/bb
+        }
+    }
+}
+"""
+    )
+    (tmp_path / "helpers.py").write_text("def present(inputs, outputs, context):\n    pass\n")
+    with pytest.raises(earl.EarlError) as refused:
+        earl.simulate(earl.load(spec), check=False)
+    assert [d.code for d in refused.value.diagnostics if d.code != "EARL-X011"] == ["EARL-X004"]  # (cs: no fsm)

@@ -156,8 +156,26 @@ def build_network(
     for link in system.links:
         _connect(link, None, keys, network, problems, remote)
     if problems:
-        raise EarlError(problems, system.sources)  # type: ignore[arg-type]
+        raise EarlError(_once_per_binding(problems), system.sources)  # type: ignore[arg-type]
     return network
+
+
+#: the codes of code that cannot be bound: the same spec line fails alike for every member of a family
+_BINDING_CODES = frozenset({"EARL-X002", "EARL-X003", "EARL-X004", "EARL-X005"})
+
+
+def _once_per_binding(problems: list[Diagnostic]) -> list[Diagnostic]:
+    """A binding that fails is said once for its line, not once per member of the family that names it."""
+    seen: set[tuple[str, object]] = set()
+    kept = []
+    for problem in problems:
+        if problem.code in _BINDING_CODES and problem.location is not None:
+            place = (problem.code, (problem.location.file, problem.location.line, problem.location.column))
+            if place in seen:
+                continue
+            seen.add(place)
+        kept.append(problem)
+    return kept
 
 
 def _duration_problem(subsystem: Subsystem) -> tuple[str, SourceLocation | None] | None:
