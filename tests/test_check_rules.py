@@ -1299,3 +1299,11 @@ def test_a_family_of_receptors_off_the_chain_is_said_once_with_its_range() -> No
     )
     found = findings(text, "EARL-E015")
     assert [d.message for d in found] == ["`a4/a.cam[1..2]/rr` is not on a chain rr → vr → cs"]
+
+
+def test_a_link_family_named_otherwise_is_said_as_a_family() -> None:
+    """`link m[K in 1..2],drive: …` into `d[K]/re`: said once, as the family is written, with the index
+    kept in the suggestion (`m[K],d`), not as its first member (`m[1],drive` → `m,d`)."""
+    text = add(FAMILY_AGENT.replace("link m[K in 1..2],d[K]:", "link m[K in 1..2],drive:"))
+    found = [d.message for d in findings(text, "EARL-W010") if "drive" in d.message]
+    assert found == ["link `m[K],drive` is not named after its ends; §2.5 suggests `m[K],d`"]

@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from operator import attrgetter
 
 from earl.check.context import CheckContext, ResolvedLink, instance_name, subsystem_name
 from earl.check.registry import Finding, rule
 from earl.diagnostics import Severity
+from earl.model.elements import LinkNamePart
 from earl.model.kinds import KIND_TITLES, Kind
 from earl.model.tables import PERMITTED_LINKS, permitted_link
 from earl.model.types import type_text
@@ -149,11 +150,22 @@ def link_names(context: CheckContext) -> Iterator[Finding]:
             expected = [link.source_subsystem.name, link.destination_subsystem.name]
         if parts != expected and id(link.link.location) not in reported:
             reported.add(id(link.link.location))
+            name, suggested = link.link.name_text, f"{expected[0]},{expected[1]}"
+            family = link.link.family
+            if family is not None and len(expected) == len(link.link.name):
+                # a member of a link family: said as the family is written, its index kept on the indexed side
+                name = _family_link_name(parts, link.link.name, family.index)
+                suggested = _family_link_name(expected, link.link.name, family.index)
             yield Finding(
-                f"link `{link.link.name_text}` is not named after its ends; §2.5 suggests `{expected[0]},{expected[1]}`",
+                f"link `{name}` is not named after its ends; §2.5 suggests `{suggested}`",
                 link.link.location,
                 None,
             )
+
+
+def _family_link_name(names: list[str], parts: Iterable[LinkNamePart], index: str) -> str:
+    """`eye[K],detector`: the names of a link family's ends, the index on the side that has one."""
+    return ",".join(f"{n}[{index}]" if part.index is not None else n for n, part in zip(names, parts, strict=True))
 
 
 @rule("EARL-E016", Severity.ERROR, "a subsystem never waits for ever", "§2.2, Figure 5b")
