@@ -329,3 +329,15 @@ def test_a_value_of_the_wrong_type_in_a_model_built_in_python_is_named_where_it_
         check(system)
     system, _ = counter()
     assert system.to_earl() and not [d for d in check(system) if d.severity.name == "ERROR"]
+
+
+def test_a_data_type_given_as_a_string_in_python_is_said_where_it_is_declared() -> None:
+    from earl.check import check
+
+    system = earl.load(Path(__file__).parent.parent / "examples" / "pick_and_place")
+    buffer = system.agent("manip").control_subsystem.input_buffers[0]  # type: ignore[union-attr]
+    buffer.data_type = "ManipulatorCommand"  # type: ignore[assignment]
+    first = check(system)[0]
+    assert first.code == "EARL-R012" and first.message == "`ManipulatorCommand` is not a data type"
+    assert first.hint == 'write `PrimitiveType("ManipulatorCommand")` or `TypeReference("ManipulatorCommand")`'
+    assert first.location == buffer.location

@@ -285,9 +285,9 @@ class Resolver:
                             names[member.name].location,
                         )
                     names[member.name] = member
-                    self.data_type(member.data_type, scope)
+                    self.data_type(member.data_type, scope, member.location)
             else:
-                self.data_type(definition.data_type, scope)
+                self.data_type(definition.data_type, scope, definition.location)
         self._type_cycles()
 
     def _type_cycles(self) -> None:
@@ -327,7 +327,8 @@ class Resolver:
                         visited.add(child)
                         stack.append((child, [*path, child]))
 
-    def data_type(self, data_type: DataType, scope: Scope) -> None:
+    def data_type(self, data_type: DataType, scope: Scope, where: SourceLocation | None = None) -> None:
+        """`where`: the declaration that holds it, for a value that has no location of its own."""
         if isinstance(data_type, TypeReference):
             if data_type.name not in self.types:
                 self.error(
@@ -338,13 +339,24 @@ class Resolver:
                     or "declare it with `struct` or `type`, or import the file that does",
                 )
         elif isinstance(data_type, ArrayType):
-            self.data_type(data_type.element, scope)
+            self.data_type(data_type.element, scope, where)
             if data_type.size is not None:
                 size = self.constant_integer(data_type.size, scope, "an array size")
                 if size is not None and size < 0:
                     self.error(
                         f"an array size must not be negative, here it is {size}", data_type.size.location, "EARL-R013"
                     )
+        elif not isinstance(data_type, PrimitiveType):
+            # only a model built in Python can hold this (`data_type="double"`); the reader makes types
+            written = f"`{data_type}`" if isinstance(data_type, str) else type(data_type).__name__
+            self.error(
+                f"{written} is not a data type",
+                where,
+                "EARL-R012",
+                f'write `PrimitiveType("{data_type}")` or `TypeReference("{data_type}")`'
+                if isinstance(data_type, str)
+                else "a data type is a PrimitiveType, a TypeReference or an ArrayType",
+            )
 
     def structural_type(self, data_type: DataType) -> DataType | StructType | None:
         """The type behind aliases: a primitive, an array or a struct; None when unknown."""
@@ -530,7 +542,7 @@ class Resolver:
                 names[element.name] = _Declared(element, family)
                 self._count_expanded(subsystems * _size(family), element.location)
                 if hasattr(element, "data_type"):
-                    self.data_type(element.data_type, scope)
+                    self.data_type(element.data_type, scope, element.location)
         return table
 
     def _agent_body(self, table: _AgentTable) -> None:
