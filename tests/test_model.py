@@ -327,6 +327,14 @@ def test_a_value_of_the_wrong_type_in_a_model_built_in_python_is_named_where_it_
     cs.fsm.states[0].behaviour = ElementReference("count", Kind.BASIC_BEHAVIOUR)
     with pytest.raises(ModelTypeError, match=r"\.fsm\.states\[0\]\.behaviour: expected str, got ElementReference"):
         check(system)
+    system, cs = counter()
+    cs.fsm.initial = None  # printed, it would read `initial None`: another spec
+    with pytest.raises(ModelTypeError, match=r"\.fsm\.initial: expected str, got NoneType"):
+        system.to_earl()
+    system, _ = counter()
+    system.links.append("x")  # would be left out of the text without a word
+    with pytest.raises(ModelTypeError, match=r"system\.links\[0\]: expected Link, got str"):
+        system.to_earl()
     system, _ = counter()
     assert system.to_earl() and not [d for d in check(system) if d.severity.name == "ERROR"]
 

@@ -146,6 +146,8 @@ def format_system(system: System) -> str:
             _agent(printer, declaration)
         elif isinstance(declaration, Link):
             _link(printer, 0, declaration)
+        else:  # a model built in Python: never dropped without a word (System.to_earl says where)
+            raise TypeError(f"not a declaration of a system: {declaration!r}")
     if system.comments.closing:
         printer.blank()
         for comment in system.comments.closing:
@@ -305,6 +307,8 @@ def _basic_behaviour(printer: _Printer, depth: int, behaviour: BasicBehaviour) -
 
 def _fsm(printer: _Printer, depth: int, fsm: FSM) -> None:
     printer.line(depth, "fsm {", fsm.comments)
+    if not isinstance(fsm.initial, str):  # a model built in Python: `initial None` would read back otherwise
+        raise TypeError(f"the initial state is {fsm.initial!r}, not a name")
     printer.line(depth + 1, f"initial {fsm.initial}")
     for state in fsm.states:
         _state(printer, depth + 1, state)
