@@ -23,7 +23,7 @@ from earl.model.elements import (
     Parameter,
     Subsystem,
     System,
-    duration_problem,
+    duration_problems,
 )
 from earl.model.expressions import (
     BUILTIN_FUNCTIONS,
@@ -609,17 +609,11 @@ class Resolver:
             self.expression(behaviour.terminal_condition.expression, table, scope, owner)
             if behaviour.error_condition is not None:
                 self.expression(behaviour.error_condition.expression, table, scope, owner)
-        durations = [("the period", subsystem.period, subsystem.location)]
         if subsystem.fsm is not None:
             self._fsm(subsystem.fsm, table, scope, owner)
-            durations += [
-                (f"the timeout of state `{state.name}`", state.timeout, state.location)
-                for state in subsystem.fsm.states
-            ]
-        for what, duration, location in durations:
-            wrong = None if duration is None else duration_problem(duration)
-            if wrong is not None:  # the reader refuses such a duration; a model built in Python may hold one
-                self.error(f"{what} of `{owner}` {wrong}", location, "EARL-S012")
+        # the reader refuses such a duration; a model built in Python may hold one
+        for what, wrong, location in duration_problems(subsystem):
+            self.error(f"{what} of `{owner}` {wrong}", location, "EARL-S012")
 
     def _fsm(self, fsm: FSM, table: _SubsystemTable, scope: Scope, owner: str) -> None:
         states: dict[str, Any] = {}

@@ -47,6 +47,22 @@ class Duration:
         return self.value * self.UNITS[self.unit]
 
 
+def duration_problems(subsystem: Subsystem) -> list[tuple[str, str, SourceLocation | None]]:
+    """`(what, problem, where)` for the subsystem's period and each state's timeout that
+    `duration_problem` refuses: `("the period", "is -2 ms; it must be …", location)`."""
+    durations = [("the period", subsystem.period, subsystem.location)]
+    if subsystem.fsm is not None:
+        durations += [
+            (f"the timeout of state `{state.name}`", state.timeout, state.location) for state in subsystem.fsm.states
+        ]
+    found = []
+    for what, duration, location in durations:
+        problem = None if duration is None else duration_problem(duration)
+        if problem is not None:
+            found.append((what, problem, location))
+    return found
+
+
 def duration_problem(duration: object) -> str | None:
     """What keeps `duration` from being a period or timeout, in words, or None: a unit other than
     `s`, `ms`, `us`, no number, or a length under 1 ns (time is kept in whole nanoseconds) or over

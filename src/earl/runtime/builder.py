@@ -13,10 +13,9 @@ from pathlib import Path
 from typing import Any, Protocol
 
 from earl.diagnostics import Diagnostic, EarlError, Severity
-from earl.model.elements import Agent, Link, LinkEnd, PrimitivePredicate, Subsystem, System, duration_problem
+from earl.model.elements import Agent, Link, LinkEnd, PrimitivePredicate, Subsystem, System, duration_problems
 from earl.model.expressions import ElementReference, Literal, Read
 from earl.model.kinds import Kind
-from earl.model.location import SourceLocation
 from earl.model.types import DataType
 from earl.runtime.binding import (
     PREDICATE_SIGNATURE,
@@ -112,13 +111,14 @@ def build_network(
                 agent_parameters[agent.family.index] = agent.index
             agent_parameters.update({p.name: _value(p.value) for p in agent.parameters})
             for subsystem in agent.subsystems:
-                wrong = _duration_problem(subsystem)
-                if wrong is not None:  # a model built in Python, where the reader's S012 never looked
+                wrong = duration_problems(subsystem)
+                if wrong:  # a model built in Python, where the reader's S012 never looked
+                    what, problem, location = wrong[0]
                     problems.append(
                         Diagnostic(
                             Severity.ERROR,
-                            f"{subsystem_name(agent, subsystem)} cannot run: {wrong[0]}",
-                            wrong[1] or subsystem.location,
+                            f"{subsystem_name(agent, subsystem)} cannot run: {what} {problem}",
+                            location or subsystem.location,
                             code="EARL-X014",
                         )
                     )
@@ -176,20 +176,6 @@ def _once_per_binding(problems: list[Diagnostic]) -> list[Diagnostic]:
             seen.add(place)
         kept.append(problem)
     return kept
-
-
-def _duration_problem(subsystem: Subsystem) -> tuple[str, SourceLocation | None] | None:
-    """What is wrong with the subsystem's period or a state's timeout, where time could not advance."""
-    durations = [("period", subsystem.period, subsystem.location)]
-    if subsystem.fsm is not None:
-        durations += [
-            (f"the timeout of state `{state.name}`", state.timeout, state.location) for state in subsystem.fsm.states
-        ]
-    for what, duration, location in durations:
-        wrong = None if duration is None else duration_problem(duration)
-        if wrong is not None:
-            return f"{what} {wrong}", location
-    return None
 
 
 def _value(expression: Any) -> Any:
