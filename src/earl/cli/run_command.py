@@ -229,12 +229,11 @@ def _run(arguments: argparse.Namespace) -> int:
         if arguments.plot:
             # what the plot draws is recorded, and a signal the system does not have is said now
             from earl.model.expand import expand
-            from earl.runtime.plot import memory_to_record, outputs_to_record
+            from earl.runtime.plot import what_to_record
 
             try:
                 expanded = expand(system, parameters)
-                plotted = memory_to_record(expanded, list(signals or []))
-                plotted_outputs = outputs_to_record(expanded, list(signals or []))
+                plotted, plotted_outputs = what_to_record(expanded, list(signals or []))
             except ValueError as error:
                 _close(transport)
                 return usage_error(f"--signal {error}")

@@ -32,13 +32,15 @@ def plot_output_problem(output: Path) -> str | None:
     return None
 
 
-def memory_to_record(expanded: System, signals: list[str]) -> list[str]:
-    """The subsystems whose memory `signals` name, which a run that plots them must record; a
-    `ValueError` saying why for a signal that names no memory or output buffer of the system, found
-    before the run rather than after it (`earl run --plot`)."""
+def what_to_record(expanded: System, signals: list[str]) -> tuple[list[str], list[str]]:
+    """What a run that plots `signals` must record: the subsystems whose memory they name, and the
+    output buffers (`manip/a.cs.manipulatorState`) whose links carry the values they name
+    (`Simulation(record_outputs=…)`). A `ValueError` saying why for a signal that names no memory or
+    output buffer of the system, found before the run rather than after it (`earl run --plot`)."""
     subsystems = {subsystem_name(a, s): s for a in expanded.agents for s in a.subsystems}
     longest_first = sorted(subsystems, key=len, reverse=True)
     record: list[str] = []
+    sending: list[str] = []
     for signal in signals:
         owner = next((name for name in longest_first if signal.startswith(name + ".")), None)
         if owner is None:
@@ -62,7 +64,9 @@ def memory_to_record(expanded: System, signals: list[str]) -> list[str]:
         outputs = sorted({o.name for o in subsystem.output_buffers})
         if element in memories:
             record.append(owner)
-        elif element not in outputs:  # an output buffer's values are the messages on its links
+        elif element in outputs:  # an output buffer's values are the messages on its links
+            sending.append(f"{owner}.{element}")
+        else:
             hint = did_you_mean(element, [*memories, *outputs])
             known = ", ".join(f"`{name}`" for name in dict.fromkeys([*memories, *outputs])) or "none"
             raise ValueError(
@@ -72,23 +76,7 @@ def memory_to_record(expanded: System, signals: list[str]) -> list[str]:
         problem = _path_problem(expanded, subsystem, element, signal[len(owner) + 1 + len(element) :])
         if problem is not None:
             raise ValueError(f"`{signal}`: {problem}")
-    return sorted(set(record))
-
-
-def outputs_to_record(expanded: System, signals: list[str]) -> list[str]:
-    """The output buffers (`manip/a.cs.manipulatorState`) `signals` name, whose links a run that plots
-    them must record (`Simulation(record_outputs=…)`); signals are checked by `memory_to_record`."""
-    subsystems = {subsystem_name(a, s): s for a in expanded.agents for s in a.subsystems}
-    longest_first = sorted(subsystems, key=len, reverse=True)
-    found: set[str] = set()
-    for signal in signals:
-        owner = next((name for name in longest_first if signal.startswith(name + ".")), None)
-        if owner is None:
-            continue
-        element = signal_element(signal[len(owner) + 1 :])
-        if element in {o.name for o in subsystems[owner].output_buffers}:
-            found.add(f"{owner}.{element}")
-    return sorted(found)
+    return sorted(set(record)), sorted(set(sending))
 
 
 _STEP = re.compile(r"\[(\*|\d+)\]|\.([A-Za-z_]\w*)")
