@@ -521,6 +521,23 @@ def test_the_environment_takes_n_from_the_expanded_spec_and_the_box_from_the_see
         joints_of(SimpleNamespace(parameters=[]))
 
 
+def test_an_environment_built_for_another_arm_is_said_by_every_drive_not_run_silently() -> None:
+    from pick_and_place.environment import PickAndPlaceEnvironment
+
+    import earl
+
+    system = earl.load(Path(__file__).resolve().parent.parent / "examples" / "pick_and_place" / "system.earl", {"N": 3})
+    simulation = earl.simulate(system, environment=PickAndPlaceEnvironment(6, 0))
+    try:
+        simulation.advance_to(0.004)
+        drives = {fault.subsystem for fault in simulation.faults}
+        assert drives == {f"manip/a.motor[{joint}]/re" for joint in (1, 2, 3)} | {"grip/a.fingerDrive/re"}
+        raised = [fault for fault in simulation.faults if fault.kind == "exception"]
+        assert raised and all("arm of N=3 joints, but the environment was built for N=6" in f.message for f in raised)
+    finally:
+        simulation.close()
+
+
 def test_placement_measures_the_box_against_the_target() -> None:
     from pick_and_place.environment import PickAndPlaceEnvironment
 

@@ -937,3 +937,20 @@ def test_a_trace_cut_before_its_first_whole_record_says_so(tmp_path: Path) -> No
         summary = earl_cli("trace", "summary", str(cut))
         assert summary.returncode == 1
         assert "cut short (or damaged) before its first whole record" in summary.stderr, summary.stderr
+
+
+def test_the_faults_are_counted_by_kind_so_that_more_faults_than_iterations_is_explained(tmp_path: Path) -> None:
+    """A function that raises at every iteration stops its behaviour each time, and the state may find no
+    transition: the closing line and `earl trace summary` count each kind, as docs/semantics.md names them."""
+    spec = counter_whose_increment_then(tmp_path, "    raise RuntimeError('the counter is broken')\n")
+    trace = tmp_path / "run.mcap"
+    result = earl_cli("run", str(spec), "--duration", "20ms", "--trace", str(trace))
+    assert result.returncode == 0, result.stderr
+    found = re.search(
+        r"(\d+) fault\(s\) \((\d+) exception, (\d+) no-transition; docs/semantics.md, Faults\)", result.stdout
+    )
+    assert found, result.stdout
+    total, raised, stuck = map(int, found.groups())
+    assert total == raised + stuck and raised > stuck >= 1
+    summary = earl_cli("trace", "summary", str(trace))
+    assert f"{total} faults ({raised} exception, {stuck} no-transition)" in summary.stdout, summary.stdout

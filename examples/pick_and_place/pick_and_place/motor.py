@@ -25,6 +25,17 @@ def _plant(context: Any) -> Any:
             f"{context.subsystem} drives a simulated motor and needs the MuJoCo environment: run with "
             '`environment = "pick_and_place.environment:make_environment"` (examples/pick_and_place/run.toml)'
         )
+    joints = context.parameters.get("N")
+    built_for = getattr(environment, "n", joints)
+    if joints is not None and built_for != joints:
+        # a hand-made environment for another arm: its other joints would hang unpowered and the run
+        # would fail to place the box with no word of why
+        raise NoPlant(
+            f"{context.subsystem} drives joint motors of an arm of N={joints} joints, but the environment "
+            f"was built for N={built_for}: build it from the system this run runs "
+            "(pick_and_place.environment.make_environment(expanded_system, seed)) or pass N to "
+            "PickAndPlaceEnvironment"
+        )
     return environment.plant
 
 

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import re
 import sys
+from collections import Counter
+from collections.abc import Iterable
 from pathlib import Path
 
 from earl.lang.loader import ParameterValue, locate_spec
@@ -116,3 +118,11 @@ def watch_supervisor() -> None:
         os.kill(os.getpid(), signal.SIGTERM)
 
     threading.Thread(target=watch, name="earl-supervisor-watch", daemon=True).start()
+
+
+def fault_kinds(kinds: Iterable[str]) -> str:
+    """`88 exception, 4 no-transition`: how many faults of each kind, most first.  A subsystem's
+    faults can outnumber its iterations (two functions that raise in one iteration are two faults,
+    and the behaviour they stop may then find no transition), which the counts by kind make plain."""
+    counts = Counter(kinds)
+    return ", ".join(f"{count} {kind}" for kind, count in sorted(counts.items(), key=lambda item: (-item[1], item[0])))

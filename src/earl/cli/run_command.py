@@ -19,7 +19,7 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 from rich.text import Text
 
-from earl.cli.common import UsageError, brief, parse_parameters, spec_path, usage_error
+from earl.cli.common import UsageError, brief, fault_kinds, parse_parameters, spec_path, usage_error
 from earl.cli.output import print_diagnostics
 from earl.diagnostics import EarlError
 from earl.transport.deployment import DeploymentError
@@ -527,7 +527,11 @@ def _summary(simulation: Any, wall: float, arguments: argparse.Namespace) -> Non
     console.print(table)
     faults = simulation.faults
     if faults:
-        console.print(Text.assemble((f"{len(faults)} fault(s)", "yellow"), "; the first:"))
+        kinds = fault_kinds(fault.kind for fault in faults)
+        console.print(
+            Text.assemble((f"{len(faults)} fault(s)", "yellow"), f" ({kinds}; docs/semantics.md, Faults); the first:"),
+            soft_wrap=True,
+        )
         first = faults[0]
         console.print(
             f"  t={first.time / 1e9:.6f} s {first.subsystem} ({first.kind}): {brief(first.message)}", soft_wrap=True

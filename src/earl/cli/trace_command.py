@@ -10,7 +10,7 @@ from typing import Any
 from rich.console import Console
 from rich.table import Table
 
-from earl.cli.common import brief, usage_error
+from earl.cli.common import brief, fault_kinds, usage_error
 
 EXIT_OK, EXIT_FAILED = 0, 1
 
@@ -88,7 +88,8 @@ def run_summary(arguments: argparse.Namespace) -> int:
             f"the trace ends at {end:.3f} s without the run's end (the run was killed): what it holds is whole, "
             "but the iteration counts, written at the end, are not known"
         )
-    console.print(f"{summary.messages} messages on links, {len(summary.faults)} faults")
+    kinds = f" ({fault_kinds(str(fault['kind']) for fault in summary.faults)})" if summary.faults else ""
+    console.print(f"{summary.messages} messages on links, {len(summary.faults)} faults{kinds}")
     for fault in summary.faults[:10]:
         console.print(
             f"  t={fault['time'] * 1e-9:.6f} s {fault['subsystem']} ({fault['kind']}): {brief(str(fault['message']))}",
