@@ -954,3 +954,21 @@ def test_the_faults_are_counted_by_kind_so_that_more_faults_than_iterations_is_e
     assert total == raised + stuck and raised > stuck >= 1
     summary = earl_cli("trace", "summary", str(trace))
     assert f"{total} faults ({raised} exception, {stuck} no-transition)" in summary.stdout, summary.stdout
+
+
+def test_the_closing_table_written_to_a_pipe_is_not_cut_to_80_columns() -> None:
+    """A log has no screen to fit: the real-time table's seven columns, cut to 80, broke states and
+    figures over several lines (`opera` / `te`)."""
+    environment = {name: value for name, value in os.environ.items() if name != "COLUMNS"}
+    result = subprocess.run(
+        [*EARL, "run", str(SPECS / "counter"), "--realtime", "--duration", "30ms"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+        env=environment,
+    )
+    assert result.returncode == 0, result.stderr
+    rows = [line for line in result.stdout.splitlines() if "counter/a.relay/ve" in line]
+    assert len(rows) == 1 and re.search(r"\d+ µs / \d+ µs", rows[0]), result.stdout
+    assert any("start lateness p50 / p99" in line for line in result.stdout.splitlines())

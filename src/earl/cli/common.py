@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import os
 import re
 import sys
 from collections import Counter
 from collections.abc import Iterable
 from pathlib import Path
+
+from rich.console import Console
 
 from earl.lang.loader import ParameterValue, locate_spec
 
@@ -126,3 +129,16 @@ def fault_kinds(kinds: Iterable[str]) -> str:
     and the behaviour they stop may then find no transition), which the counts by kind make plain."""
     counts = Counter(kinds)
     return ", ".join(f"{count} {kind}" for kind, count in sorted(counts.items(), key=lambda item: (-item[1], item[0])))
+
+
+#: the width of a table written to a file or a pipe: a log has no screen to fit, and Rich's default of
+#: 80 columns cut the run's table into cells like `opera` / `te`
+UNBOUNDED_TABLE_WIDTH = 200
+
+
+def table_console() -> Console:
+    """A console for the closing tables: the terminal's width on a terminal, a wide one in a file."""
+    console = Console(highlight=False, markup=False)  # names and messages are the spec's text, not markup
+    if not console.is_terminal and "COLUMNS" not in os.environ:
+        console.width = UNBOUNDED_TABLE_WIDTH
+    return console

@@ -19,7 +19,7 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 from rich.text import Text
 
-from earl.cli.common import UsageError, brief, fault_kinds, parse_parameters, spec_path, usage_error
+from earl.cli.common import UsageError, brief, fault_kinds, parse_parameters, spec_path, table_console, usage_error
 from earl.cli.output import print_diagnostics
 from earl.diagnostics import EarlError
 from earl.transport.deployment import DeploymentError
@@ -497,7 +497,7 @@ def _advance(
 
 
 def _summary(simulation: Any, wall: float, arguments: argparse.Namespace) -> None:
-    console = Console(highlight=False, markup=False)
+    console = table_console()
     table = Table(title=f"system {simulation.system.name}: {simulation.time:.3f} s", title_justify="left")
     # names in full: the members of a family differ only at their end (`manip/a.motorController[3]/ve`)
     longest = max((len(name) for name in simulation.subsystems), default=9)

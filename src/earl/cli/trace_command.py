@@ -7,10 +7,9 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from rich.console import Console
 from rich.table import Table
 
-from earl.cli.common import brief, fault_kinds, usage_error
+from earl.cli.common import brief, fault_kinds, table_console, usage_error
 
 EXIT_OK, EXIT_FAILED = 0, 1
 
@@ -62,7 +61,7 @@ def run_summary(arguments: argparse.Namespace) -> int:
     except TraceError as error:
         sys.stderr.write(f"earl trace: {error}\n")
         return EXIT_FAILED
-    console = Console(highlight=False, markup=False)  # fault messages are the spec's code's text
+    console = table_console()
     end = summary.end_time * 1e-9
     settings = ", ".join(f"{k}={v}" for k, v in summary.settings.items())
     table = Table(title=f"{path.name}: {end:.3f} s ({settings})", title_justify="left")
