@@ -402,3 +402,51 @@ def test_an_output_buffer_read_as_an_attribute_before_it_is_written_is_told_to_k
         import sys
 
         sys.modules.pop("sharing", None)
+
+
+FLOAT32_MAX = 3.4028234663852886e38
+
+
+def test_a_float32_holds_what_single_precision_holds_in_every_form_of_value() -> None:
+    """Values are kept at double precision, but a finite value beyond float32's range is refused, as an
+    integer out of range is: scalars, struct fields and arrays (short and long, and a double[] array the
+    runtime checked before), through the quick tests and the full check alike; an infinity passes."""
+    from earl.model.expressions import Literal
+    from earl.model.types import ArrayType, PrimitiveType, TypeReference
+    from earl.runtime.values import TypeSystem, ValueTypeError
+
+    system = earl.loads("system s\nstruct Pose {\n    x: float32\n    y: double\n}\n")
+    types = TypeSystem(system)
+    scalar = types.coercer(PrimitiveType("float32"), "x/mo")
+    pose = types.coercer(TypeReference("Pose"), "p/mo")
+    short = types.coercer(ArrayType(PrimitiveType("float32"), Literal(3)), "a/mo")
+    long = types.coercer(ArrayType(PrimitiveType("float32"), Literal(20)), "b/mo")
+    doubles = types.coercer(ArrayType(PrimitiveType("double"), Literal(3)), "d/mo")
+    big = FLOAT32_MAX * 2
+    assert scalar(FLOAT32_MAX) == FLOAT32_MAX and scalar(-1.5) == -1.5 and scalar(3) == 3.0
+    assert scalar(math.inf) == math.inf and pose({"x": -math.inf, "y": 1e300})["x"] == -math.inf
+    assert short([1.0, math.inf, -FLOAT32_MAX]) == (1.0, math.inf, -FLOAT32_MAX)
+    refusals = [
+        (scalar, big, "x/mo = 6.805646932770577e+38 does not fit float32 (at most ±3.4028235e+38"),
+        (scalar, -(10**39), "does not fit float32"),
+        (pose, {"x": big, "y": 0.0}, "p/mo.x = 6.805646932770577e+38 does not fit float32"),
+        (short, [0.0, 0.0, big], "a/mo[2] = 6.805646932770577e+38 does not fit float32"),
+        (long, [0.0] * 19 + [-big], "does not fit float32"),
+        (short, doubles([1.0, big, 0.0]), "a/mo[1] = 6.805646932770577e+38 does not fit float32"),
+    ]
+    for coerce, value, message in refusals:
+        with pytest.raises(ValueTypeError) as refused:
+            coerce(value)
+        assert message in str(refused.value)
+    assert doubles([big, 0.0, 0.0]) == (big, 0.0, 0.0)  # a double holds it
+
+
+def test_a_float32_initial_value_or_parameter_beyond_its_range_is_refused_by_the_checker() -> None:
+    text = "system s\nr/a {\n    cs {\n        period 1 ms\n        x/m: float32 = 1e300\n        y/m: float32 = -3e38\n    }\n}\n"
+    found = [(d.code, d.location.line if d.location else 0) for d in earl.check.check(earl.loads(text))]
+    assert ("EARL-E043", 5) in found and ("EARL-E043", 6) not in found, found
+    with pytest.raises(earl.EarlError) as refused:
+        earl.loads("system s\nparam G: float32 = 1e39\n")
+    assert "parameter `G` is `float32` but its value 1e+39 does not fit it (at most ±3.4028235e+38" in str(
+        refused.value
+    )

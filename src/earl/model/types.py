@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 from earl.model.expressions import Expression
@@ -43,6 +44,11 @@ INTEGER_RANGES: dict[str, tuple[int, int]] = {
 #: The primitive types of real numbers: a whole number given for one is that real (`3` is `3.0`).
 REAL_TYPES: frozenset[str] = frozenset({"double", "float32", "float64"})
 
+#: The largest finite magnitude of each real type narrower than a double.  Values are held at double
+#: precision whatever the type; a finite value beyond its type's range is refused as an integer out of
+#: range is (an infinity, which IEEE 754 single precision has too, is not).
+REAL_LIMITS: dict[str, float] = {"float32": 3.4028234663852886e38}
+
 #: The types a `param` may have, and the Python values each accepts (a boolean is no number here).
 PARAMETER_TYPES: dict[str, tuple[type, ...]] = {
     "boolean": (bool,),
@@ -66,9 +72,17 @@ def parameter_value_problem(type_name: str, value: object) -> str | None:
             return f"its value {_briefly(value)} does not fit it ({low}..{high})"
     if isinstance(value, float) and value != value:
         return "its value is NaN (not a number), which no computation or export can use"
+    if type_name in REAL_LIMITS and isinstance(value, (int, float)) and not real_fits(type_name, float(value)):
+        return f"its value {_briefly(value)} does not fit it (at most ±{REAL_LIMITS[type_name]:.8g}; infinity may be)"
     if isinstance(value, str) and lone_surrogate(value) is not None:
         return f"its value {_briefly(value)} is not text (it holds a lone surrogate, from undecodable bytes)"
     return None
+
+
+def real_fits(type_name: str, value: float) -> bool:
+    """Whether a real (not NaN) is within its type's range: any float is a double, an infinity any real."""
+    limit = REAL_LIMITS.get(type_name)
+    return limit is None or -limit <= value <= limit or value in (math.inf, -math.inf)
 
 
 def lone_surrogate(text: str) -> int | None:

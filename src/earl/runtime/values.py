@@ -25,6 +25,7 @@ from earl.model.expressions import Arithmetic, ConstantError, ListLiteral, Liter
 from earl.model.location import SourceLocation
 from earl.model.types import (
     INTEGER_RANGES,
+    REAL_LIMITS,
     ArrayType,
     DataType,
     PrimitiveType,
@@ -32,6 +33,7 @@ from earl.model.types import (
     TypeAlias,
     TypeReference,
     lone_surrogate,
+    real_fits,
     type_text,
 )
 from earl.runtime.codegen import compiled
@@ -96,11 +98,15 @@ class QuickTest:
     low: int = 0
     high: int = 0
     size: int | None = None
+    #: the largest magnitude of a real type narrower than a double (float32), tested too
+    real_limit: float | None = None
 
     def lines(self, value: str, slow: str) -> list[str]:
         """Python lines leaving the variable `value` checked; `slow(value)` is called only when the test fails."""
         if self.kind == "real":
             test = f"type({value}) is float and {value} == {value}"  # not NaN
+            if self.real_limit is not None:  # NaN fails the comparisons too; an infinity is left to `slow`
+                test = f"type({value}) is float and {-self.real_limit!r} <= {value} <= {self.real_limit!r}"
         elif self.kind == "boolean":
             test = f"type({value}) is bool"
         elif self.kind == "integer":
@@ -116,11 +122,18 @@ class QuickTest:
                 floats = "".join(f" and type({value}[{index}]) is float" for index in range(self.size))
             else:
                 floats = f" and only_floats(map(type, {value}))"
+            # Reals checked as a double[] are not yet within a float32's range: tested again
+            in_range = (
+                "" if self.real_limit is None else f" and max(map(abs, {value}), default=0.0) <= {self.real_limit!r}"
+            )
+            trusted = (
+                "" if self.real_limit is None else f" or max(map(abs, {value}), default=0.0) > {self.real_limit!r}"
+            )
             return [
-                f"if type({value}) is not Reals{wrong_size}:",
+                f"if type({value}) is not Reals{wrong_size}{trusted}:",
                 f"    if not {sequence} and getattr({value}, 'ndim', None) == 1:",
                 f"        {value} = {value}.tolist()",
-                f"    if {sequence}{size}{floats} and (total := sum({value})) == total:",
+                f"    if {sequence}{size}{floats} and (total := sum({value})) == total{in_range}:",
                 f"        {value} = new_tuple(Reals, {value})",
                 "    else:",
                 f"        {value} = {slow}({value})",
@@ -278,14 +291,16 @@ class TypeSystem:
         resolved = self.resolve(data_type)
         if isinstance(resolved, PrimitiveType):
             if resolved.name in _REAL_TYPES:
-                return QuickTest("real")
+                return QuickTest("real", real_limit=REAL_LIMITS.get(resolved.name))
             if resolved.name == "boolean":
                 return QuickTest("boolean")
             if resolved.name in INTEGER_RANGES:
                 low, high = INTEGER_RANGES[resolved.name]
                 return QuickTest("integer", low, high)
         if isinstance(resolved, ArrayType) and self._holds_reals(resolved):
-            return QuickTest("real_array", size=_fixed_size(resolved))
+            element = self.resolve(resolved.element)
+            limit = REAL_LIMITS.get(element.name) if isinstance(element, PrimitiveType) else None
+            return QuickTest("real_array", size=_fixed_size(resolved), real_limit=limit)
         return None
 
     def record_class(self, struct: str, fields: Iterable[str] = ()) -> type[Record]:
@@ -329,7 +344,10 @@ class TypeSystem:
             resolved = self.resolve(field.data_type)
             primitive = resolved.name if isinstance(resolved, PrimitiveType) else None
             test: str
-            if primitive in _REAL_TYPES:
+            if primitive in REAL_LIMITS:  # NaN fails the comparisons too; an infinity goes to `slow`
+                limit = REAL_LIMITS[primitive]
+                test = f"type({variable}) is float and {-limit!r} <= {variable} <= {limit!r}"
+            elif primitive in _REAL_TYPES:
                 test = f"type({variable}) is float and {variable} == {variable}"
             elif primitive == "boolean":
                 test = f"type({variable}) is bool"
@@ -437,6 +455,10 @@ def _coerce_primitive(value: Any, name: str, where: str) -> Value:
             raise ValueTypeError(f"{where} = {_shown(value)} is too large for a {name}") from None
         if math.isnan(result):
             raise ValueTypeError(f"{where} is NaN (not a number): a computation went wrong upstream")
+        if not real_fits(name, result):
+            raise ValueTypeError(
+                f"{where} = {_shown(value)} does not fit {name} (at most ±{REAL_LIMITS[name]:.8g}; infinity may be)"
+            )
         return result
     if name in INTEGER_RANGES:
         if isinstance(value, bool) or not isinstance(value, int):
