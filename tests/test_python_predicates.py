@@ -157,6 +157,24 @@ def test_a_predicate_that_raises_is_one_fault_per_decision(tmp_path: Path) -> No
         sim.close()
 
 
+def test_a_predicate_that_raises_in_the_error_and_the_terminal_condition_is_one_fault(tmp_path: Path) -> None:
+    """The error condition asks it first and records the fault; the terminal condition, in the same decision,
+    finds it failed and counts it false without a second fault."""
+    spec = write(tmp_path, CODE.replace("return inputs.x >=", "return inputs.y >="))
+    text = spec.read_text()
+    spec.write_text(
+        text.replace("            tc = big/pp\n", "            tc = big/pp\n            ec = big/pp and false/pp\n", 1)
+    )
+    sim = earl.simulate(earl.load(spec))
+    try:
+        sim.advance_to(0.0025)  # three iterations, three decisions
+        assert [f.kind for f in sim.faults] == ["predicate"] * 3
+        assert all("error condition" in f.message for f in sim.faults)
+        assert sim.state_of("counter/a.cs").state == "count"
+    finally:
+        sim.close()
+
+
 def test_the_document_and_the_sysml_export_name_its_code(tmp_path: Path) -> None:
     """Table 4 and the SysML constraint say which code computes the predicate; the export calls the
     library's opaque `EARL::python` (which exists), with the predicate's reads as arguments."""

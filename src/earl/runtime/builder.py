@@ -401,7 +401,7 @@ def _python_predicate(engine: SubsystemEngine, predicate: PrimitivePredicate) ->
                 values[name] = raised
                 raise
         if isinstance(known, BaseException):
-            raise known
+            raise known  # the engine records it once, then leaves a PredicateFailedBefore in its place
         return known
 
     return evaluate

@@ -289,11 +289,22 @@ class SubsystemEngine:
             return bool(predicate(self.inputs, self.new_data, self.timed_out, self.memory, self.predicates))
         except (KeyboardInterrupt, SystemExit):
             raise
+        except PredicateFailedBefore:
+            return False
         except BaseException as raised:  # a Python predicate's own exception class may derive from BaseException
             inside = _predicate_raising(raised)
             where = f" in `{inside}`" if inside and inside not in what else ""
             self.report_fault(time, "predicate", f"evaluating {what} raised {exception_text(explain(raised))}{where}")
+            self._failure_recorded(raised)
             return False
+
+    def _failure_recorded(self, raised: BaseException) -> None:
+        """A Python predicate that raised is asked again in the same decision (a `tc` and a transition naming
+        it) as false, without a second fault for the one failure."""
+        values = self.python_predicate_values
+        for name, value in values.items():
+            if value is raised:
+                values[name] = PredicateFailedBefore(name)
 
     def decide(self, time: int) -> None:
         """Test `ec` then `tc`; when either holds, `fsm.selectState()`."""
@@ -315,6 +326,8 @@ class SubsystemEngine:
                 )
             except (KeyboardInterrupt, SystemExit):
                 raise
+            except PredicateFailedBefore:
+                terminal = False
             except BaseException as raised:
                 what = f"the terminal condition of `{behaviour.name}/bb`"
                 inside = _predicate_raising(raised)
@@ -322,6 +335,7 @@ class SubsystemEngine:
                 self.report_fault(
                     time, "predicate", f"evaluating {what} raised {exception_text(explain(raised))}{where}"
                 )
+                self._failure_recorded(raised)
                 terminal = False
             if not terminal:
                 return
@@ -353,6 +367,12 @@ class SubsystemEngine:
 
     def snapshot(self) -> dict[str, Any]:
         return dict(self.memory)
+
+
+class PredicateFailedBefore(Exception):
+    """What a Python primitive predicate raises when asked again in the decision where it raised and its
+    fault was recorded: the condition is false again, without a second fault for one failure (an `ec`
+    and a `tc` naming one predicate made two)."""
 
 
 def _predicate_raising(error: BaseException) -> str | None:
