@@ -25,7 +25,9 @@ class Watch(Recorder):
         self.states: list[tuple[int, str, str]] = []
         self.stop_commands: list[int] = []
 
-    def state_changed(self, time: int, subsystem: str, source: str | None, destination: str, transition: str) -> None:
+    def state_changed(
+        self, time: int, subsystem: str, source: str | None, destination: str, transition: str | None
+    ) -> None:
         self.states.append((time, subsystem, destination))
 
     def message_sent(self, time: int, link: str, value: Any) -> None:

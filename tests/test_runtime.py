@@ -3,6 +3,7 @@ snapshot isolation, refused undeclared writes, faults and recovery, FIFOs, timeo
 
 from __future__ import annotations
 
+import math
 import re
 import shutil
 import sys
@@ -28,7 +29,9 @@ class Events(Recorder):
         self.messages: list[tuple[int, str, Any]] = []
         self.stops: list[tuple[int, str, str, int, str]] = []
 
-    def state_changed(self, time: int, subsystem: str, source: str | None, destination: str, transition: str) -> None:
+    def state_changed(
+        self, time: int, subsystem: str, source: str | None, destination: str, transition: str | None
+    ) -> None:
         self.states.append((time, subsystem, source, destination))
 
     def message_sent(self, time: int, link: str, value: Any) -> None:
@@ -704,3 +707,46 @@ a/a {
     with pytest.raises(earl.EarlError) as refused:
         earl.simulate(earl.load(spec), check=False)
     assert [d.code for d in refused.value.diagnostics if d.code != "EARL-X011"] == ["EARL-X004"]  # (cs: no fsm)
+
+
+def test_a_run_time_beyond_any_float_is_refused_as_out_of_range_not_overflowed() -> None:
+    """`10**400` is an int Python cannot make a float: compared, not converted, it is refused like infinity,
+    and the message quotes it short."""
+    simulation = earl.simulate(earl.load(SPECS / "counter"))
+    try:
+        for call, seconds, message in [
+            (simulation.advance_to, 10**400, "at most 1e+09 s, not (a whole number of 401 digits)"),
+            (simulation.advance_to, -(10**400), "from 0 on, not -(a whole number of 401 digits)"),
+            (simulation.advance_to, -math.inf, "finite run time"),
+            (simulation.advance_by, 10**5000, "duration of at most 1e+09 s, not (a whole number of 5001 digits)"),
+        ]:
+            with pytest.raises(ValueError) as refused:
+                call(seconds)
+            assert message in str(refused.value)
+        simulation.advance_to(0.002)  # the refusals left it able to run
+        assert simulation.time == 0.002
+    finally:
+        simulation.close()
+
+
+def test_the_entry_into_the_initial_state_names_no_transition(tmp_path: Path) -> None:
+    """`*,counting` read as an any-source transition the spec does not have: the first record of each FSM
+    topic says `from` and `transition` null, later ones the transition taken; the summary counts only those."""
+    import json
+
+    from mcap.reader import make_reader
+
+    from earl.runtime.trace_reader import summarise
+
+    sim, _ = simulate(SPECS / "counter", trace=tmp_path / "run.mcap")
+    sim.advance_to(0.05)
+    sim.close()
+    with (tmp_path / "run.mcap").open("rb") as stream:
+        changes = [
+            json.loads(message.data)
+            for _, channel, message in make_reader(stream).iter_messages()
+            if channel.topic == "counter/a.cs/fsm"
+        ]
+    assert changes[0] == {"from": None, "to": "counting", "transition": None}
+    assert changes[1:] == [{"from": "counting", "to": "finished", "transition": "counting,finished"}]
+    assert summarise(tmp_path / "run.mcap").subsystems["counter/a.cs"].transitions == {"counting,finished": 1}

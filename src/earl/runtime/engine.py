@@ -159,7 +159,8 @@ class SubsystemEngine:
         self.state = self.states[initial]
         self.iterate = self._iteration_of(self.state)
         self.iteration = 0
-        self.recorder.state_changed(time, self.name, None, initial, f"*,{initial}")
+        # no transition led here: `*,idle` would name an any-source transition the spec may not have
+        self.recorder.state_changed(time, self.name, None, initial, None)
         self.recorder.behaviour_started(time, self.name, initial, self.state.behaviour.name)
 
     def prepare(self) -> None:

@@ -41,9 +41,14 @@ class SubsystemStatistics:
 
 
 class Recorder:
-    """Receives the events of a run; this base class ignores them all."""
+    """Receives the events of a run; this base class ignores them all.
 
-    def state_changed(self, time: int, subsystem: str, source: str | None, destination: str, transition: str) -> None:
+    `state_changed` gives the transition's name (`idle,move`); the entry into the initial state, when
+    the FSM starts, has neither a source state nor a transition (None, None)."""
+
+    def state_changed(
+        self, time: int, subsystem: str, source: str | None, destination: str, transition: str | None
+    ) -> None:
         pass
 
     def behaviour_started(self, time: int, subsystem: str, state: str, behaviour: str) -> None:
@@ -101,7 +106,9 @@ class Recorders(Recorder):
 
         return write
 
-    def state_changed(self, time: int, subsystem: str, source: str | None, destination: str, transition: str) -> None:
+    def state_changed(
+        self, time: int, subsystem: str, source: str | None, destination: str, transition: str | None
+    ) -> None:
         for recorder in self.recorders:
             recorder.state_changed(time, subsystem, source, destination, transition)
 
@@ -141,11 +148,14 @@ class StatisticsRecorder(Recorder):
             found = self.subsystems[subsystem] = SubsystemStatistics()
         return found
 
-    def state_changed(self, time: int, subsystem: str, source: str | None, destination: str, transition: str) -> None:
+    def state_changed(
+        self, time: int, subsystem: str, source: str | None, destination: str, transition: str | None
+    ) -> None:
         statistics = self._of(subsystem)
         if source is not None:
             statistics.state_time[source] = statistics.state_time.get(source, 0) + time - statistics.entered
-            statistics.transitions[transition] = statistics.transitions.get(transition, 0) + 1
+            name = transition or "?"
+            statistics.transitions[name] = statistics.transitions.get(name, 0) + 1
         statistics.state = destination
         statistics.entered = time
 

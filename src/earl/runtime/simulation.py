@@ -1,10 +1,10 @@
 """Running a system: the Python API behind `earl run`.
 
     >>> import earl
-    >>> sim = earl.simulate(earl.load("examples/counter"), seed=1)
-    >>> sim.advance_to(2.0)                       # seconds of simulated time
+    >>> sim = earl.simulate(earl.load("tests/runtime_specs/counter"), seed=1)
+    >>> sim.advance_to(0.05)                      # seconds of simulated time
     >>> sim.state_of("counter/a.cs").state
-    'counting'
+    'finished'
 
 Like Drake's Simulator, the model (an `earl.System`) stays untouched; the run's
 state lives in the subsystem engines this object owns.
@@ -29,6 +29,7 @@ from earl.runtime.engine import exception_text
 from earl.runtime.events import Fault, Recorder, Recorders, StatisticsRecorder
 from earl.runtime.scheduler import Inbox, Scheduler
 from earl.runtime.trace import TraceWriter
+from earl.runtime.values import shown_value
 
 ParameterValue = bool | int | float | str
 
@@ -179,15 +180,18 @@ class Simulation:
             raise RuntimeError("this simulation is closed")
         if isinstance(seconds, bool) or not isinstance(seconds, numbers.Real):
             raise TypeError(f"advance_to takes a run time in seconds (a number), not {seconds!r}")
-        if not math.isfinite(seconds) or seconds > Duration.MAX_SECONDS:
+        # compared, not converted: an int beyond any float (10**400) is as far out of range as infinity
+        if seconds != seconds or seconds > Duration.MAX_SECONDS or seconds == -math.inf:
             raise ValueError(
-                f"advance_to takes a finite run time of at most {Duration.MAX_SECONDS:g} s, not {seconds!r}"
+                f"advance_to takes a finite run time of at most {Duration.MAX_SECONDS:g} s, not {shown_value(seconds)}"
             )
         if should_stop is not None and not callable(should_stop):
             raise TypeError(f"should_stop takes a function of no arguments, not {should_stop!r:.60}")
         if seconds < 0:
             # a run time starts at 0: a slip between advance_to and advance_by, most likely
-            raise ValueError(f"advance_to takes a run time from 0 on, not {seconds!r} (advance_by takes a duration)")
+            raise ValueError(
+                f"advance_to takes a run time from 0 on, not {shown_value(seconds)} (advance_by takes a duration)"
+            )
         if self._stopped_inside is not None:
             raise RuntimeError(
                 f"this simulation stopped inside an instant ({self._stopped_inside}), so a subsystem may be "
@@ -207,7 +211,11 @@ class Simulation:
         if isinstance(seconds, bool) or not isinstance(seconds, numbers.Real):
             raise TypeError(f"advance_by takes a duration in seconds (a number), not {seconds!r}")
         if seconds < 0:
-            raise ValueError(f"advance_by takes a duration of 0 s or more, not {seconds!r}")
+            raise ValueError(f"advance_by takes a duration of 0 s or more, not {shown_value(seconds)}")
+        if seconds > Duration.MAX_SECONDS:
+            raise ValueError(
+                f"advance_by takes a duration of at most {Duration.MAX_SECONDS:g} s, not {shown_value(seconds)}"
+            )
         self.advance_to(self.time + seconds, should_stop)
 
     def close(self) -> None:

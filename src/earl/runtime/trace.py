@@ -49,7 +49,7 @@ _STATE_SCHEMA = {
     "properties": {
         "from": {"type": ["string", "null"]},
         "to": {"type": "string"},
-        "transition": {"type": "string"},
+        "transition": {"type": ["string", "null"]},
     },
 }
 _BEHAVIOUR_SCHEMA = {
@@ -275,7 +275,9 @@ class TraceWriter(Recorder):
         start = {"event": "start", "earl": __version__, **settings}
         self._write(self._channel("/earl/run", "earl.Run", _RUN_SCHEMA, {}), 0, start)
 
-    def state_changed(self, time: int, subsystem: str, source: str | None, destination: str, transition: str) -> None:
+    def state_changed(
+        self, time: int, subsystem: str, source: str | None, destination: str, transition: str | None
+    ) -> None:
         channel = self._channel(f"{subsystem}/fsm", "earl.StateChange", _STATE_SCHEMA, {"subsystem": subsystem})
         self._write(channel, time, {"from": source, "to": destination, "transition": transition})
 

@@ -424,13 +424,13 @@ def _describe(value: Any) -> str:
     if isinstance(value, bool):
         return f"the Boolean {value}"
     if isinstance(value, (int, float)):
-        return f"the number {_shown(value)}"
+        return f"the number {shown_value(value)}"
     if isinstance(value, str):
-        return f"the string {_shown(value)}"
+        return f"the string {shown_value(value)}"
     return f"a {type(value).__name__}"
 
 
-def _shown(value: int | float | str) -> str:
+def shown_value(value: int | float | str) -> str:
     """A value as a message quotes it: short, whatever its size (Python refuses to print an int of over
     4,300 digits, and a megabyte string would drown the message)."""
     if isinstance(value, int) and value.bit_length() > 200:
@@ -452,12 +452,12 @@ def _coerce_primitive(value: Any, name: str, where: str) -> Value:
         try:
             result = float(value)
         except OverflowError:  # an int beyond any double
-            raise ValueTypeError(f"{where} = {_shown(value)} is too large for a {name}") from None
+            raise ValueTypeError(f"{where} = {shown_value(value)} is too large for a {name}") from None
         if math.isnan(result):
             raise ValueTypeError(f"{where} is NaN (not a number): a computation went wrong upstream")
         if not real_fits(name, result):
             raise ValueTypeError(
-                f"{where} = {_shown(value)} does not fit {name} (at most ±{REAL_LIMITS[name]:.8g}; infinity may be)"
+                f"{where} = {shown_value(value)} does not fit {name} (at most ±{REAL_LIMITS[name]:.8g}; infinity may be)"
             )
         return result
     if name in INTEGER_RANGES:
@@ -468,7 +468,7 @@ def _coerce_primitive(value: Any, name: str, where: str) -> Value:
                 raise ValueTypeError(f"{where} must be a whole number ({name}), not {_describe(value)}")
         low, high = INTEGER_RANGES[name]
         if not low <= value <= high:
-            raise ValueTypeError(f"{where} = {_shown(value)} does not fit {name} ({low}..{high})")
+            raise ValueTypeError(f"{where} = {shown_value(value)} does not fit {name} ({low}..{high})")
         return value
     if name == "string":
         if isinstance(value, str):
