@@ -530,6 +530,22 @@ CASES: list[Case] = [
         edit(("        x/m: double = 0.0\n", "        x/m: double = 0.0\n        v/m: double[3] = [1.0, 2.0, 3]\n")),
     ),
     Case(
+        "EARL-E043",
+        edit(("        x/m: double = 0.0\n", '        x/m: double = -"zero"\n')),
+        6,
+        23,
+        "an initial value must be a constant: `-` needs a number",
+        edit(("        x/m: double = 0.0\n", "        x/m: double = -(-2)\n")),
+    ),
+    Case(
+        "EARL-E043",
+        edit(("        x/m: double = 0.0\n", "        x/m: double = 0.0\n        k/m: int = -true\n")),
+        7,
+        20,
+        "`-` needs a number",  # Python's -True is -1: it passed, and the SysML export wrote `-true`
+        edit(("        x/m: double = 0.0\n", "        x/m: double = 0.0\n        k/m: int = -1\n")),
+    ),
+    Case(
         "EARL-W011",
         edit(("        inp/ib: double\n", "        inp/ib: double\n        spare/ib: double\n")),
         25,

@@ -380,9 +380,9 @@ def _constant(expression: Any) -> Any:
         return expression.value
     if isinstance(expression, ListLiteral):
         return [_constant(item) for item in expression.items]
-    if isinstance(expression, Negate):
-        return -_constant(expression.operand)
-    if isinstance(expression, Arithmetic):  # `2 * QUEUE + 0.5`: the expansion put the parameter's value in
+    if isinstance(expression, (Negate, Arithmetic)):
+        # `2 * QUEUE + 0.5`: the expansion put the parameter's value in.  `-` is the constant evaluator's too,
+        # which refuses `-"x"`, `-[1]` and `-true` (Python's -True is -1) as the reader does for a parameter
         try:
             return evaluate_constant(expression, {})
         except ConstantError as error:
