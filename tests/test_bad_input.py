@@ -189,6 +189,42 @@ def test_a_type_nested_10000_deep_is_refused(tmp_path: Path) -> None:
     assert error.location is not None and (error.location.line, error.location.column) == (3, 10)
 
 
+@pytest.mark.parametrize(
+    ("types", "line", "message"),
+    [
+        ("type A = A[]\n", 3, "type `A` is an alias of itself (A -> A), so it names no type"),
+        ("type A = B[]\ntype B = A[3]\n", 3, "type `A` is an alias of itself (A -> B -> A)"),
+        (
+            "type A0 = int\n" + "".join(f"type A{i} = A{i - 1}[]\n" for i in range(1, 3001)),
+            36,
+            "type `A33` written out is 33 array dimensions: at most 32",
+        ),
+        (
+            "type A0 = int\n" + "".join(f"type A{i} = A{i - 1}\n" for i in range(1, 3001)),
+            103,
+            "type `A100` written out is 101 aliases and arrays deep",
+        ),
+    ],
+    ids=["itself", "through another", "3000 aliases of arrays", "3000 aliases"],
+)
+def test_an_alias_that_names_itself_or_nests_beyond_the_limits_is_refused_once(
+    types: str, line: int, message: str, tmp_path: Path
+) -> None:
+    """An alias is written out wherever it is used: the SysML export recursed for ever on `type A = A[]`
+    and on a chain of thousands of aliases, which check accepted. One error, at the first alias too deep."""
+    path = tmp_path / "aliases.earl"
+    path.write_text("system s\n\n" + types)
+    [error] = _errors(path)
+    assert message in error.message
+    assert error.location is not None and error.location.line == line
+
+
+def test_a_struct_holding_itself_through_a_variable_array_is_a_type(tmp_path: Path) -> None:
+    path = tmp_path / "tree.earl"
+    path.write_text("system s\n\nstruct Tree {\n    children: Tree[]\n}\n\ntype Forest = Tree[]\n")
+    assert [t.name for t in earl.load(path).types] == ["Tree", "Forest"]
+
+
 def test_unknown_and_duplicate_names_are_all_reported(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     path = tmp_path / "names.earl"
     path.write_text(

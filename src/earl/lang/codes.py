@@ -49,6 +49,7 @@ READING_CODES: dict[str, str] = {
     "EARL-R016": "an empty or negative family range",
     "EARL-R017": "a family range too large, or families that multiply beyond 4,000,000 elements",
     "EARL-R018": "a FIFO without room for a message",
+    "EARL-R019": "a type alias that, written out, nests too deep",
     "EARL-R020": "a name that is no parameter or index in scope",
     "EARL-R021": "an element of a kind that cannot be used here",
     "EARL-R022": "an unknown buffer, memory, predicate, function or behaviour",

@@ -44,18 +44,22 @@ from earl.model.kinds import KIND_TITLES, Kind
 from earl.model.location import SourceLocation
 from earl.model.text import reference_text
 from earl.model.types import (
+    MAX_ARRAY_DIMENSIONS,
     PARAMETER_TYPES,
     PRIMITIVE_TYPES,
     ArrayType,
     DataType,
     PrimitiveType,
     StructType,
+    TypeAlias,
     TypeReference,
     parameter_value_problem,
 )
 
 Value = bool | int | float | str
 
+#: aliases and arrays nested in a type written out: walks over types recurse once per level
+MAX_ALIAS_NESTING = 100
 #: A family larger than this is almost certainly a typo (`1..1000000`), and would exhaust memory.
 MAX_FAMILY_MEMBERS = 100_000
 #: subsystems and their elements once every family is expanded: nested families multiply (100,000
@@ -288,10 +292,90 @@ class Resolver:
                     self.data_type(member.data_type, scope, member.location)
             else:
                 self.data_type(definition.data_type, scope, definition.location)
-        self._type_cycles()
+        self._alias_depths(self._type_cycles())
 
-    def _type_cycles(self) -> None:
-        """A struct that contains itself (other than through a variable array) has no finite size."""
+    def _alias_depths(self, reported: set[str]) -> None:
+        """An alias is written out wherever it is used (the SysML export, a document's types): one that
+        names itself through an array (`type A = A[]`) names no type, and a chain of thousands of aliases
+        (`type A2 = A1[]` …) is as deep as the array types the reader refuses (S017)."""
+        # per alias: (aliases and arrays nested, array dimensions) of its type written out; None while
+        # it is being measured, which is how a cycle shows
+        measured: dict[str, tuple[int, int] | None] = {}
+        inner: dict[str, str | None] = {}  # the type each alias names, under its arrays
+
+        def too_deep(name: str | None) -> bool:
+            found = measured.get(name) if name is not None else None
+            return found is not None and (found[1] > MAX_ARRAY_DIMENSIONS or found[0] > MAX_ALIAS_NESTING)
+
+        def measure(name: str) -> tuple[int, int]:
+            # iterative over the chain of aliases: a recursive walk is what this rule protects the others from
+            chain: list[tuple[str, int]] = []  # each alias on the way, with the arrays around its next one
+            current: str | None = name
+            nested = (0, 0)
+            while current is not None:
+                if current in measured:
+                    known = measured[current]
+                    if known is None:  # back at an alias measured in this chain: a cycle
+                        cycle = [n for n, _ in chain]
+                        start = cycle.index(current)
+                        self._alias_cycle([*cycle[start:], current], reported)
+                        known = (0, 0)
+                    nested = known
+                    break
+                definition = self.types.get(current)
+                if not isinstance(definition, TypeAlias):
+                    break
+                measured[current] = None
+                data_type, arrays = definition.data_type, 0
+                while isinstance(data_type, ArrayType):
+                    data_type, arrays = data_type.element, arrays + 1
+                chain.append((current, arrays))
+                current = data_type.name if isinstance(data_type, TypeReference) else None
+                inner[chain[-1][0]] = current
+            for alias, arrays in reversed(chain):
+                nested = (nested[0] + 1 + arrays, nested[1] + arrays)
+                measured[alias] = nested
+            return nested
+
+        for name, definition in self.types.items():
+            if not isinstance(definition, TypeAlias) or name in measured:
+                continue
+            measure(name)
+        for name, definition in self.types.items():
+            found = measured.get(name)
+            if found is None or name in reported:
+                continue
+            nested, dimensions = found
+            # the first alias of a chain that is too deep: those built on it say nothing new
+            if too_deep(name) and not too_deep(inner.get(name)):
+                written = (
+                    f"{dimensions} array dimensions"
+                    if dimensions > MAX_ARRAY_DIMENSIONS
+                    else f"{nested} aliases and arrays deep"
+                )
+                self.error(
+                    f"type `{name}` written out is {written}: at most {MAX_ARRAY_DIMENSIONS} dimensions and "
+                    f"{MAX_ALIAS_NESTING} levels",
+                    definition.location,
+                    "EARL-R019",
+                    "flatten the dimensions (`double[N * M]`), or group them in a struct",
+                )
+
+    def _alias_cycle(self, cycle: list[str], reported: set[str]) -> None:
+        if cycle[0] in reported:
+            return
+        reported.update(cycle)
+        definition = self.types[cycle[0]]
+        self.error(
+            f"type `{cycle[0]}` is an alias of itself ({' -> '.join(cycle)}), so it names no type",
+            definition.location,
+            "EARL-R011",
+            "a type that holds itself is a struct with a variable array field: `struct T { children: T[] }`",
+        )
+
+    def _type_cycles(self) -> set[str]:
+        """A struct that contains itself (other than through a variable array) has no finite size; the
+        types reported are returned."""
 
         def direct(data_type: DataType) -> Iterable[str]:
             if isinstance(data_type, TypeReference):
@@ -326,6 +410,7 @@ class Resolver:
                     elif child not in visited:
                         visited.add(child)
                         stack.append((child, [*path, child]))
+        return reported
 
     def data_type(self, data_type: DataType, scope: Scope, where: SourceLocation | None = None) -> None:
         """`where`: the declaration that holds it, for a value that has no location of its own."""

@@ -68,6 +68,7 @@ from earl.model.expressions import (
 from earl.model.kinds import Kind
 from earl.model.location import SourceLocation
 from earl.model.types import (
+    MAX_ARRAY_DIMENSIONS,
     PRIMITIVE_TYPES,
     ArrayType,
     DataType,
@@ -89,9 +90,6 @@ def _kind(suffix: str) -> Kind:
 
 #: Deeper expressions are refused: no person writes them, and they would exhaust the stack.
 MAX_EXPRESSION_DEPTH = 100
-
-#: Deeper array types are refused for the same reason.
-MAX_ARRAY_DIMENSIONS = 32
 
 
 class SpecificationSyntaxError(Exception):
@@ -216,7 +214,7 @@ class ElementBuilder:
                     f"this array type has more than {MAX_ARRAY_DIMENSIONS} dimensions",
                     array.location,
                     code="EARL-S017",
-                    hint="name the inner array with `type` and build on it, or flatten the dimensions",
+                    hint="flatten the dimensions (`double[N * M]`), or group them in a struct",
                 )
             )
         self._depth[id(array)] = depth

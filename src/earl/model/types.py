@@ -28,6 +28,10 @@ PRIMITIVE_TYPES: tuple[str, ...] = (
     "bytes",
 )
 
+#: Deeper array types are refused (EARL-S017; EARL-R019 through aliases): no person writes them, and every
+#: walk over a type recurses once per dimension.
+MAX_ARRAY_DIMENSIONS = 32
+
 #: The whole numbers each integer type holds (`int` is 64 bits, as in the runtime and on the wire).
 INTEGER_RANGES: dict[str, tuple[int, int]] = {
     "int8": (-(2**7), 2**7 - 1),
