@@ -220,3 +220,74 @@ def test_fmt_diff_of_a_file_with_cr_line_ends_is_a_patch_that_applies(tmp_path: 
     assert diff.count(b"\\ No newline at end of file") == 1
     subprocess.run([patch, "-s", str(spec)], input=diff, check=True, timeout=60)
     assert spec.read_text() == CANONICAL
+
+
+BLOCK_COMMENTS = """\
+system s
+
+struct Empty {
+    // nothing yet
+}
+
+struct Pose {
+    x: double
+    // y and z to come
+}
+
+x/a {
+    cs {
+        period 1 ms
+        f/pp = true
+        b/bb {
+            tf = {}
+            tc = f/pp
+            // the error condition to come
+        }
+        fsm {
+            initial r
+            state r: b/bb
+            *  // from every state
+                // however it was reached
+                -> r when f/pp
+
+            // TODO: a way out
+        }
+        // end of the control subsystem
+    }
+    // end of the agent
+}  // not this one: after the `}`, it goes to what follows
+
+r/r {
+    x/a
+    // the robot's other agents
+}
+"""
+
+
+def test_a_comment_that_ends_a_block_stays_in_it(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A comment after the last line of a block's body (a TODO before an fsm's `}`) used to leave the block
+    for the next top-level declaration; and a comment between `*` and `->` made the `*` a syntax error."""
+    path = tmp_path / "blocks.earl"
+    path.write_text(BLOCK_COMMENTS)
+    assert main(["fmt", str(path)]) == 0
+    formatted = capsys.readouterr().out
+    for comment, closing in [
+        ("    // nothing yet", "}"),
+        ("    // y and z to come", "}"),
+        ("            // the error condition to come", "        }"),
+        ("            // TODO: a way out", "        }"),
+        ("        // end of the control subsystem", "    }"),
+        ("    // end of the agent", "}"),
+        ("    // the robot's other agents", "}"),
+    ]:
+        lines = formatted.splitlines()
+        assert lines[lines.index(comment) + 1] == closing, formatted
+    assert (
+        "            * -> r when f/pp  // from every state\n            // however it was reached\n\n            // TODO"
+        in formatted
+    )
+    assert "// not this one: after the `}`, it goes to what follows\nr/r {" in formatted
+    again = tmp_path / "again.earl"
+    again.write_text(formatted)
+    assert main(["fmt", "--check", str(again)]) == 0
+    assert earl.load(again) == earl.load(path)

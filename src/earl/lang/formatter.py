@@ -60,6 +60,12 @@ class _Printer:
         comment = comment.rstrip()  # trailing space, and the `\r` a CRLF file leaves in a comment
         self.lines.append(f"{INDENT * depth}{comment}" if comment else "")
 
+    def close(self, depth: int, comments: Comments) -> None:
+        """A block's `}`, after the comments that ended its body."""
+        for comment in comments.closing:
+            self.comment(depth + 1, comment)
+        self.line(depth, "}")
+
     def text(self) -> str:
         while self.lines and self.lines[-1] == "":
             self.lines.pop()
@@ -182,14 +188,14 @@ def _parameter(printer: _Printer, depth: int, parameter: Parameter) -> None:
 
 
 def _struct(printer: _Printer, struct: StructType) -> None:
-    if not struct.fields:
+    if not struct.fields and not struct.comments.closing:
         printer.line(0, f"struct {struct.name} {{}}", struct.comments)
         return
     printer.line(0, f"struct {struct.name} {{", struct.comments)
     for field in struct.fields:
         optional = "?" if field.optional else ""
         printer.line(1, f"{field.name}: {data_type_text(field.data_type)}{optional}", field.comments)
-    printer.line(0, "}")
+    printer.close(0, struct.comments)
 
 
 def _robot(printer: _Printer, robot: Robot) -> None:
@@ -198,7 +204,7 @@ def _robot(printer: _Printer, robot: Robot) -> None:
         printer.line(1, reference_text(agent))
     for link in robot.links:
         printer.line(1, f"link {link.name}")
-    printer.line(0, "}")
+    printer.close(0, robot.comments)
 
 
 def _agent(printer: _Printer, agent: Agent) -> None:
@@ -213,7 +219,7 @@ def _agent(printer: _Printer, agent: Agent) -> None:
         printer.blank()
     for link in agent.links:
         _link(printer, 1, link)
-    printer.line(0, "}")
+    printer.close(0, agent.comments)
 
 
 def _link(printer: _Printer, depth: int, link: Link) -> None:
@@ -255,7 +261,7 @@ def _subsystem(printer: _Printer, subsystem: Subsystem) -> None:
         if not first:
             printer.blank()
         _fsm(printer, depth, subsystem.fsm)
-    printer.line(1, "}")
+    printer.close(1, subsystem.comments)
 
 
 def _body_item(printer: _Printer, depth: int, item: object) -> None:
@@ -302,7 +308,7 @@ def _basic_behaviour(printer: _Printer, depth: int, behaviour: BasicBehaviour) -
     printer.line(depth + 1, f"tc = {expression_text(behaviour.terminal_condition.expression)}")
     if behaviour.error_condition is not None:
         printer.line(depth + 1, f"ec = {expression_text(behaviour.error_condition.expression)}")
-    printer.line(depth, "}")
+    printer.close(depth, behaviour.comments)
 
 
 def _fsm(printer: _Printer, depth: int, fsm: FSM) -> None:
@@ -320,7 +326,7 @@ def _fsm(printer: _Printer, depth: int, fsm: FSM) -> None:
         printer.blank()
     for assumption in fsm.assumptions:
         printer.line(depth + 1, f"assume {expression_text(assumption.expression)}", assumption.comments)
-    printer.line(depth, "}")
+    printer.close(depth, fsm.comments)
 
 
 def _state(printer: _Printer, depth: int, state: State) -> None:

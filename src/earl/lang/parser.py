@@ -16,7 +16,9 @@ from earl.lang import reductions
 from earl.lang.driver import Driver, NotWellFormed
 from earl.lang.syntax_errors import translate
 from earl.lang.transformer import ElementBuilder, ParsedFile, SpecificationSyntaxError
+from earl.model.elements import FSM, Agent, BasicBehaviour, Robot, Subsystem
 from earl.model.location import SourceLocation
+from earl.model.types import StructType
 
 #: Larger files are refused before parsing.  The benchmark's thousand agents, written out in
 #: full, take 5 MB and some 4–5 s of CPU to read (benchmarks/results/parse.json); a file much
@@ -256,6 +258,10 @@ def _statements(declarations: list[Any]) -> list[Any]:
     return found
 
 
+#: the elements written with braces around a body, which keep the comments that end it (`Comments.closing`)
+_BLOCKS: tuple[type, ...] = (StructType, Robot, Agent, Subsystem, BasicBehaviour, FSM)
+
+
 def attach_comments(declarations: list[Any], comments: list[Token], path: str) -> list[str]:
     """Give each comment to the element it sits above, or ends the line of; return those after the last.
 
@@ -268,13 +274,23 @@ def attach_comments(declarations: list[Any], comments: list[Token], path: str) -
     # the first element of each line (the leftmost), and the lines that have one, in order: a
     # comment goes to the first of them at or below it; only lines are sorted, not elements
     by_line: dict[int, Any] = {}
-    for element in _statements(declarations):
+    statements = _statements(declarations)
+    for element in statements:
         location = element.location
         first = by_line.get(location.line)
         if first is None or location.column < first.location.column:
             by_line[location.line] = element
     starts = sorted(by_line)
-    last_line: dict[int, int] = {}  # id(element) -> line of its last leading comment
+    # the elements written as a block, outermost first: a comment after the last line of a block's
+    # body (`// TODO: a way out of fault` before an fsm's `}`) stays in that block
+    blocks: list[Any] = [e for e in statements if isinstance(e, _BLOCKS)]  # each has a location (_statements)
+    blocks = sorted(
+        (e for e in blocks if e.location.end_line > e.location.line),
+        key=lambda e: (e.location.line, -e.location.end_line),
+    )
+    inside: list[Any] = []  # the blocks open at the comment, innermost last
+    next_block = 0
+    last_line: dict[int, int] = {}  # id(element) -> line of its last leading (or closing) comment
     commented: list[Any] = []
     last_closing = 0
     for comment in comments:
@@ -284,7 +300,23 @@ def attach_comments(declarations: list[Any], comments: list[Token], path: str) -
         if owner is not None and (comment.column or 1) > owner.location.column:
             owner.comments.trailing = text
             continue
+        while next_block < len(blocks) and blocks[next_block].location.line < line:
+            block = blocks[next_block]
+            while inside and inside[-1].location.end_line < block.location.line:
+                inside.pop()
+            inside.append(block)
+            next_block += 1
+        while inside and inside[-1].location.end_line <= line:  # a comment on the `}` line is after it
+            inside.pop()
         position = bisect_left(starts, line)
+        if inside and (position == len(starts) or starts[position] > inside[-1].location.end_line):
+            block = inside[-1]
+            closing_of_block = block.comments.closing
+            if closing_of_block and line > last_line[id(block)] + 1:
+                closing_of_block.append("")
+            closing_of_block.append(text)
+            last_line[id(block)] = line
+            continue
         if position < len(starts):
             element = by_line[starts[position]]
             leading = element.comments.leading

@@ -42,7 +42,8 @@ class Comments:
 
     leading: list[str] = field(default_factory=list)
     trailing: str | None = None
-    #: Comments after the last element of a file (kept on the System).
+    #: Comments after the last element of a file (kept on the System), or of a block's body, before its
+    #: `}` (an agent, subsystem, basic behaviour, FSM, struct or robot); "" keeps a blank line between two.
     closing: list[str] = field(default_factory=list)
 
 
