@@ -409,6 +409,34 @@ SYNTAX = [
         "EARL-S017",
         "this array type has more than 32 dimensions",
     ),
+    # a bracket opening a line is stray: pointed at itself, not at the end of the line before it
+    Malformed(
+        "stray_brace_at_a_line_start",
+        "system s\n\nx/a {\n    cs {\n        v/ib: int\n\n        { w/m: int = 0\n    }\n}\n",
+        7,
+        9,
+        "EARL-S006",
+        "unexpected `{` after `int`",
+        "this `{` belongs to nothing before it",
+    ),
+    Malformed(
+        "stray_bracket_at_a_line_start",
+        "system s\n\nx/a {\n    cs {\n        v/ib: int\n        ] w/m: int = 0\n    }\n}\n",
+        6,
+        9,
+        "EARL-S006",
+        "unexpected `]` after `int`",
+        "this `]` belongs to nothing before it",
+    ),
+    Malformed(
+        "comment_between_any_state_and_arrow",
+        "system s\nx/a {\n    cs {\n        fsm {\n            initial r\n            state r: b/bb\n"
+        "            *  // from every state\n                -> r when\n        }\n    }\n}\n",
+        8,
+        26,
+        "EARL-S006",
+        "expected an expression",
+    ),
     # a string's escapes are JSON's: what JSON refuses is pointed at, never a traceback
     Malformed(
         "string_with_unknown_escape",

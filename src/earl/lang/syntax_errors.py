@@ -8,6 +8,7 @@ without its unit, an element without its kind, a `{` never closed.
 
 from __future__ import annotations
 
+import dataclasses
 from functools import lru_cache
 from typing import Any
 
@@ -261,10 +262,12 @@ def _unexpected_token(
         end is not None
         and token.line > end[0]
         and token.type not in ("NUMBER", "INT", "STRING")
+        and token.type not in _STRAY_BRACKETS
         and _last_character(text, end) not in ("{", "}")
     ):
         # What is missing belongs at the end of the line before, not before the next statement. After
-        # `{` or `}` the line before is complete: the statement found is the one in the wrong place.
+        # `{` or `}` the line before is complete: the statement found is the one in the wrong place. A
+        # bracket that opens a line is pointed at itself: it is stray, nothing before it is missing.
         location = after_previous()
     else:
         column = token.column or 1
@@ -284,7 +287,17 @@ def _unexpected_token(
         diagnostic = special(token, context, location, path)
         if diagnostic is not None:
             return diagnostic
-    return _expected_message(token, context, location)
+    diagnostic = _expected_message(token, context, location)
+    if token.type in _STRAY_BRACKETS and end is not None and token.line and token.line > end[0]:
+        # nothing is missing before a bracket that opens its line: "is a `}` missing?" misled
+        return dataclasses.replace(
+            diagnostic, hint=f"this `{token}` belongs to nothing before it: remove it, or move it to its declaration"
+        )
+    return diagnostic
+
+
+#: brackets that cannot begin a declaration: one opening a line where it is unexpected is stray
+_STRAY_BRACKETS = frozenset({"LBRACE", "LSQB", "RSQB", "LPAR", "RPAR"})
 
 
 def _last_character(text: str, end: tuple[int, int]) -> str:
