@@ -464,3 +464,19 @@ def test_families_inside_families_that_multiply_beyond_memory_are_refused_at_onc
     assert "families inside families multiply" in diagnostic.message
     assert diagnostic.location is not None and diagnostic.location.line == 12
     earl.loads(NESTED_FAMILIES, "big.earl", {"A": 100, "S": 100, "B": 100})  # a million: allowed
+
+
+def test_text_of_the_spec_in_a_message_cannot_start_a_line_of_its_own(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A string value is quoted as the spec writes it, escapes and all; any control character that reaches a
+    message or hint another way is escaped when printed: a spec cannot print what looks like a diagnostic."""
+    from earl.diagnostics import Severity, SourceMap, render
+
+    path = tmp_path / "forged.earl"
+    path.write_text('system s\n\nparam P: int = "a\\nerror[EARL-E999]: fake\\n --> x.earl:1:1"\n')
+    printed = _check_exits_1(path, capsys)
+    assert 'its value is "a\\nerror[EARL-E999]: fake\\n --> x.earl:1:1"' in printed
+    assert not any(line.startswith("error[EARL-E999]") for line in printed.splitlines())
+    text = render(Diagnostic(Severity.ERROR, "cannot open x\nerror: y\x1b[31m", None, hint="a\rb"), SourceMap())
+    assert text == "error: cannot open x\\nerror: y\\x1b[31m\n = hint: a\\rb"

@@ -97,10 +97,15 @@ def _window(source: str, start: int, width: int) -> tuple[str, int, int]:
     return shown, offset, max(1, min(width, last - start))
 
 
+#: control characters as escapes: a message or hint quoting the spec's text (a string value, a file name
+#: with a newline) stays on its line, and cannot print what looks like another diagnostic
+_ESCAPED_CONTROLS = {code: f"\\x{code:02x}" for code in range(32)} | {10: "\\n", 13: "\\r", 9: "\\t", 127: "\\x7f"}
+
+
 def render(diagnostic: Diagnostic, sources: SourceMap) -> str:
     """The diagnostic as plain text with the source line and a caret under the spot."""
     code = f"[{diagnostic.code}]" if diagnostic.code else ""
-    lines = [f"{diagnostic.severity.value}{code}: {diagnostic.message}"]
+    lines = [f"{diagnostic.severity.value}{code}: {diagnostic.message.translate(_ESCAPED_CONTROLS)}"]
     location = diagnostic.location
     if location is not None:
         number = str(location.line)
@@ -120,5 +125,5 @@ def render(diagnostic: Diagnostic, sources: SourceMap) -> str:
             lines.append(f"{gutter} | {' ' * offset}{'^' * width}")
     if diagnostic.hint:
         gutter = " " * (len(str(location.line)) if location else 0)
-        lines.append(f"{gutter} = hint: {diagnostic.hint}")
+        lines.append(f"{gutter} = hint: {diagnostic.hint.translate(_ESCAPED_CONTROLS)}")
     return "\n".join(lines)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import dataclass, field
 
@@ -110,7 +111,8 @@ def _briefly(value: object) -> str:
     if isinstance(value, str):
         shown = value if len(value) <= 50 else f"{value[:40]}… ({len(value)} characters)"
         shown = shown.encode("utf-8", "backslashreplace").decode("utf-8")  # a lone surrogate, shown escaped
-        return '"' + shown.replace("\\", "\\\\").replace('"', '\\"') + '"'
+        # as the spec writes it, escapes and all: a newline in a value must not start a line of the message
+        return json.dumps(shown, ensure_ascii=False)
     if isinstance(value, int) and abs(value) >= 10**30:
         return f"{'-' if value < 0 else ''}(a whole number of {len(str(abs(value))) if abs(value) < 10**4000 else 'over 4000'} digits)"
     text = repr(value)
