@@ -448,3 +448,92 @@ def test_a_transition_covered_by_several_before_it_names_them_all() -> None:
         "transition `run,run/t` of x/a.cs can never be taken: whenever its condition holds, one of `run,a/t`, "
         "`run,b/t` holds too and is tried first"
     ]
+
+
+def test_a_predicate_defined_through_itself_is_e045_and_switches_nothing_off() -> None:
+    """`odd/pp = not odd/pp` tied as `v ≡ ¬v` made every formula false: a real overlap went unreported."""
+    extra = "        odd/pp = not odd/pp\n        p/pp = not q/pp\n        q/pp = p/pp and go/pp\n"
+    found = probe_text("go/pp", "go/pp or odd/pp or p/pp", extra=extra)
+    assert found["EARL-E060"] == ["transitions `run,a/t` and `run,b/t` of x/a.cs can both hold, e.g. when go/pp = true"]
+    text = PROBE.replace("TC", "true").replace("FIRST", "go/pp").replace("SECOND", "not go/pp")
+    text = text.replace("        false/pp = false\n", "        false/pp = false\n" + extra)
+    cycles = [d.message for d in check(earl.loads(text, "probe.earl")) if d.code == "EARL-E045"]
+    assert cycles == [
+        "primitive predicate `odd/pp` of x/a.cs is defined through itself (odd/pp -> odd/pp), so it has no value",
+        "primitive predicate `p/pp` of x/a.cs is defined through itself (p/pp -> q/pp -> p/pp), so it has no value",
+    ]
+
+
+OBLIGATORY = """\
+        watch/bb {
+            tf = {work/pf}
+            tc = true
+        }
+"""
+
+
+def test_what_receiving_in_a_state_makes_true_is_known_to_the_analysis() -> None:
+    """A state that waits for `v/ib` (with a timeout) ends each iteration with `newData(v/ib)` or
+    `timeout(v/ib)`; a state that does not wait for it never sees it time out; without a timeout it
+    always has new data. Obligatory sensor plus timeout was an E060 and a W061 before."""
+    obligatory = "{ obligatory v/ib  timeout 50 ms }"
+    text = PROBE.replace("TC", "true").replace("FIRST", "newData(v/ib)").replace("SECOND", "timeout(v/ib)")
+    text = text.replace("state run: run/bb", f"state run: run/bb {obligatory}")
+    codes = [d.code for d in check(earl.loads(text, "probe.earl"))]
+    assert "EARL-W061" not in codes and "EARL-E060" not in codes
+    optional = (
+        PROBE.replace("TC", "true")
+        .replace("FIRST", "newData(v/ib) or timeout(v/ib)")
+        .replace("SECOND", "not newData(v/ib)")
+    )
+    assert "EARL-E060" not in [d.code for d in check(earl.loads(optional, "probe.earl"))]
+    forever = PROBE.replace("TC", "true").replace("FIRST", "newData(v/ib)").replace("SECOND", "false")
+    forever = forever.replace("state run: run/bb", "state run: run/bb { obligatory v/ib }")
+    assert "EARL-W061" not in [d.code for d in check(earl.loads(forever, "probe.earl"))]
+
+
+def test_a_buffer_fed_by_another_agent_may_time_out_anywhere_and_the_message_says_when() -> None:
+    """Over Zenoh a stale sender makes its buffer read as timed out in every state: the overlap is real
+    there, and the message says that it happens only then."""
+    text = (
+        PROBE.replace("TC", "true")
+        .replace("FIRST", "newData(v/ib) or timeout(v/ib)")
+        .replace("SECOND", "not newData(v/ib)")
+    )
+    text = text.replace(
+        "r/r { x/a }",
+        "r/r { x/a }\n\ny/a {\n    cs {\n        period 10 ms\n        out/ob: double\n    }\n}\n\nlink y,x: y/a.cs.out -> x/a.cs.v\n",
+    )
+    [message] = [d.message for d in check(earl.loads(text, "probe.earl")) if d.code == "EARL-E060"]
+    assert message.endswith(
+        "(only while a sending agent in another process is stale: its buffer then reads as timed out in every state)"
+    )
+
+
+@pytest.mark.parametrize(
+    ("first", "second"),
+    [("v/ib > 3.0", "v/ib <= 3.0"), ("v/ib > 3.0 and v/ib < 1e999", "v/ib <= 3.0 or v/ib == 1e999")],
+)
+def test_an_infinite_constant_is_a_value_on_the_line_not_the_end_of_the_analysis(first: str, second: str) -> None:
+    extra = "        finite/pp = v/ib < 1e999\n"
+    found = probe_text(first, second, extra=extra, fsm_extra="            assume finite/pp or not finite/pp\n")
+    assert "EARL-E060" not in found and "EARL-W061" not in found
+
+
+def test_repeats_of_a_comparison_do_not_count_towards_the_limit_of_different_comparisons() -> None:
+    """Each occurrence counted: 131 occurrences of 2 comparisons passed the 128 cap and unrelated them."""
+    extra = "        w[K in 1..70]/ib: boolean\n        busy/pp = any(K in 1..64: v/ib > 3.0 and w[K]/ib) or any(K in 1..64: v/ib > 3.0 or w[K]/ib)\n"
+    found = probe_text(
+        "v/ib > 3.0", "v/ib <= 3.0", extra=extra, fsm_extra="            assume busy/pp or not busy/pp\n"
+    )
+    assert "EARL-E060" not in found and "EARL-W061" not in found
+
+
+def test_two_transitions_into_one_state_may_overlap_and_a_star_is_named_as_written() -> None:
+    found = probe_text("go/pp", "v/ib > 3.0", stop="true", fsm_extra="            * -> a when v/ib > 4.0\n")
+    assert found["EARL-E060"] == [
+        "transitions `run,a/t` and `run,b/t` of x/a.cs can both hold, e.g. when go/pp = true, v/ib > 3.0 = true",
+        "transitions `*,a/t` (from `run`) and `run,b/t` of x/a.cs can both hold, e.g. when v/ib > 3.0 = true, v/ib > 4.0 = true",
+    ]
+    always = probe_text("true", "true", stop="true")
+    assert always["EARL-E060"] == ["transitions `run,a/t` and `run,b/t` of x/a.cs can both hold, whatever the inputs"]

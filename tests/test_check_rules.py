@@ -546,6 +546,19 @@ CASES: list[Case] = [
         edit(("        x/m: double = 0.0\n", "        x/m: double = 0.0\n        k/m: int = -1\n")),
     ),
     Case(
+        "EARL-E045",
+        edit(("        go/pp = x/mi > 1.0\n", "        go/pp = x/mi > 1.0 and not late/pp\n        late/pp = go/pp\n")),
+        7,
+        9,
+        "primitive predicate `go/pp` of a1/a.cs is defined through itself (go/pp -> late/pp -> go/pp)",
+        edit(
+            (
+                "        go/pp = x/mi > 1.0\n",
+                "        go/pp = x/mi > 1.0 and not late/pp\n        late/pp = x/mi > 2.0\n",
+            )
+        ),
+    ),
+    Case(
         "EARL-W011",
         edit(("        inp/ib: double\n", "        inp/ib: double\n        spare/ib: double\n")),
         25,

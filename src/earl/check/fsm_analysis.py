@@ -11,14 +11,19 @@ mean adds constraints, conjoined with the FSM's `assume` formulas:
 - comparisons of one value with constants (`v/ib > 5.0`, `v/ib < 3.0`, `mode/ib == "stop"`) are
   decided over the real numbers (or the distinct strings): `v/ib > 5.0 and v/ib < 3.0` never holds.
   An `int` value is treated as a real, so `n/ib > 3 and n/ib < 4` is thought possible;
-- `newData(x/ib.field)` holds only when `newData(x/ib)` does, and `timeout(x/ib)` and
-  `stale(x/ib)` only when it does not (docs/semantics.md).
+- `newData(x/ib.field)` holds only when `newData(x/ib)` does, and `timeout(x/ib)` only when it
+  does not (docs/semantics.md);
+- per state, what receiving there makes true: a buffer the state waits for (`obligatory`) took a
+  message or timed out, and with no `timeout` took one; one it does not wait for never times out,
+  unless an inter-agent link feeds it (over Zenoh its sender may go stale, and a stale buffer reads
+  as timed out in every state: a finding that needs this says so);
+- a primitive predicate defined through itself (EARL-E045) stays a free Boolean.
 
 The transitions leaving a state are evaluated only when its behaviour stops (`tc or ec`, step 5
 of docs/semantics.md), in priority order.  With these, for every state of every FSM:
 
-- two leaving transitions whose conditions can hold together when the behaviour stops, without
-  distinct priorities, make the FSM nondeterministic (error, with one assignment);
+- two leaving transitions into different states whose conditions can hold together when the
+  behaviour stops, without distinct priorities, make the FSM nondeterministic (error, with one assignment);
 - a behaviour that can stop while no leaving transition holds is stuck (warning, with one assignment);
 - a transition that can never be taken — its condition never holds when the behaviour stops, or
   a transition of higher priority always holds then too — is dead (warning);
@@ -45,13 +50,14 @@ from earl.check.context import CheckContext, subsystem_name
 from earl.check.expression_types import BOOLEAN, ExpressionTyper
 from earl.check.registry import Finding, rule
 from earl.diagnostics import Severity
-from earl.model.elements import FSM, Agent, Subsystem, Transition
+from earl.model.elements import FSM, Agent, State, Subsystem, Transition
 from earl.model.expressions import (
     Arithmetic,
     BooleanOperation,
     Call,
     Comparison,
     ConstantError,
+    ElementReference,
     Expression,
     Literal,
     Negate,
@@ -60,7 +66,7 @@ from earl.model.expressions import (
     evaluate_constant,
 )
 from earl.model.kinds import Kind
-from earl.model.text import expression_text
+from earl.model.text import expression_text, reference_text
 
 
 def _import_dd_without_networkx() -> ModuleType:
@@ -168,6 +174,10 @@ class _Encoder:
             p.name: p.expression for p in subsystem.primitive_predicates if p.implementation is None
         }
         self._defining: set[str] = set()
+        #: predicates reached again while their own definition was being encoded: defined through
+        #: themselves (EARL-E045), they stay free Booleans; `p ≡ not p` would make every formula false
+        self._cyclic: set[str] = set()
+        self._open: list[str] = []  # the predicates whose definitions are being encoded, innermost last
         self._constants: dict[str, Function] = {}  # predicates whose definitions are constants
         self.meaning = self.bdd.true  # what the atoms mean: definitions, comparisons, newData
         #: per compared value (its text): the comparisons with a constant, as (operator, constant, variable)
@@ -229,14 +239,20 @@ class _Encoder:
         text = expression_text(read)
         name = read.target.name
         definition = self.definitions.get(name)
+        if name in self._open:
+            self._cyclic.add(name)
         if definition is not None and name not in self._defining and text not in self.by_text:
-            self._defining.add(name)  # each once; a predicate defined through itself stays free
+            self._defining.add(name)  # each once
             self._depth += 1
+            self._open.append(name)
             try:
                 meaning = self.encode(definition)
             finally:
                 self._depth -= 1
-            if meaning in (self.bdd.true, self.bdd.false):
+                self._open.pop()
+            if name in self._cyclic:
+                pass  # defined through itself: free
+            elif meaning in (self.bdd.true, self.bdd.false):
                 self._constants[name] = meaning  # the manual's `false/pp`: the constant itself
             else:
                 self.meaning &= self.variable(text).equiv(meaning)
@@ -290,15 +306,22 @@ class _Encoder:
     def _regions(self, atoms: list[tuple[str, Constant, Function]]) -> Function:
         """One value compared with constants lies in one region of the line (or is one of the strings):
         the atoms hold together only as in one of the regions."""
-        atoms = list({id(variable): (op, c, variable) for op, c, variable in atoms}.values())  # each once
+        # each comparison once: the same text is the same Boolean (dd makes a new wrapper per `var`)
+        atoms = list({(op, type(c), c): (op, c, variable) for op, c, variable in atoms}.values())
         if len(atoms) > _MOST_COMPARISONS:
             return self.bdd.true  # regions × atoms grows as the square: such comparisons stay unrelated
         constants = [constant for _, constant, _ in atoms]
-        if all(_is_number(c) and (isinstance(c, int) or math.isfinite(c)) for c in constants):  # type: ignore[arg-type]
-            # exact: a float is a fraction, and so is an int of any size (2**53 + 1 is not 2**53)
-            points = sorted({Fraction(c) for c in constants})  # type: ignore[arg-type]
-            samples: list[object] = [points[0] - 1, points[-1] + 1, *points]
-            samples += [(low + high) / 2 for low, high in itertools.pairwise(points)]
+        if all(_is_number(c) for c in constants):
+            # exact: a float is a fraction, and so is an int of any size (2**53 + 1 is not 2**53); an
+            # infinity (`1e999`) is a value a real may hold, and compares with fractions as it should;
+            # a NaN constant (`1e999 - 1e999`) compares false with every value, as at run time
+            finite = sorted({Fraction(c) for c in constants if isinstance(c, int) or math.isfinite(c)})  # type: ignore[arg-type]
+            samples: list[object] = [-math.inf, math.inf, *finite]
+            if finite:
+                samples += [finite[0] - 1, finite[-1] + 1]
+                samples += [(low + high) / 2 for low, high in itertools.pairwise(finite)]
+            else:
+                samples.append(Fraction(0))
         elif all(isinstance(c, str) for c in constants) and all(op in ("==", "!=") for op, _, _ in atoms):
             samples = [*dict.fromkeys(constants), object()]  # the strings, and any other
         else:
@@ -316,12 +339,16 @@ class _Encoder:
         shown = self.bdd.exist(hidden, formula) if hidden else formula
         assignment: dict[str, Any] = self.bdd.pick(shown) or {}
         if not assignment:
-            return "always"
+            return "whatever the inputs"
         parts = [
             f"{self.names[name]} = {'true' if value else 'false'}"
             for name, value in sorted(assignment.items(), key=lambda item: self.names[item[0]])
         ]
         return ", ".join(parts)
+
+
+def _when(example: str) -> str:
+    return example if example == "whatever the inputs" else f"e.g. when {example}"
 
 
 def _distinct_priorities(first: Transition, second: Transition) -> bool:
@@ -364,6 +391,15 @@ def analyse(context: CheckContext, subsystem: Subsystem, fsm: FSM, owner: str) -
         )
         return Analysis(findings)
     assumed &= meaning
+    fed_by_other_agents = _fed_by_other_agents(context, subsystem)
+    #: transitions that a `*` stands for (one per other state), named as written
+    starred = {id(t) for group in _by_declaration(fsm.transitions).values() if len(group) > 1 for t in group}
+
+    def named(transition: Transition) -> str:
+        if id(transition) in starred:
+            return f"`*,{transition.destination}/t` (from `{transition.source}`)"
+        return f"`{transition.name}/t`"
+
     #: per transition: when `fsm.selectState()` takes it (its behaviour stopped, nothing before it held)
     taken: dict[int, Function] = {}
     dead: dict[int, Finding] = {}  # transitions of states that can stop which are never taken, and why
@@ -371,7 +407,19 @@ def analyse(context: CheckContext, subsystem: Subsystem, fsm: FSM, owner: str) -
         behaviour = subsystem.basic_behaviour(state.behaviour)
         if behaviour is None:
             continue
-        stop = stops[state.name] & assumed
+        stop = stops[state.name] & assumed & _buffer_facts(encoder, state, fed_by_other_agents)
+        # what also holds when no sender is stale: in one process, or while every peer is alive
+        alive = _buffer_facts(encoder, state, frozenset()) if fed_by_other_agents else bdd.true
+
+        def when(situation: Function, alive: Function = alive) -> str:
+            said = _when(encoder.example(situation))
+            if (situation & alive) == bdd.false:
+                said += (
+                    " (only while a sending agent in another process is stale: its buffer then reads as timed out "
+                    "in every state)"
+                )
+            return said
+
         leaving = [t for t in fsm.transitions if t.source == state.name]
         if stop == bdd.false:
             findings["EARL-I063"].append(
@@ -406,7 +454,7 @@ def analyse(context: CheckContext, subsystem: Subsystem, fsm: FSM, owner: str) -
                     else f"its condition never holds when `{behaviour.name}/bb` stops"
                 )
                 dead[id(transition)] = Finding(
-                    f"transition `{transition.name}/t` of {owner} can never be taken: {never}",
+                    f"transition {named(transition)} of {owner} can never be taken: {never}",
                     transition.location,
                     "check the condition, the behaviour's terminal condition and the `assume` formulas",
                 )
@@ -414,26 +462,28 @@ def analyse(context: CheckContext, subsystem: Subsystem, fsm: FSM, owner: str) -
                 covering = [t for t in before if (holds & conditions[id(t)]) != bdd.false]
                 alone = next((t for t in covering if (holds & ~conditions[id(t)]) == bdd.false), None)
                 tried = (
-                    f"`{alone.name}/t` holds too and is tried first"
+                    f"{named(alone)} holds too and is tried first"
                     if alone is not None
-                    else "one of " + ", ".join(f"`{t.name}/t`" for t in covering) + " holds too and is tried first"
+                    else "one of "
+                    + ", ".join(dict.fromkeys(named(t) for t in covering))
+                    + " holds too and is tried first"
                 )
                 dead[id(transition)] = Finding(
-                    f"transition `{transition.name}/t` of {owner} can never be taken: whenever its condition "
+                    f"transition {named(transition)} of {owner} can never be taken: whenever its condition "
                     f"holds, {tried}",
                     transition.location,
                     "narrow the condition of the transition tried first, or change the priorities",
                 )
         for position, first in enumerate(leaving):
             for second in leaving[position + 1 :]:
-                if _distinct_priorities(first, second):
-                    continue
+                if _distinct_priorities(first, second) or first.destination == second.destination:
+                    continue  # one is tried first, or the next state is the same either way
                 # both the first to hold: one of higher priority holding would be taken instead
                 both = taken[id(first)] & taken[id(second)]
                 if both != bdd.false:
                     findings["EARL-E060"].append(
                         Finding(
-                            f"transitions `{first.name}/t` and `{second.name}/t` of {owner} can both hold, e.g. when {encoder.example(both)}",
+                            f"transitions {named(first)} and {named(second)} of {owner} can both hold, {when(both)}",
                             second.location,
                             "give them distinct priorities (`priority 1` is evaluated first) or declare an `assume` that rules this out",
                         )
@@ -445,16 +495,13 @@ def analyse(context: CheckContext, subsystem: Subsystem, fsm: FSM, owner: str) -
         if stuck != bdd.false:
             findings["EARL-W061"].append(
                 Finding(
-                    f"`{behaviour.name}/bb` can stop while no transition out of `{state.name}` holds ({owner}), e.g. when {encoder.example(stuck)}",
+                    f"`{behaviour.name}/bb` can stop while no transition out of `{state.name}` holds ({owner}), {when(stuck)}",
                     state.location,
                     "add a transition for this case, narrow the terminal condition, or declare an `assume` that rules it out",
                 )
             )
     # `* -> recover` stands for one transition from every other state: dead only when none is ever taken.
-    declared: dict[object, list[Transition]] = {}
-    for transition in fsm.transitions:
-        declared.setdefault(transition.location or id(transition), []).append(transition)
-    for group in declared.values():
+    for group in _by_declaration(fsm.transitions).values():
         if len(group) == 1:
             if id(group[0]) in dead:
                 findings["EARL-W062"].append(dead[id(group[0])])
@@ -488,7 +535,68 @@ def analyse(context: CheckContext, subsystem: Subsystem, fsm: FSM, owner: str) -
     return Analysis(findings)
 
 
-def _fsm_key(subsystem: Subsystem) -> tuple[object, ...]:
+def _by_declaration(transitions: list[Transition]) -> dict[object, list[Transition]]:
+    """The transitions as written: a `*` line stands for several, one per other state."""
+    declared: dict[object, list[Transition]] = {}
+    for transition in transitions:
+        declared.setdefault(transition.location or id(transition), []).append(transition)
+    return declared
+
+
+def _fed_by_other_agents(context: CheckContext, subsystem: Subsystem) -> frozenset[tuple[str, int | None]]:
+    """The input buffers (name, index) an inter-agent link feeds: over Zenoh their sender can go stale,
+    and a stale buffer reads as timed out in every state (docs/distributed.md)."""
+    return frozenset(
+        (buffer.name, buffer.index)
+        for buffer in subsystem.input_buffers
+        if any(link.between_agents for link in context.links_into.get(id(buffer), ()))
+    )
+
+
+def _waits_for(references: list[ElementReference], read: Read) -> bool:
+    """Whether a state's buffer group names the buffer `read` reads (`wheelState[*]/ib` names them all)."""
+    for reference in references:
+        if reference.name != read.target.name:
+            continue
+        if reference.is_family_wide or not reference.indices or reference.indices == read.target.indices:
+            return True
+    return False
+
+
+def _buffer_key(read: Read) -> tuple[str, int | None] | None:
+    """The buffer a read names, as (name, index); None when its index is no whole number."""
+    indices = read.target.indices
+    if not indices:
+        return (read.target.name, None)
+    index = indices[0].value if len(indices) == 1 and isinstance(indices[0], Literal) else None
+    return (read.target.name, index) if isinstance(index, int) and not isinstance(index, bool) else None
+
+
+def _buffer_facts(encoder: _Encoder, state: State, fed_by_other_agents: frozenset[tuple[str, int | None]]) -> Function:
+    """What receiving in `state` makes true (docs/semantics.md, step 4): a buffer the state waits for
+    took a message or timed out (and, with no timeout, took one); a buffer it does not wait for never
+    times out. A buffer an inter-agent link feeds is exempt from the last two: its sender may go
+    stale, and a stale buffer reads as timed out in every state (docs/distributed.md)."""
+    facts = encoder.bdd.true
+    for (function, text), variable in list(encoder.calls.items()):
+        read = encoder.call_arguments[text]
+        if read.path:
+            continue
+        key = _buffer_key(read)
+        may_go_stale = key is None or key in fed_by_other_agents
+        waited_for = _waits_for(state.obligatory, read)
+        if function == "timeout":
+            arrived = encoder.calls.get(("newData", text))
+            if waited_for and arrived is not None:
+                facts &= arrived | variable
+            elif not waited_for and not may_go_stale:
+                facts &= ~variable
+        elif function == "newData" and waited_for and state.timeout is None and not may_go_stale:
+            facts &= variable  # waited for with no timeout: the iteration ends only once it has come
+    return facts
+
+
+def _fsm_key(context: CheckContext, subsystem: Subsystem) -> tuple[object, ...]:
     """Equal for two members of a family whose FSM, conditions and predicates read the same once
     expanded: one analysis serves them all. A member whose index reaches its conditions (`K == 1`
     is `2 == 1` in member 2) reads differently and is analysed on its own."""
@@ -496,7 +604,11 @@ def _fsm_key(subsystem: Subsystem) -> tuple[object, ...]:
     assert fsm is not None
     parts: list[object] = [id(subsystem.location), fsm.initial]
     parts += [(p.name, expression_text(p.expression)) for p in subsystem.primitive_predicates]
-    parts += [(s.name, s.behaviour) for s in fsm.states]
+    parts += [
+        (s.name, s.behaviour, tuple(reference_text(r) for r in s.obligatory), s.timeout is None) for s in fsm.states
+    ]
+    # which buffers can go stale (`_buffer_facts`): a member fed from another agent reads differently
+    parts.append(_fed_by_other_agents(context, subsystem))
     parts += [(t.source, t.destination, t.priority, expression_text(t.condition.expression)) for t in fsm.transitions]
     parts += [expression_text(a.expression) for a in fsm.assumptions]
     for behaviour in subsystem.basic_behaviours:
@@ -524,7 +636,7 @@ def analyses(context: CheckContext) -> dict[str, list[Finding]]:
     groups: dict[object, list[tuple[Agent, Subsystem]]] = {}
     for agent, subsystem in context.subsystems():
         if subsystem.fsm is not None:
-            groups.setdefault(_fsm_key(subsystem), []).append((agent, subsystem))
+            groups.setdefault(_fsm_key(context, subsystem), []).append((agent, subsystem))
     for members in groups.values():
         _, subsystem = members[0]
         assert subsystem.fsm is not None
@@ -561,8 +673,12 @@ _register(
     "`fsm.selectState()` must pick one next state. Two transitions leaving one state whose initial conditions "
     "can hold at once when its behaviour stops (under the FSM's `assume` formulas) need distinct priorities, "
     "or an assumption that excludes the overlap. Comparisons of one value with constants are decided over "
-    "the numbers (`v/ib > 5.0` and `v/ib < 3.0` never hold together), a primitive predicate stands for its "
-    "definition. The manual's own Table 5 overlaps: `jointMove,jointMove/t` and `jointMove,idle/t` "
+    "the numbers (`v/ib > 5.0` and `v/ib < 3.0` never hold together, infinity included), a primitive "
+    "predicate stands for its definition, and what receiving in the state makes true is known: a buffer "
+    "the state waits for took a message or timed out (with no `timeout`, took one), one it does not wait "
+    "for never times out — unless another agent feeds it, whose sender may go stale over Zenoh (the "
+    "message then says so). Two transitions into the same state may overlap: the next state is the same. "
+    "The manual's own Table 5 overlaps: `jointMove,jointMove/t` and `jointMove,idle/t` "
     "both hold when a new joint position arrives without an emergency stop.",
 )
 _register(

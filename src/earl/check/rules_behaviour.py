@@ -458,3 +458,47 @@ def timeouts_that_can_happen(context: CheckContext) -> Iterator[Finding]:
                         f"make it obligatory where it is awaited: `state S: B/bb {{ obligatory {target.name}/ib "
                         "timeout 50 ms }`",
                     )
+
+
+@rule("EARL-E045", Severity.ERROR, "a primitive predicate is not defined through itself", "§2.2, Table 4")
+def predicates_defined_through_themselves(context: CheckContext) -> Iterator[Finding]:
+    """A primitive predicate defined through itself (`odd/pp = not odd/pp`, or `p/pp = not q/pp` with
+    `q/pp = p/pp`) has no value: evaluating it would never end, and the FSM analysis leaves it free."""
+    for agent, subsystem in context.distinct_subsystems():
+        uses = {
+            predicate.name: sorted(
+                {
+                    node.target.name
+                    for node in walk(predicate.expression)
+                    if isinstance(node, Read) and node.target.kind is Kind.PRIMITIVE_PREDICATE
+                }
+            )
+            for predicate in subsystem.primitive_predicates
+            if predicate.implementation is None
+        }
+        locations = {p.name: p.location for p in subsystem.primitive_predicates}
+        reported: set[str] = set()
+        for start in uses:
+            if start in reported:
+                continue
+            # depth first, without recursion: a path of uses from `start` back to itself
+            stack: list[tuple[str, list[str]]] = [(start, [start])]
+            seen: set[str] = set()
+            while stack:
+                name, path = stack.pop()
+                for used in uses.get(name, ()):
+                    if used == start:
+                        cycle = [*path, start]
+                        reported.update(path)
+                        owner = subsystem_name(agent, subsystem)
+                        yield Finding(
+                            f"primitive predicate `{start}/pp` of {owner} is defined through itself "
+                            f"({' -> '.join(f'{n}/pp' for n in cycle)}), so it has no value",
+                            locations[start],
+                            "define it from buffers, memory and other predicates only",
+                        )
+                        stack.clear()
+                        break
+                    if used not in seen and used in uses:
+                        seen.add(used)
+                        stack.append((used, [*path, used]))
