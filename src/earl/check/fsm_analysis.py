@@ -440,13 +440,21 @@ def analyse(context: CheckContext, subsystem: Subsystem, fsm: FSM, owner: str) -
             )
             continue
         ordered = _evaluation_order(leaving)
+        # when none of the transitions tried before this priority holds, built up a priority at a time:
+        # one conjunction per transition, where conjoining every earlier one anew grew as the square
+        none_before = bdd.true
+        none_in_group = bdd.true
+        group_start = 0
         for position, transition in enumerate(ordered):
+            if position and _distinct_priorities(ordered[position - 1], transition):
+                none_before &= none_in_group
+                none_in_group = bdd.true
+                group_start = position
             holds = conditions[id(transition)] & stop
-            before = [t for t in ordered[:position] if _distinct_priorities(t, transition)]
-            first_to_hold = holds
-            for earlier in before:
-                first_to_hold &= ~conditions[id(earlier)]
+            none_in_group &= ~conditions[id(transition)]
+            first_to_hold = holds & none_before
             taken[id(transition)] = first_to_hold
+            before = ordered[:group_start]
             if holds == bdd.false:
                 never = (
                     "its condition never holds"
