@@ -537,3 +537,14 @@ def test_two_transitions_into_one_state_may_overlap_and_a_star_is_named_as_writt
     ]
     always = probe_text("true", "true", stop="true")
     assert always["EARL-E060"] == ["transitions `run,a/t` and `run,b/t` of x/a.cs can both hold, whatever the inputs"]
+
+
+def test_new_data_of_a_field_every_message_holds_is_new_data_of_the_message() -> None:
+    """`newData(s/ib.a)` of a field that is not optional holds exactly with `newData(s/ib)`; of an
+    optional one, only when the message holds it."""
+    assert probe_text("newData(s/ib.a)", "not newData(s/ib)") == {}
+    found = probe_text("newData(s/ib.opt)", "not newData(s/ib)")
+    assert found["EARL-W061"] == [
+        "`run/bb` can stop while no transition out of `run` holds (x/a.cs), e.g. when newData(s/ib) = true, "
+        "newData(s/ib.opt) = false"
+    ]

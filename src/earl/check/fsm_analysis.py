@@ -59,6 +59,7 @@ from earl.model.expressions import (
     ConstantError,
     ElementReference,
     Expression,
+    FieldAccess,
     Literal,
     Negate,
     Not,
@@ -67,6 +68,7 @@ from earl.model.expressions import (
 )
 from earl.model.kinds import Kind
 from earl.model.text import expression_text, reference_text
+from earl.model.types import StructType
 
 
 def _import_dd_without_networkx() -> ModuleType:
@@ -296,12 +298,30 @@ class _Encoder:
             for (function, _), variable in list(self.calls.items()):
                 read = self.call_arguments[_]
                 if function == "newData" and read.path:
-                    meaning &= variable.implies(self._call("newData", Read(read.target)))
+                    whole = self._call("newData", Read(read.target))
+                    # a field that every message holds is new exactly when the message is
+                    meaning &= variable.equiv(whole) if self._always_present(read) else variable.implies(whole)
                 elif function == "timeout":
                     meaning &= variable.implies(~self._call("newData", read))
         finally:
             self._depth = depth
         return meaning
+
+    def _always_present(self, read: Read) -> bool:
+        """Whether every message of the buffer holds what `read` names: fields none of them optional, no
+        array element on the way (an index can be out of range)."""
+        element = self.typer.context.input_buffer(self.subsystem, read.target)
+        if element is None:
+            return False
+        current = self.typer.context.structural(element.data_type)
+        for accessor in read.path:
+            if not (isinstance(accessor, FieldAccess) and isinstance(current, StructType)):
+                return False
+            field = current.field_named(accessor.name)
+            if field is None or field.optional:
+                return False
+            current = self.typer.context.structural(field.data_type)
+        return True
 
     def _regions(self, atoms: list[tuple[str, Constant, Function]]) -> Function:
         """One value compared with constants lies in one region of the line (or is one of the strings):
