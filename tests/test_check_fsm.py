@@ -548,3 +548,12 @@ def test_new_data_of_a_field_every_message_holds_is_new_data_of_the_message() ->
         "`run/bb` can stop while no transition out of `run` holds (x/a.cs), e.g. when newData(s/ib) = true, "
         "newData(s/ib.opt) = false"
     ]
+
+
+@pytest.mark.parametrize(
+    ("first", "second"),
+    [("hot/pp", "not (3.0 < v/ib)"), ("v/ib > 0.0", "not (v/ib > -0.0)"), ("v/ib > 2.0 + 1.0", "not (v/ib > 3.0)")],
+)
+def test_one_comparison_written_two_ways_is_related_both_ways(first: str, second: str) -> None:
+    """Kept once per (operator, constant), the second text of one comparison lost its regions: a false E060."""
+    assert probe_text(first, second) == {}

@@ -718,7 +718,8 @@ def test_a_run_time_beyond_any_float_is_refused_as_out_of_range_not_overflowed()
             (simulation.advance_to, 10**400, "at most 1e+09 s, not (a whole number of 401 digits)"),
             (simulation.advance_to, -(10**400), "from 0 on, not -(a whole number of 401 digits)"),
             (simulation.advance_to, -math.inf, "finite run time"),
-            (simulation.advance_by, 10**5000, "duration of at most 1e+09 s, not (a whole number of 5001 digits)"),
+            (simulation.advance_by, 10**5000, "advance_by takes a finite duration that ends the run by 1e+09 s"),
+            (simulation.advance_by, math.nan, "advance_by takes a finite duration"),
         ]:
             with pytest.raises(ValueError) as refused:
                 call(seconds)

@@ -429,6 +429,16 @@ SYNTAX = [
         "this `]` belongs to nothing before it",
     ),
     Malformed(
+        "brace_on_the_next_line_of_a_tf_without_its_equals",
+        "system s\nx/a {\n    cs {\n        work/pf(->)\n        b/bb {\n            tf\n            {work/pf}\n"
+        "            tc = true\n        }\n    }\n}\n",
+        6,
+        15,
+        "EARL-S006",
+        "expected `=` after `tf`, found `{`",
+        "a transition function is written `tf = {first/pf",
+    ),
+    Malformed(
         "comment_between_any_state_and_arrow",
         "system s\nx/a {\n    cs {\n        fsm {\n            initial r\n            state r: b/bb\n"
         "            *  // from every state\n                -> r when\n        }\n    }\n}\n",
@@ -890,3 +900,17 @@ def test_a_long_source_line_is_cut_around_the_spot(column: int) -> None:
     width = carets.count("^")
     assert quoted[start : start + width] == line[column - 1 : column - 1 + width]
     assert width == min(3, 1001 - column)
+
+
+def test_a_star_before_a_comment_holding_an_arrow_is_still_a_multiplication_and_quick(tmp_path: Path) -> None:
+    """`* // a -> b` then a number: the `->` is in the comment, so the `*` multiplies; and a comment of many
+    `//` after a `*` took exponential time to look past (the any-state lookahead split it every way)."""
+    import time
+
+    path = tmp_path / "star.earl"
+    slashes = " //" * 40
+    path.write_text(f"system s\nparam M: int = 2 * // twice -> more\n    3\nparam N: int = 2 *{slashes}\n    3\n")
+    started = time.monotonic()
+    system = earl.load(path)
+    assert time.monotonic() - started < 5
+    assert [p.name for p in system.parameters] == ["M", "N"]

@@ -425,6 +425,8 @@ def test_a_float32_holds_what_single_precision_holds_in_every_form_of_value() ->
     big = FLOAT32_MAX * 2
     assert scalar(FLOAT32_MAX) == FLOAT32_MAX and scalar(-1.5) == -1.5 and scalar(3) == 3.0
     assert scalar(math.inf) == math.inf and pose({"x": -math.inf, "y": 1e300})["x"] == -math.inf
+    # FLT_MAX as printed rounds to FLT_MAX: a float32, though a hair above the double FLT_MAX is
+    assert scalar(3.4028235e38) == 3.4028235e38 and short([3.4028235e38] * 3) == (3.4028235e38,) * 3
     assert short([1.0, math.inf, -FLOAT32_MAX]) == (1.0, math.inf, -FLOAT32_MAX)
     refusals = [
         (scalar, big, "x/mo = 6.805646932770577e+38 does not fit float32 (at most ±3.4028235e+38"),
@@ -445,6 +447,10 @@ def test_a_float32_initial_value_or_parameter_beyond_its_range_is_refused_by_the
     text = "system s\nr/a {\n    cs {\n        period 1 ms\n        x/m: float32 = 1e300\n        y/m: float32 = -3e38\n    }\n}\n"
     found = [(d.code, d.location.line if d.location else 0) for d in earl.check.check(earl.loads(text))]
     assert ("EARL-E043", 5) in found and ("EARL-E043", 6) not in found, found
+    assert earl.loads("system s\nparam F: float32 = 3.4028235e38\n").parameters[0].name == "F"
+    with pytest.raises(earl.EarlError) as huge:
+        earl.loads("system s\nparam H: double = 1" + "0" * 400 + "\n")
+    assert "is too large for a double" in str(huge.value)
     with pytest.raises(earl.EarlError) as refused:
         earl.loads("system s\nparam G: float32 = 1e39\n")
     assert "parameter `G` is `float32` but its value 1e+39 does not fit it (at most ±3.4028235e+38" in str(

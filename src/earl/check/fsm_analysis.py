@@ -326,8 +326,9 @@ class _Encoder:
     def _regions(self, atoms: list[tuple[str, Constant, Function]]) -> Function:
         """One value compared with constants lies in one region of the line (or is one of the strings):
         the atoms hold together only as in one of the regions."""
-        # each comparison once: the same text is the same Boolean (dd makes a new wrapper per `var`)
-        atoms = list({(op, type(c), c): (op, c, variable) for op, c, variable in atoms}.values())
+        # each Boolean once, by its name (dd makes a new wrapper per `var`, so not by identity); two
+        # texts of one comparison (`3.0 < v/ib`, `v/ib > 3.0`) are two Booleans, each in the regions
+        atoms = list({variable.var: (op, c, variable) for op, c, variable in atoms}.values())
         if len(atoms) > _MOST_COMPARISONS:
             return self.bdd.true  # regions × atoms grows as the square: such comparisons stay unrelated
         constants = [constant for _, constant, _ in atoms]

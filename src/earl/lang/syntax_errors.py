@@ -262,12 +262,10 @@ def _unexpected_token(
         end is not None
         and token.line > end[0]
         and token.type not in ("NUMBER", "INT", "STRING")
-        and token.type not in _STRAY_BRACKETS
         and _last_character(text, end) not in ("{", "}")
     ):
         # What is missing belongs at the end of the line before, not before the next statement. After
-        # `{` or `}` the line before is complete: the statement found is the one in the wrong place. A
-        # bracket that opens a line is pointed at itself: it is stray, nothing before it is missing.
+        # `{` or `}` the line before is complete: the statement found is the one in the wrong place.
         location = after_previous()
     else:
         column = token.column or 1
@@ -288,10 +286,17 @@ def _unexpected_token(
         if diagnostic is not None:
             return diagnostic
     diagnostic = _expected_message(token, context, location)
-    if token.type in _STRAY_BRACKETS and end is not None and token.line and token.line > end[0]:
-        # nothing is missing before a bracket that opens its line: "is a `}` missing?" misled
+    line = token.line
+    opens_its_line = token.type in _STRAY_BRACKETS and end is not None and line is not None and line > end[0]
+    if line is not None and opens_its_line and (diagnostic.hint is None or diagnostic.hint.startswith("is a `")):
+        # Nothing more specific is known of the line before (`tf` then `{…}` is told that `=` is
+        # missing): the bracket that opens its line is the stray thing, pointed at itself, and
+        # "is a `}` missing?" misled.
+        column = token.column or 1
         return dataclasses.replace(
-            diagnostic, hint=f"this `{token}` belongs to nothing before it: remove it, or move it to its declaration"
+            diagnostic,
+            location=SourceLocation(path, line, column, token.end_line or line, token.end_column or column + 1),
+            hint=f"this `{token}` belongs to nothing before it: remove it, or move it to its declaration",
         )
     return diagnostic
 

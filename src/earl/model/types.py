@@ -53,6 +53,9 @@ REAL_TYPES: frozenset[str] = frozenset({"double", "float32", "float64"})
 #: precision whatever the type; a finite value beyond its type's range is refused as an integer out of
 #: range is (an infinity, which IEEE 754 single precision has too, is not).
 REAL_LIMITS: dict[str, float] = {"float32": 3.4028234663852886e38}
+#: the least double that single precision rounds to infinity (half an ulp above its largest, 3.4028235e38):
+#: below it a value is a float32, `3.4028235e38` as printed included
+ROUNDS_TO_INFINITY: dict[str, float] = {"float32": 3.4028235677973366e38}
 
 #: The types a `param` may have, and the Python values each accepts (a boolean is no number here).
 PARAMETER_TYPES: dict[str, tuple[type, ...]] = {
@@ -77,6 +80,11 @@ def parameter_value_problem(type_name: str, value: object) -> str | None:
             return f"its value {_briefly(value)} does not fit it ({low}..{high})"
     if isinstance(value, float) and value != value:
         return "its value is NaN (not a number), which no computation or export can use"
+    if type_name in REAL_TYPES and isinstance(value, int) and not isinstance(value, bool):
+        try:
+            float(value)
+        except OverflowError:  # 400 digits: no double holds it
+            return f"its value {_briefly(value)} is too large for a {type_name}"
     if type_name in REAL_LIMITS and isinstance(value, (int, float)) and not real_fits(type_name, float(value)):
         return f"its value {_briefly(value)} does not fit it (at most ±{REAL_LIMITS[type_name]:.8g}; infinity may be)"
     if isinstance(value, str) and lone_surrogate(value) is not None:
@@ -86,8 +94,8 @@ def parameter_value_problem(type_name: str, value: object) -> str | None:
 
 def real_fits(type_name: str, value: float) -> bool:
     """Whether a real (not NaN) is within its type's range: any float is a double, an infinity any real."""
-    limit = REAL_LIMITS.get(type_name)
-    return limit is None or -limit <= value <= limit or value in (math.inf, -math.inf)
+    limit = ROUNDS_TO_INFINITY.get(type_name)
+    return limit is None or -limit < value < limit or value in (math.inf, -math.inf)
 
 
 def lone_surrogate(text: str) -> int | None:

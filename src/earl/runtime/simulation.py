@@ -212,9 +212,10 @@ class Simulation:
             raise TypeError(f"advance_by takes a duration in seconds (a number), not {seconds!r}")
         if seconds < 0:
             raise ValueError(f"advance_by takes a duration of 0 s or more, not {shown_value(seconds)}")
-        if seconds > Duration.MAX_SECONDS:
+        if seconds != seconds or seconds > Duration.MAX_SECONDS or self.time + seconds > Duration.MAX_SECONDS:
             raise ValueError(
-                f"advance_by takes a duration of at most {Duration.MAX_SECONDS:g} s, not {shown_value(seconds)}"
+                f"advance_by takes a finite duration that ends the run by {Duration.MAX_SECONDS:g} s of run time, "
+                f"not {shown_value(seconds)} (the run is at {self.time:g} s)"
             )
         self.advance_to(self.time + seconds, should_stop)
 

@@ -26,6 +26,7 @@ from earl.model.location import SourceLocation
 from earl.model.types import (
     INTEGER_RANGES,
     REAL_LIMITS,
+    ROUNDS_TO_INFINITY,
     ArrayType,
     DataType,
     PrimitiveType,
@@ -98,7 +99,7 @@ class QuickTest:
     low: int = 0
     high: int = 0
     size: int | None = None
-    #: the largest magnitude of a real type narrower than a double (float32), tested too
+    #: for a real type narrower than a double (float32): the least magnitude it rounds to infinity
     real_limit: float | None = None
 
     def lines(self, value: str, slow: str) -> list[str]:
@@ -106,7 +107,7 @@ class QuickTest:
         if self.kind == "real":
             test = f"type({value}) is float and {value} == {value}"  # not NaN
             if self.real_limit is not None:  # NaN fails the comparisons too; an infinity is left to `slow`
-                test = f"type({value}) is float and {-self.real_limit!r} <= {value} <= {self.real_limit!r}"
+                test = f"type({value}) is float and {-self.real_limit!r} < {value} < {self.real_limit!r}"
         elif self.kind == "boolean":
             test = f"type({value}) is bool"
         elif self.kind == "integer":
@@ -124,10 +125,10 @@ class QuickTest:
                 floats = f" and only_floats(map(type, {value}))"
             # Reals checked as a double[] are not yet within a float32's range: tested again
             in_range = (
-                "" if self.real_limit is None else f" and max(map(abs, {value}), default=0.0) <= {self.real_limit!r}"
+                "" if self.real_limit is None else f" and max(map(abs, {value}), default=0.0) < {self.real_limit!r}"
             )
             trusted = (
-                "" if self.real_limit is None else f" or max(map(abs, {value}), default=0.0) > {self.real_limit!r}"
+                "" if self.real_limit is None else f" or max(map(abs, {value}), default=0.0) >= {self.real_limit!r}"
             )
             return [
                 f"if type({value}) is not Reals{wrong_size}{trusted}:",
@@ -291,7 +292,7 @@ class TypeSystem:
         resolved = self.resolve(data_type)
         if isinstance(resolved, PrimitiveType):
             if resolved.name in _REAL_TYPES:
-                return QuickTest("real", real_limit=REAL_LIMITS.get(resolved.name))
+                return QuickTest("real", real_limit=ROUNDS_TO_INFINITY.get(resolved.name))
             if resolved.name == "boolean":
                 return QuickTest("boolean")
             if resolved.name in INTEGER_RANGES:
@@ -299,7 +300,7 @@ class TypeSystem:
                 return QuickTest("integer", low, high)
         if isinstance(resolved, ArrayType) and self._holds_reals(resolved):
             element = self.resolve(resolved.element)
-            limit = REAL_LIMITS.get(element.name) if isinstance(element, PrimitiveType) else None
+            limit = ROUNDS_TO_INFINITY.get(element.name) if isinstance(element, PrimitiveType) else None
             return QuickTest("real_array", size=_fixed_size(resolved), real_limit=limit)
         return None
 
@@ -344,9 +345,9 @@ class TypeSystem:
             resolved = self.resolve(field.data_type)
             primitive = resolved.name if isinstance(resolved, PrimitiveType) else None
             test: str
-            if primitive in REAL_LIMITS:  # NaN fails the comparisons too; an infinity goes to `slow`
-                limit = REAL_LIMITS[primitive]
-                test = f"type({variable}) is float and {-limit!r} <= {variable} <= {limit!r}"
+            if primitive in ROUNDS_TO_INFINITY:  # NaN fails the comparisons too; an infinity goes to `slow`
+                limit = ROUNDS_TO_INFINITY[primitive]
+                test = f"type({variable}) is float and {-limit!r} < {variable} < {limit!r}"
             elif primitive in _REAL_TYPES:
                 test = f"type({variable}) is float and {variable} == {variable}"
             elif primitive == "boolean":
