@@ -480,3 +480,19 @@ def test_text_of_the_spec_in_a_message_cannot_start_a_line_of_its_own(
     assert not any(line.startswith("error[EARL-E999]") for line in printed.splitlines())
     text = render(Diagnostic(Severity.ERROR, "cannot open x\nerror: y\x1b[31m", None, hint="a\rb"), SourceMap())
     assert text == "error: cannot open x\\nerror: y\\x1b[31m\n = hint: a\\rb"
+
+
+def test_the_source_line_and_the_file_name_of_a_diagnostic_are_printed_without_their_controls(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An ESC sequence in a comment on the line at fault, or a newline in the file's name, reached the
+    terminal as they were: the first could rewrite the screen, the second forge an `error:` line."""
+    path = tmp_path / "evil\nerror[EARL-E999]: fake.earl"
+    path.write_text("system s\nparam P: int = true  // \x1b[2K\x1b[1A\u009b31m\n")
+    printed = _check_exits_1(path, capsys)
+    assert "\x1b" not in printed and "\u009b" not in printed
+    assert not any(line.startswith("error[EARL-E999]") for line in printed.splitlines())
+    assert "evil\\nerror[EARL-E999]: fake.earl:2:16" in printed
+    source = next(line for line in printed.splitlines() if line.startswith("2 | "))
+    caret = next(line for line in printed.splitlines() if line.strip().startswith("| ") and "^" in line)
+    assert source.index("true") == caret.index("^")  # the caret still under the spot

@@ -99,20 +99,30 @@ def _window(source: str, start: int, width: int) -> tuple[str, int, int]:
 
 #: control characters as escapes: a message or hint quoting the spec's text (a string value, a file name
 #: with a newline) stays on its line, and cannot print what looks like another diagnostic
-_ESCAPED_CONTROLS = {code: f"\\x{code:02x}" for code in range(32)} | {10: "\\n", 13: "\\r", 9: "\\t", 127: "\\x7f"}
+_ESCAPED_CONTROLS = (
+    {code: f"\\x{code:02x}" for code in [*range(32), *range(0x7F, 0xA0)]}  # C0, DEL and C1 (CSI is 0x9b)
+    | {10: "\\n", 13: "\\r", 9: "\\t"}
+)
+
+
+def escape_controls(text: str) -> str:
+    """`text` with its control characters written as escapes: what the spec or its code wrote (a message,
+    a file name, a source line) can neither start a line of its own nor drive the terminal."""
+    return text.translate(_ESCAPED_CONTROLS)
 
 
 def render(diagnostic: Diagnostic, sources: SourceMap) -> str:
     """The diagnostic as plain text with the source line and a caret under the spot."""
     code = f"[{diagnostic.code}]" if diagnostic.code else ""
-    lines = [f"{diagnostic.severity.value}{code}: {diagnostic.message.translate(_ESCAPED_CONTROLS)}"]
+    lines = [f"{diagnostic.severity.value}{code}: {escape_controls(diagnostic.message)}"]
     location = diagnostic.location
     if location is not None:
         number = str(location.line)
         gutter = " " * len(number)
-        lines.append(f"{gutter}--> {location}")
+        lines.append(f"{gutter}--> {escape_controls(str(location))}")
         source = sources.line(location.file, location.line)
         if source is not None:
+            # a tab is one column wide as the caret counts; other controls are escaped after the caret is placed
             source = source.replace("\t", " ")
             if location.end_line == location.line and location.end_column > location.column:
                 width = location.end_column - location.column
@@ -121,9 +131,15 @@ def render(diagnostic: Diagnostic, sources: SourceMap) -> str:
             width = max(1, min(width, max(1, len(source) - location.column + 1)))
             source, offset, width = _window(source, location.column - 1, width)
             lines.append(f"{gutter} |")
-            lines.append(f"{number} | {source}")
+            lines.append(f"{number} | {_shown_source(source)}")
             lines.append(f"{gutter} | {' ' * offset}{'^' * width}")
     if diagnostic.hint:
         gutter = " " * (len(str(location.line)) if location else 0)
-        lines.append(f"{gutter} = hint: {diagnostic.hint.translate(_ESCAPED_CONTROLS)}")
+        lines.append(f"{gutter} = hint: {escape_controls(diagnostic.hint)}")
     return "\n".join(lines)
+
+
+def _shown_source(source: str) -> str:
+    """A source line as printed: a control character shown as `?`, one column like the character it
+    replaces, so that the caret below still points at the spot."""
+    return "".join("?" if ord(character) in _ESCAPED_CONTROLS else character for character in source)

@@ -11,6 +11,7 @@ from pathlib import Path
 
 from rich.console import Console
 
+from earl.diagnostics import escape_controls
 from earl.lang.loader import ParameterValue, locate_spec
 
 EXIT_USAGE = 2
@@ -82,6 +83,7 @@ def brief(text: str, limit: int = SHOWN_MESSAGE) -> str:
         if len(text) <= limit
         else f"{text[:limit]}… ({len(text) - limit:,} more characters; the trace has them all)"
     )
+    shown = escape_controls(shown)  # an exception's text must not drive the terminal or forge a line
     return shown if shown.isascii() else shown.encode("utf-8", "backslashreplace").decode("utf-8")
 
 
