@@ -291,3 +291,18 @@ def test_a_comment_that_ends_a_block_stays_in_it(tmp_path: Path, capsys: pytest.
     again.write_text(formatted)
     assert main(["fmt", "--check", str(again)]) == 0
     assert earl.load(again) == earl.load(path)
+
+
+def test_comments_parted_only_by_code_stay_one_block(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A comment above `tf` and one above `tc` gather at the end of the behaviour as one block: the
+    line of code between them is no blank line to keep."""
+    path = tmp_path / "behaviour.earl"
+    path.write_text(
+        "system s\nx/a {\n    cs {\n        period 1 ms\n        w/pf(->)\n        b/bb {\n            // the work\n"
+        "            tf = {w/pf}\n            // until true\n            tc = true\n        }\n    }\n}\n"
+    )
+    assert main(["fmt", str(path)]) == 0
+    assert (
+        "            tc = true\n            // the work\n            // until true\n        }\n"
+        in capsys.readouterr().out
+    )

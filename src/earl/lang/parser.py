@@ -179,7 +179,7 @@ def parse_text(text: str, path: str = "<text>", sources: SourceMap | None = None
         header_line = parsed.system_location.line
         parsed.header_comments = _with_blank_lines([c for c in comments if (c.line or 1) <= header_line], header_line)
         comments = [c for c in comments if (c.line or 1) > header_line]
-    parsed.closing_comments = attach_comments(parsed.declarations, comments, path)
+    parsed.closing_comments = attach_comments(parsed.declarations, comments, path, text)
     return parsed
 
 
@@ -262,7 +262,7 @@ def _statements(declarations: list[Any]) -> list[Any]:
 _BLOCKS: tuple[type, ...] = (StructType, Robot, Agent, Subsystem, BasicBehaviour, FSM)
 
 
-def attach_comments(declarations: list[Any], comments: list[Token], path: str) -> list[str]:
+def attach_comments(declarations: list[Any], comments: list[Token], path: str, text: str | None = None) -> list[str]:
     """Give each comment to the element it sits above, or ends the line of; return those after the last.
 
     A blank line that parts a comment from the comment or element below it is kept as an
@@ -271,6 +271,21 @@ def attach_comments(declarations: list[Any], comments: list[Token], path: str) -
     closing: list[str] = []
     if not comments:
         return closing
+    blank_lines: set[int] | None = None
+
+    def parted(first: int, last: int) -> bool:
+        """Whether a blank line lies between lines `first` and `last` (lines of code between two
+        comments part them no more than the blank lines the source has: a comment above `tf` and one
+        above `tc` stay one block)."""
+        nonlocal blank_lines
+        if last <= first + 1:
+            return False
+        if text is None:
+            return True
+        if blank_lines is None:
+            blank_lines = {number for number, line in enumerate(text.split("\n"), start=1) if not line.strip()}
+        return any(number in blank_lines for number in range(first + 1, last))
+
     # the first element of each line (the leftmost), and the lines that have one, in order: a
     # comment goes to the first of them at or below it; only lines are sorted, not elements
     by_line: dict[int, Any] = {}
@@ -312,7 +327,7 @@ def attach_comments(declarations: list[Any], comments: list[Token], path: str) -
         if inside and (position == len(starts) or starts[position] > inside[-1].location.end_line):
             block = inside[-1]
             closing_of_block = block.comments.closing
-            if closing_of_block and line > last_line[id(block)] + 1:
+            if closing_of_block and parted(last_line[id(block)], line):
                 closing_of_block.append("")
             closing_of_block.append(text)
             last_line[id(block)] = line
@@ -320,18 +335,18 @@ def attach_comments(declarations: list[Any], comments: list[Token], path: str) -
         if position < len(starts):
             element = by_line[starts[position]]
             leading = element.comments.leading
-            if leading and line > last_line[id(element)] + 1:
+            if leading and parted(last_line[id(element)], line):
                 leading.append("")
             elif not leading:
                 commented.append(element)
             leading.append(text)
             last_line[id(element)] = line
         else:
-            if closing and line > last_closing + 1:
+            if closing and parted(last_closing, line):
                 closing.append("")
             closing.append(text)
             last_closing = line
     for element in commented:
-        if element.location.line > last_line[id(element)] + 1:
+        if parted(last_line[id(element)], element.location.line):
             element.comments.leading.append("")
     return closing
