@@ -309,11 +309,11 @@ def attach_comments(declarations: list[Any], comments: list[Token], path: str, t
     commented: list[Any] = []
     last_closing = 0
     for comment in comments:
-        text = str(comment)
+        said = str(comment)
         line = comment.line or 1
         owner = by_line.get(line)
         if owner is not None and (comment.column or 1) > owner.location.column:
-            owner.comments.trailing = text
+            owner.comments.trailing = said
             continue
         while next_block < len(blocks) and blocks[next_block].location.line < line:
             block = blocks[next_block]
@@ -329,7 +329,7 @@ def attach_comments(declarations: list[Any], comments: list[Token], path: str, t
             closing_of_block = block.comments.closing
             if closing_of_block and parted(last_line[id(block)], line):
                 closing_of_block.append("")
-            closing_of_block.append(text)
+            closing_of_block.append(said)
             last_line[id(block)] = line
             continue
         if position < len(starts):
@@ -339,12 +339,12 @@ def attach_comments(declarations: list[Any], comments: list[Token], path: str, t
                 leading.append("")
             elif not leading:
                 commented.append(element)
-            leading.append(text)
+            leading.append(said)
             last_line[id(element)] = line
         else:
             if closing and parted(last_closing, line):
                 closing.append("")
-            closing.append(text)
+            closing.append(said)
             last_closing = line
     for element in commented:
         if parted(last_line[id(element)], element.location.line):
