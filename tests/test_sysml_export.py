@@ -450,3 +450,16 @@ def test_a_name_renamed_for_a_library_feature_gets_no_short_name_that_would_hide
     assert "package EARL_system {" in exported
     spec.write_text(text.replace(system_line, "system ScalarValues", 1), encoding="utf-8")
     assert "package ScalarValues_system {" in export_sysml(earl.load(spec))
+
+
+def test_a_system_built_in_python_is_resolved_before_it_is_written() -> None:
+    """An alias that names itself, added in Python, sent the writer into endless recursion: the reader's
+    R011 is raised instead, as for a file."""
+    from earl.export.sysml import export_sysml
+    from earl.model.types import ArrayType, TypeAlias, TypeReference
+
+    system = earl.loads("system s\n")
+    system.types.append(TypeAlias("A", ArrayType(TypeReference("A"), None)))
+    with pytest.raises(earl.EarlError) as refused:
+        export_sysml(system)
+    assert [d.code for d in refused.value.diagnostics] == ["EARL-R011"]

@@ -24,8 +24,10 @@ from pathlib import Path
 from earl import __version__
 from earl.check import context_for as check_context_for
 from earl.check.context import CheckContext, instance_name
+from earl.diagnostics import EarlError, Severity
 from earl.export.sysml_expressions import ExpressionWriter, literal
 from earl.export.sysml_names import Namespace, name_text, quoted, readable
+from earl.lang.resolver import resolve
 from earl.model.elements import (
     Agent,
     BasicBehaviour,
@@ -81,7 +83,14 @@ LIBRARY_PACKAGES = frozenset({"EARL", "ScalarValues", "ISQ", "SequenceFunctions"
 
 
 def export_sysml(system: System, parameters: Mapping[str, Value] | None = None) -> str:
-    """`system` as SysML v2 text, every family expanded with `parameters` (the system's own values by default)."""
+    """`system` as SysML v2 text, every family expanded with `parameters` (the system's own values by default).
+
+    A system built or edited in Python never met the reader: its names and types are resolved first,
+    and what the reader would refuse (a type alias naming itself, which the writer would follow for
+    ever) raises `EarlError` with the reader's diagnostics."""
+    unresolved = [d for d in resolve(system, parameters or {}) if d.severity is Severity.ERROR]
+    if unresolved:
+        raise EarlError(unresolved)
     return _Writer(system, check_context_for(system, parameters or {})).write()
 
 
