@@ -349,3 +349,13 @@ def test_a_data_type_given_as_a_string_in_python_is_said_where_it_is_declared() 
     assert first.code == "EARL-R012" and first.message == "`ManipulatorCommand` is not a data type"
     assert first.hint == 'write `PrimitiveType("ManipulatorCommand")` or `TypeReference("ManipulatorCommand")`'
     assert first.location == buffer.location
+
+
+def test_cycles_are_found_in_one_walk_each_once_from_where_the_walk_returns() -> None:
+    from earl.model.graphs import cycles
+
+    graph = {"a": ["b", "c"], "b": ["a"], "c": ["a", "d"], "d": [], "e": ["e"]}
+    assert list(cycles(graph, graph.__getitem__)) == [["a", "b"], ["a", "c"], ["e"]]
+    chain = {f"n{i}": [f"n{i + 1}"] for i in range(20_000)} | {"n20000": ["n0"]}
+    [cycle] = cycles(chain, chain.__getitem__)  # no recursion, and no walk from each node in turn
+    assert len(cycle) == 20_001 and cycle[0] == "n0"

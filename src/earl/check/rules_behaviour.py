@@ -11,6 +11,7 @@ from earl.check.registry import Finding, rule
 from earl.diagnostics import Severity
 from earl.model.elements import BasicBehaviour, Subsystem
 from earl.model.expressions import Call, ElementReference, Expression, Read, reads, walk
+from earl.model.graphs import cycles
 from earl.model.kinds import Kind
 from earl.model.location import SourceLocation
 from earl.model.text import expression_text, reference_text
@@ -478,27 +479,14 @@ def predicates_defined_through_themselves(context: CheckContext) -> Iterator[Fin
         }
         locations = {p.name: p.location for p in subsystem.primitive_predicates}
         reported: set[str] = set()
-        for start in uses:
-            if start in reported:
+        for cycle in cycles(uses, uses.__getitem__):
+            if set(cycle) <= reported:
                 continue
-            # depth first, without recursion: a path of uses from `start` back to itself
-            stack: list[tuple[str, list[str]]] = [(start, [start])]
-            seen: set[str] = set()
-            while stack:
-                name, path = stack.pop()
-                for used in uses.get(name, ()):
-                    if used == start:
-                        cycle = [*path, start]
-                        reported.update(path)
-                        owner = subsystem_name(agent, subsystem)
-                        yield Finding(
-                            f"primitive predicate `{start}/pp` of {owner} is defined through itself "
-                            f"({' -> '.join(f'{n}/pp' for n in cycle)}), so it has no value",
-                            locations[start],
-                            "define it from buffers, memory and other predicates only",
-                        )
-                        stack.clear()
-                        break
-                    if used not in seen and used in uses:
-                        seen.add(used)
-                        stack.append((used, [*path, used]))
+            reported.update(cycle)
+            first = cycle[0]
+            yield Finding(
+                f"primitive predicate `{first}/pp` of {subsystem_name(agent, subsystem)} is defined through itself "
+                f"({' -> '.join(f'{n}/pp' for n in [*cycle, first])}), so it has no value",
+                locations[first],
+                "define it from buffers, memory and other predicates only",
+            )

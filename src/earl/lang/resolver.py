@@ -40,6 +40,7 @@ from earl.model.expressions import (
     children,
     evaluate_constant,
 )
+from earl.model.graphs import cycles
 from earl.model.kinds import KIND_TITLES, Kind
 from earl.model.location import SourceLocation
 from earl.model.text import reference_text
@@ -391,38 +392,19 @@ class Resolver:
                 return [t for f in node.fields for t in direct(f.data_type)]
             return list(direct(node.data_type))
 
-        # One depth-first walk over every type, without recursion: a walk from each type in turn, as
-        # before, took time quadratic in a chain of aliases (5,000 of them: a minute).
+        # one walk over every type: a walk from each type in turn took a minute for 5,000 chained aliases
         reported: set[str] = set()
-        finished: set[str] = set()
-        for root in self.types:
-            if root in finished:
+        for cycle in cycles(self.types, contained):
+            if set(cycle) <= reported:
                 continue
-            path: list[str] = [root]  # the types being walked, each containing the next
-            on_path = {root}
-            pending = [iter(contained(root))]
-            while pending:
-                child = next(pending[-1], None)
-                if child is None:
-                    pending.pop()
-                    finished.add(path[-1])
-                    on_path.discard(path.pop())
-                    continue
-                if child in on_path:  # back to a type being walked: it contains itself
-                    cycle = path[path.index(child) :]
-                    if not set(cycle) <= reported:
-                        reported.update(cycle)
-                        definition = self.types[child]
-                        self.error(
-                            f"type `{child}` contains itself ({' -> '.join([*cycle, child])}), so it has no finite size",
-                            definition.location,
-                            "EARL-R011",
-                            "break the cycle with a variable array (`T[]`): an optional field does not end it",
-                        )
-                elif child not in finished and child in self.types:
-                    path.append(child)
-                    on_path.add(child)
-                    pending.append(iter(contained(child)))
+            reported.update(cycle)
+            first = cycle[0]
+            self.error(
+                f"type `{first}` contains itself ({' -> '.join([*cycle, first])}), so it has no finite size",
+                self.types[first].location,
+                "EARL-R011",
+                "break the cycle with a variable array (`T[]`): an optional field does not end it",
+            )
         return reported
 
     def data_type(self, data_type: DataType, scope: Scope, where: SourceLocation | None = None) -> None:
