@@ -8,6 +8,10 @@
     with N joints, N = 2,500, 5,000 and 10,000, so one agent holds N virtual and N real
     effectors and 2N links between them (a rule that compared every effector with every link
     of its agent once made N = 10,000 take 78 s).
+(e) The FSM analysis where conditions compare numbers: 8 values, 10 comparisons of each, a state
+    left by 20 to 40 prioritised transitions. The peer is the same analysis with the BDD
+    variables in the order of first use (earl's order before 2026-11-22: 30 transitions took
+    19 s, 40 took 66 s); both must report exactly the same findings.
 
 The spec of (a) and (b) comes from benchmarks/generate_families.py: agent and subsystem
 families, so the text is short and the cost is reading it, expanding it into 100,000 concrete
@@ -27,6 +31,7 @@ the process's CPU time (the machine may be shared; CPU time is what an idle mach
 from __future__ import annotations
 
 import argparse
+import functools
 import itertools
 import json
 import os
@@ -46,7 +51,13 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
 import earl  # noqa: E402
-from earl.check import CheckContext, check_context, collector_paused, context_for  # noqa: E402
+from earl.check import (  # noqa: E402
+    CheckContext,
+    check_context,
+    collector_paused,
+    context_for,
+    fsm_analysis,
+)
 from earl.check.fsm_analysis import analyse  # noqa: E402
 from earl.diagnostics import Severity  # noqa: E402
 from earl.model.elements import FSM, Subsystem  # noqa: E402
@@ -378,6 +389,80 @@ def bench_fsm(predicates: int, transitions: int, runs: int, peer: bool) -> dict[
     return row
 
 
+# ---------------------------------------------------------------------- (e): comparisons
+
+
+def comparisons_spec(values: int, comparisons: int, transitions: int, seed: int = 1) -> str:
+    """One subsystem reading a struct of `values` reals; `comparisons` predicates compare each with a
+    constant; state `run` is left by `transitions` prioritised transitions of one to three of them."""
+    chooser = random.Random(seed)
+    lines = [f"system compare{values}x{comparisons}x{transitions}", "", "struct S {"]
+    lines += [f"    f{i}: double" for i in range(values)]
+    lines += ["}", "", "r/r { a/a }", "", "a/a {", "    cs {", "        period 1 ms", "        s/ib: S"]
+    lines += ["        m/m: double = 0.0", '        f/pf(s/ib -> m/mo) = python "code:f"']
+    for value in range(values):
+        for constant in range(comparisons):
+            operator = chooser.choice(["<", ">", "<=", ">="])
+            lines.append(f"        p{value}_{constant}/pp = s/ib.f{value} {operator} {constant}.0")
+    lines += [
+        "        stop/pp = newData(s/ib)",
+        "        run/bb {",
+        "            tf = {f/pf}",
+        "            tc = stop/pp",
+    ]
+    lines += ["        }", "        fsm {", "            initial run", "            state run: run/bb"]
+    lines += [f"            state s{k}: run/bb" for k in range(4)]
+    for priority in range(1, transitions + 1):
+        literals = []
+        for _ in range(chooser.randint(1, 3)):
+            name = f"p{chooser.randrange(values)}_{chooser.randrange(comparisons)}/pp"
+            literals.append(("not " if chooser.random() < 0.3 else "") + name)
+        joined = chooser.choice([" and ", " or "]).join(literals)
+        lines.append(f"            run -> s{priority % 4} when {joined} priority {priority}")
+    lines += [f"            s{k} -> run when stop/pp" for k in range(4)]
+    lines += ["        }", "    }", "}", ""]
+    return "\n".join(lines)
+
+
+def bench_comparisons(transitions: list[int], peer_up_to: int, runs: int) -> list[dict[str, Any]]:
+    """(e): earl's variable order against the order of first use, on the same FSMs."""
+    rows = []
+    for count in transitions:
+        system = earl.loads(comparisons_spec(8, 10, count), "compare.earl")
+        context = context_for(system)
+        subsystem = next(s for _, s in context.subsystems())
+        fsm = subsystem.fsm
+        assert fsm is not None
+        timings = []
+        for _ in range(runs):
+            found, timing = timed(functools.partial(bdd_findings, context, subsystem, fsm))
+            timings.append(timing)
+        row: dict[str, Any] = {
+            "values": 8,
+            "comparisons_per_value": 10,
+            "transitions": count,
+            "runs": runs,
+            "earl": asdict(median(timings)),
+        }
+        if count <= peer_up_to:
+            ordered = fsm_analysis._Encoder.order_variables
+            fsm_analysis._Encoder.order_variables = lambda self: None  # type: ignore[method-assign]
+            try:
+                first_use, timing = timed(functools.partial(bdd_findings, context, subsystem, fsm))
+            finally:
+                fsm_analysis._Encoder.order_variables = ordered  # type: ignore[method-assign]
+            if first_use != found:
+                raise SystemExit(f"the two variable orders disagree:\n{found}\n{first_use}")
+            row["order_of_first_use"] = asdict(timing)
+            row["speedup"] = timing.wall / row["earl"]["wall"]
+        rows.append(row)
+        peer = f"{row['order_of_first_use']['wall']:.2f} s" if "order_of_first_use" in row else "not run"
+        print(
+            f"comparisons: {count} transitions: earl {row['earl']['wall']:.2f} s, order of first use {peer}", flush=True
+        )
+    return rows
+
+
 # ---------------------------------------------------------------------- report
 
 
@@ -469,6 +554,7 @@ def main(argv: list[str] | None = None) -> int:
     fsm_runs = max(3, arguments.runs)
     fsms = [bench_fsm(20, 50, fsm_runs, peer=True), bench_fsm(40, 100, fsm_runs, peer=False)]
     joints = bench_joints([250, 500] if arguments.quick else JOINTS, arguments.runs)
+    compared = bench_comparisons([10, 20] if arguments.quick else [20, 30, 40], 20 if arguments.quick else 30, fsm_runs)
     summary = report(sizes, fsms)
     print()
     for d in joints["doubling"]:
@@ -490,6 +576,7 @@ def main(argv: list[str] | None = None) -> int:
         "sizes": sizes,
         "fsm": fsms,
         "one_agent_family": joints,
+        "fsm_comparisons": compared,
         **summary,
     }
     arguments.output.parent.mkdir(parents=True, exist_ok=True)

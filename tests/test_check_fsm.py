@@ -557,3 +557,67 @@ def test_new_data_of_a_field_every_message_holds_is_new_data_of_the_message() ->
 def test_one_comparison_written_two_ways_is_related_both_ways(first: str, second: str) -> None:
     """Kept once per (operator, constant), the second text of one comparison lost its regions: a false E060."""
     assert probe_text(first, second) == {}
+
+
+def test_each_value_s_comparisons_sit_side_by_side_in_the_bdd_by_their_constants() -> None:
+    """The order of first use interleaved the values' comparisons, and a BDD then carries every value's
+    region at once (8 values of 10 comparisons, 40 prioritised transitions: a minute). Each predicate
+    follows the comparison it is defined by."""
+    from earl.check.fsm_analysis import _Encoder
+
+    extra = (
+        "        w/ib: double\n"
+        "        v2/pp = v/ib > 2.0\n        w1/pp = w/ib < 1.0\n        v1/pp = v/ib > 1.0\n"
+        "        w3/pp = w/ib < 3.0\n        both/pp = v1/pp and w3/pp\n"
+    )
+    system = earl.loads(
+        PROBE.replace("TC", "true")
+        .replace("FIRST", "v2/pp and w1/pp")
+        .replace("SECOND", "both/pp")
+        .replace("        false/pp = false\n", "        false/pp = false\n" + extra),
+        "probe.earl",
+    )
+    context = context_for(system)
+    subsystem = next(s for _, s in context.subsystems())
+    assert subsystem.fsm is not None
+    encoder = _Encoder(context, subsystem)
+    for transition in subsystem.fsm.transitions:
+        encoder.encode(transition.condition.expression)
+    encoder.order_variables()
+    levels = encoder.bdd.var_levels
+    order = [encoder.names[name] for name in sorted(levels, key=levels.__getitem__)]
+    assert order == [
+        "v/ib > 1.0", "v1/pp", "v/ib > 2.0", "v2/pp",
+        "w/ib < 1.0", "w1/pp", "w/ib < 3.0", "w3/pp", "both/pp",
+    ]  # fmt: skip
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_many_prioritised_transitions_over_many_comparisons_are_analysed_as_in_the_order_of_first_use(
+    seed: int,
+) -> None:
+    """The variable order changes how large the BDDs grow, never what the analysis finds."""
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
+    try:
+        from bench_check import comparisons_spec
+    finally:
+        sys.path.pop(0)
+    from earl.check import fsm_analysis
+
+    system = earl.loads(comparisons_spec(4, 5, 12, seed), "compare.earl")
+
+    def findings() -> list[tuple[str | None, str]]:
+        # the example after "e.g. when" is the BDD's first satisfying assignment, which the order may change
+        return [(d.code, d.message.split(", e.g. when")[0]) for d in check(system)]
+
+    ordered = findings()
+    original = fsm_analysis._Encoder.order_variables
+    fsm_analysis._Encoder.order_variables = lambda self: None  # type: ignore[method-assign]
+    try:
+        first_use = findings()
+    finally:
+        fsm_analysis._Encoder.order_variables = original  # type: ignore[method-assign]
+    assert {code for code, _ in ordered} & {"EARL-E060", "EARL-W062", "EARL-W061"}
+    assert sorted(ordered) == sorted(first_use)
