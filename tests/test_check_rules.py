@@ -624,6 +624,37 @@ CASES: list[Case] = [
         ),
     ),
     Case(
+        "EARL-W046",
+        add(
+            "struct Cmd {\n    speed: double?\n}\n",
+            edit(
+                ("out/ob: double", "out/ob: Cmd"),
+                ("inp/ib: double", "inp/ib: Cmd"),
+                (
+                    "        got/pp = newData(inp/ib)\n",
+                    "        got/pp = newData(inp/ib)\n        fast/pp = inp/ib.speed > 1.0\n",
+                ),
+                ("tc = got/pp", "tc = got/pp and fast/pp"),
+            ),
+        ),
+        27,
+        19,
+        "the terminal condition of `run/bb` (through `fast/pp`) reads `inp/ib.speed` even when no message that "
+        "carries the optional field `speed` has arrived",
+        add(
+            "struct Cmd {\n    speed: double?\n}\n",
+            edit(
+                ("out/ob: double", "out/ob: Cmd"),
+                ("inp/ib: double", "inp/ib: Cmd"),
+                (
+                    "        got/pp = newData(inp/ib)\n",
+                    "        got/pp = newData(inp/ib)\n        fast/pp = inp/ib.speed > 1.0\n",
+                ),
+                ("tc = got/pp", "tc = newData(inp/ib.speed) and fast/pp"),
+            ),
+        ),
+    ),
+    Case(
         "EARL-E017",
         edit(("    cs { period 1 ms\n        inp/ib", "    cs {\n        inp/ib")),
         34,

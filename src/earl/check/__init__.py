@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
-from earl.check import fsm_analysis, rules_behaviour, rules_communication, rules_structure
+from earl.check import fsm_analysis, rules_behaviour, rules_communication, rules_optional_fields, rules_structure
 from earl.check.context import CheckContext
 from earl.check.merging import Said, merge_family_members
 from earl.check.registry import RULES, Finding, Rule
@@ -22,7 +22,7 @@ from earl.model.expand import expand
 from earl.model.types import PARAMETER_TYPES, parameter_value_problem
 
 # The rule modules register themselves on import; they are listed here so that none is forgotten.
-RULE_MODULES = (rules_structure, rules_communication, rules_behaviour, fsm_analysis)
+RULE_MODULES = (rules_structure, rules_communication, rules_behaviour, rules_optional_fields, fsm_analysis)
 
 _ORDER = {Severity.ERROR: 0, Severity.WARNING: 1, Severity.NOTE: 2}
 

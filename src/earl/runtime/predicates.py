@@ -59,7 +59,9 @@ def compile_predicate(
     """
     source = f"lambda {_ARGUMENTS}: {_source(expression)}"
     code = compile(source, f"<earl predicate {description}>", "eval")
-    function: CompiledPredicate = eval(code, {"__builtins__": {}, "stale": stale, "_element": _element})
+    function: CompiledPredicate = eval(
+        code, {"__builtins__": {}, "stale": stale, "_element": _element, "_carries": _carries}
+    )
     return function
 
 
@@ -68,6 +70,16 @@ def _element(index: int) -> int:
     if index < 0:
         raise IndexError(f"element {index} does not exist (elements count from 0)")
     return index
+
+
+def _carries(value: Any, *steps: str | int) -> bool:
+    """Whether a message holds what `steps` (field names, element indices) lead to: `newData(x/ib.a.b)` is
+    false, not a fault, when the optional field `a` is absent, or when an array is shorter than an index."""
+    for step in steps:
+        if value is None or (isinstance(step, int) and step >= len(value)):
+            return False
+        value = value[step]
+    return value is not None
 
 
 def predicate_source(expression: Expression) -> str:
@@ -136,6 +148,17 @@ def _path(read: Read) -> str:
     return "".join(parts)
 
 
+def _steps(read: Read) -> str:
+    """The accessors of `read` as arguments of `_carries`: field names, and element indices (none negative)."""
+    steps = []
+    for accessor in read.path:
+        if isinstance(accessor, FieldAccess):
+            steps.append(repr(accessor.name))
+        else:
+            steps.append(f"_element({_source(accessor.index)})")
+    return ", ".join(steps)
+
+
 def _call(call: Call) -> str:
     if len(call.arguments) != 1 or not isinstance(call.arguments[0], Read):
         raise PredicateCompileError(f"`{call.function}` takes one input buffer")
@@ -147,7 +170,7 @@ def _call(call: Call) -> str:
         if not argument.path:
             return f"nd[{key}]"
         # Table 4's newData(manipulatorCommand/ib.msg.jointPosSetpoint): a new message that carries the field
-        return f"(nd[{key}] and ib[{key}]{_path(argument)} is not None)"
+        return f"(nd[{key}] and _carries(ib[{key}], {_steps(argument)}))"
     if call.function == "timeout":
         return f"to[{key}]"
     if call.function == "stale":
