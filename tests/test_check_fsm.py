@@ -621,3 +621,17 @@ def test_many_prioritised_transitions_over_many_comparisons_are_analysed_as_in_t
         fsm_analysis._Encoder.order_variables = original  # type: ignore[method-assign]
     assert {code for code, _ in ordered} & {"EARL-E060", "EARL-W062", "EARL-W061"}
     assert sorted(ordered) == sorted(first_use)
+
+
+def test_a_star_that_stands_for_one_transition_is_still_named_as_written() -> None:
+    """In an FSM of two states `* -> a` is the one transition `run,a`: it was named so, beside the line
+    `run -> a` it was said to be covered by."""
+    text = (
+        "system star2\nr/r { x/a }\nx/a {\n    cs {\n        period 10 ms\n        v/ib: double\n"
+        "        hot/pp = v/ib > 3.0\n        run/bb {\n            tf = {}\n            tc = true\n        }\n"
+        "        fsm {\n            initial run\n            state run: run/bb\n            state a: run/bb\n"
+        "            run -> a when hot/pp priority 1\n            * -> a when hot/pp priority 2\n"
+        "            a -> run when true\n        }\n    }\n}\n"
+    )
+    messages = [d.message for d in check(earl.loads(text, "star2.earl")) if d.code == "EARL-W062"]
+    assert messages == ["transition `*,a/t` of x/a.cs can never be taken from any state"]

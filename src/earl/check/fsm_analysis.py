@@ -453,7 +453,7 @@ def analyse(context: CheckContext, subsystem: Subsystem, fsm: FSM, owner: str) -
     assumed &= meaning
     fed_by_other_agents = _fed_by_other_agents(context, subsystem)
     #: transitions that a `*` stands for (one per other state), named as written
-    starred = {id(t) for group in _by_declaration(fsm.transitions).values() if len(group) > 1 for t in group}
+    starred = {id(t) for t in fsm.transitions if t.from_any_state}
 
     def named(transition: Transition) -> str:
         if id(transition) in starred:
@@ -570,7 +570,7 @@ def analyse(context: CheckContext, subsystem: Subsystem, fsm: FSM, owner: str) -
             )
     # `* -> recover` stands for one transition from every other state: dead only when none is ever taken.
     for group in _by_declaration(fsm.transitions).values():
-        if len(group) == 1:
+        if len(group) == 1 and not group[0].from_any_state:
             if id(group[0]) in dead:
                 findings["EARL-W062"].append(dead[id(group[0])])
         elif all(taken.get(id(t), bdd.false) == bdd.false for t in group):
@@ -607,7 +607,11 @@ def _by_declaration(transitions: list[Transition]) -> dict[object, list[Transiti
     """The transitions as written: a `*` line stands for several, one per other state."""
     declared: dict[object, list[Transition]] = {}
     for transition in transitions:
-        declared.setdefault(transition.location or id(transition), []).append(transition)
+        if transition.from_any_state:
+            key: object = ("*", transition.location, transition.destination)
+        else:
+            key = transition.location or id(transition)
+        declared.setdefault(key, []).append(transition)
     return declared
 
 

@@ -274,6 +274,8 @@ class Transition:
     priority: int | None = None
     location: SourceLocation | None = location_field()
     comments: Comments = comments_field()
+    #: one of the transitions a `*` line stands for (`concrete_transitions`), named in messages as written
+    from_any_state: bool = field(default=False, compare=False, repr=False)
     kind: ClassVar[Kind] = Kind.TRANSITION
 
     @property
@@ -322,6 +324,7 @@ class FSM:
                             transition.condition,
                             transition.priority,
                             transition.location,
+                            from_any_state=True,
                         )
                     )
         return result

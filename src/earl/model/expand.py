@@ -387,7 +387,14 @@ class _Context:
             for s in fsm.states
         ]
         result.transitions = [
-            Transition(t.source, t.destination, self.predicate(t.condition), t.priority, t.location)
+            Transition(
+                t.source,
+                t.destination,
+                self.predicate(t.condition),
+                t.priority,
+                t.location,
+                from_any_state=t.from_any_state,
+            )
             for t in fsm.concrete_transitions()
         ]
         result.assumptions = [replace(a, expression=self.expression(a.expression)) for a in fsm.assumptions]
