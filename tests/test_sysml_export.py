@@ -463,3 +463,14 @@ def test_a_system_built_in_python_is_resolved_before_it_is_written() -> None:
     with pytest.raises(earl.EarlError) as refused:
         export_sysml(system)
     assert [d.code for d in refused.value.diagnostics] == ["EARL-R011"]
+
+
+def test_a_comment_that_closes_a_block_is_in_the_element_s_doc() -> None:
+    text = (
+        "system closing\n\nstruct Limits {\n    v: double\n    // the last word on the limits\n}\n\n"
+        "x/a {\n    cs {\n        period 10 ms\n        // the subsystem's last word\n    }\n    // the agent's last word\n}\n"
+    )
+    exported = export_sysml(earl.loads(text, "closing.earl"))
+    for said in ("the last word on the limits", "the subsystem's last word", "the agent's last word"):
+        assert said in exported
+    assert exported.index("the agent's last word") < exported.index("the subsystem's last word")

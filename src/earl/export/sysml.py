@@ -99,7 +99,8 @@ def _comment_lines(comments: Comments | None) -> list[str]:
     """A person's `//` comments as plain sentences: markers and separator rules dropped."""
     if comments is None:
         return []
-    lines = [*comments.leading, *([comments.trailing] if comments.trailing else [])]
+    # what closes a block (`// end of the arm's limits` before its `}`) was written about the element too
+    lines = [*comments.leading, *([comments.trailing] if comments.trailing else []), *comments.closing]
     result = []
     for line in lines:
         text = line.strip()
