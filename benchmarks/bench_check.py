@@ -8,10 +8,12 @@
     with N joints, N = 2,500, 5,000 and 10,000, so one agent holds N virtual and N real
     effectors and 2N links between them (a rule that compared every effector with every link
     of its agent once made N = 10,000 take 78 s).
-(e) The FSM analysis where conditions compare numbers: 8 values, 10 comparisons of each, a state
-    left by 20 to 40 prioritised transitions. The peer is the same analysis with the BDD
-    variables in the order of first use (earl's order before 2026-11-22: 30 transitions took
-    19 s, 40 took 66 s); both must report exactly the same findings.
+(e) Large FSMs: conditions comparing numbers (8 values, 10 comparisons of each, a state left by
+    30 or 40 prioritised transitions) and Boolean inputs (60 predicates, one state left by 200
+    prioritised transitions). The peers are the same analysis on dd's pure-Python BDDs
+    (`dd.autoref`, earl's backend where dd's wheel brings no CUDD), and, for 30 comparing
+    transitions, also with the variables in the order of first use: earl before 2026-11-22's
+    eleventh session (17 s). Every variant must report exactly the same findings.
 
 The spec of (a) and (b) comes from benchmarks/generate_families.py: agent and subsystem
 families, so the text is short and the cost is reading it, expanding it into 100,000 concrete
@@ -424,12 +426,69 @@ def comparisons_spec(values: int, comparisons: int, transitions: int, seed: int 
     return "\n".join(lines)
 
 
-def bench_comparisons(transitions: list[int], peer_up_to: int, runs: int) -> list[dict[str, Any]]:
-    """(e): earl's variable order against the order of first use, on the same FSMs."""
+def booleans_spec(predicates: int, transitions: int, seed: int = 1) -> str:
+    """One state left by `transitions` prioritised transitions, each an `and` or an `or` of three
+    literals over `predicates` Boolean inputs: most are covered by those tried before them."""
+    chooser = random.Random(seed)
+    lines = [
+        f"system booleans{predicates}x{transitions}",
+        "",
+        "r/r { a/a }",
+        "",
+        "a/a {",
+        "    cs {",
+        "        period 1 ms",
+    ]
+    lines += [f"        x{i}/ib: boolean" for i in range(predicates)]
+    lines += [f"        p{i}/pp = x{i}/ib" for i in range(predicates)]
+    lines += ["        run/bb {", "            tf = {}", "            tc = true", "        }", "        fsm {"]
+    lines += ["            initial run", "            state run: run/bb"]
+    lines += [f"            state s{k}: run/bb" for k in range(4)]
+    for priority in range(1, transitions + 1):
+        literals = [
+            ("not " if chooser.random() < 0.4 else "") + f"p{chooser.randrange(predicates)}/pp" for _ in range(3)
+        ]
+        joined = chooser.choice([" and ", " or "]).join(literals)
+        lines.append(f"            run -> s{priority % 4} when {joined} priority {priority}")
+    lines += [f"            s{k} -> run when true" for k in range(4)]
+    lines += ["        }", "    }", "}", ""]
+    return "\n".join(lines)
+
+
+def _variant(
+    context: CheckContext, subsystem: Subsystem, fsm: FSM, pure_python: bool, first_use: bool
+) -> tuple[dict[str, set[str]], Timing]:
+    """The analysis on dd's pure-Python BDDs and/or with the variables in the order of first use."""
+    import dd.autoref
+
+    library, ordered = fsm_analysis.BDD, fsm_analysis._Encoder.order_variables
+    if pure_python:
+        fsm_analysis.BDD = dd.autoref.BDD  # type: ignore[misc]
+    if first_use:
+        fsm_analysis._Encoder.order_variables = lambda self: None  # type: ignore[method-assign]
+    try:
+        return timed(functools.partial(bdd_findings, context, subsystem, fsm))
+    finally:
+        fsm_analysis.BDD = library  # type: ignore[misc]
+        fsm_analysis._Encoder.order_variables = ordered  # type: ignore[method-assign]
+
+
+def bench_large_fsms(quick: bool, runs: int) -> list[dict[str, Any]]:
+    """(e): earl's analysis against the pure-Python backend and the order of first use, same findings."""
+    cases = [
+        ("8 values x 10 comparisons, 30 prioritised transitions", comparisons_spec(8, 10, 30), True),
+        ("8 values x 10 comparisons, 40 prioritised transitions", comparisons_spec(8, 10, 40), False),
+        ("60 Boolean predicates, 200 prioritised transitions from one state", booleans_spec(60, 200), False),
+    ]
+    if quick:
+        cases = [
+            ("8 values x 10 comparisons, 20 prioritised transitions", comparisons_spec(8, 10, 20), True),
+            ("30 Boolean predicates, 60 prioritised transitions from one state", booleans_spec(30, 60), False),
+        ]
+    print(f"earl backend: {fsm_analysis.BDD.__module__}", flush=True)
     rows = []
-    for count in transitions:
-        system = earl.loads(comparisons_spec(8, 10, count), "compare.earl")
-        context = context_for(system)
+    for name, text, with_first_use in cases:
+        context = context_for(earl.loads(text, "large.earl"))
         subsystem = next(s for _, s in context.subsystems())
         fsm = subsystem.fsm
         assert fsm is not None
@@ -438,28 +497,21 @@ def bench_comparisons(transitions: list[int], peer_up_to: int, runs: int) -> lis
             found, timing = timed(functools.partial(bdd_findings, context, subsystem, fsm))
             timings.append(timing)
         row: dict[str, Any] = {
-            "values": 8,
-            "comparisons_per_value": 10,
-            "transitions": count,
+            "fsm": name,
             "runs": runs,
             "earl": asdict(median(timings)),
+            "backend": fsm_analysis.BDD.__module__,
         }
-        if count <= peer_up_to:
-            ordered = fsm_analysis._Encoder.order_variables
-            fsm_analysis._Encoder.order_variables = lambda self: None  # type: ignore[method-assign]
-            try:
-                first_use, timing = timed(functools.partial(bdd_findings, context, subsystem, fsm))
-            finally:
-                fsm_analysis._Encoder.order_variables = ordered  # type: ignore[method-assign]
-            if first_use != found:
-                raise SystemExit(f"the two variable orders disagree:\n{found}\n{first_use}")
-            row["order_of_first_use"] = asdict(timing)
-            row["speedup"] = timing.wall / row["earl"]["wall"]
+        variants = [("pure_python", True, False)] + ([("pure_python_first_use", True, True)] if with_first_use else [])
+        for label, pure_python, first_use in variants:
+            other, timing = _variant(context, subsystem, fsm, pure_python, first_use)
+            if other != found:
+                raise SystemExit(f"{label} disagrees with earl on {name}:\n{found}\n{other}")
+            row[label] = asdict(timing)
+            row[f"{label}_ratio"] = timing.wall / row["earl"]["wall"]
         rows.append(row)
-        peer = f"{row['order_of_first_use']['wall']:.2f} s" if "order_of_first_use" in row else "not run"
-        print(
-            f"comparisons: {count} transitions: earl {row['earl']['wall']:.2f} s, order of first use {peer}", flush=True
-        )
+        said = ", ".join(f"{label} {row[label]['wall']:.2f} s" for label, _, _ in variants)
+        print(f"{name}: earl {row['earl']['wall']:.3f} s; {said}", flush=True)
     return rows
 
 
@@ -554,7 +606,7 @@ def main(argv: list[str] | None = None) -> int:
     fsm_runs = max(3, arguments.runs)
     fsms = [bench_fsm(20, 50, fsm_runs, peer=True), bench_fsm(40, 100, fsm_runs, peer=False)]
     joints = bench_joints([250, 500] if arguments.quick else JOINTS, arguments.runs)
-    compared = bench_comparisons([10, 20] if arguments.quick else [20, 30, 40], 20 if arguments.quick else 30, fsm_runs)
+    compared = bench_large_fsms(arguments.quick, fsm_runs)
     summary = report(sizes, fsms)
     print()
     for d in joints["doubling"]:
@@ -576,7 +628,7 @@ def main(argv: list[str] | None = None) -> int:
         "sizes": sizes,
         "fsm": fsms,
         "one_agent_family": joints,
-        "fsm_comparisons": compared,
+        "large_fsms": compared,
         **summary,
     }
     arguments.output.parent.mkdir(parents=True, exist_ok=True)

@@ -635,3 +635,18 @@ def test_a_star_that_stands_for_one_transition_is_still_named_as_written() -> No
     )
     messages = [d.message for d in check(earl.loads(text, "star2.earl")) if d.code == "EARL-W062"]
     assert messages == ["transition `*,a/t` of x/a.cs can never be taken from any state"]
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_pure_python_bdds_find_what_cudd_finds_word_for_word(seed: int, monkeypatch: pytest.MonkeyPatch) -> None:
+    """dd's wheel brings CUDD on this platform; where it does not, earl falls back on dd.autoref. The
+    examples are each the first path of a BDD in earl's own variable order: the same with both."""
+    import dd.autoref
+
+    from earl.check import fsm_analysis
+
+    texts = [random_fsm(seed), PROBE.replace("TC", "true").replace("FIRST", "v/ib > 3.0").replace("SECOND", "go/pp")]
+    expected = [[d.message for d in check(earl.loads(text, "x.earl"))] for text in texts]
+    assert any("e.g. when" in message for messages in expected for message in messages)
+    monkeypatch.setattr(fsm_analysis, "BDD", dd.autoref.BDD)
+    assert [[d.message for d in check(earl.loads(text, "x.earl"))] for text in texts] == expected

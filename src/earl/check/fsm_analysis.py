@@ -72,7 +72,8 @@ from earl.model.types import StructType
 
 
 def _import_dd_without_networkx() -> ModuleType:
-    """`dd.autoref`, imported while `import networkx` fails.
+    """dd's BDDs, imported while `import networkx` fails: `dd.cudd` (CUDD, in C) where dd's wheel
+    brings it, else the pure-Python `dd.autoref` (same interface, 20–100× slower on large FSMs).
 
     dd imports networkx only to draw BDDs as graphs, which earl never does, and falls back
     quietly when it is missing; importing it takes a quarter of a second of every `earl check`
@@ -83,7 +84,10 @@ def _import_dd_without_networkx() -> ModuleType:
     if absent:
         sys.modules["networkx"] = None  # type: ignore[assignment]  # makes `import networkx` raise ImportError
     try:
-        return importlib.import_module("dd.autoref")
+        try:
+            return importlib.import_module("dd.cudd")
+        except ImportError:
+            return importlib.import_module("dd.autoref")
     finally:
         if absent and "networkx" in sys.modules and sys.modules["networkx"] is None:
             del sys.modules["networkx"]
@@ -92,8 +96,8 @@ def _import_dd_without_networkx() -> ModuleType:
 if TYPE_CHECKING:
     from dd.autoref import BDD, Function
 else:
-    _autoref = _import_dd_without_networkx()
-    BDD, Function = _autoref.BDD, _autoref.Function
+    _dd = _import_dd_without_networkx()
+    BDD, Function = _dd.BDD, _dd.Function
 
 
 @dataclass(frozen=True)
@@ -163,6 +167,8 @@ class _Encoder:
 
     def __init__(self, context: CheckContext, subsystem: Subsystem) -> None:
         self.bdd = BDD()
+        # the order is `order_variables`' alone: CUDD would otherwise sift it as the BDDs grow
+        self.bdd.configure(reordering=False)
         self.subsystem = subsystem
         self.typer = ExpressionTyper(context, subsystem)
         self.names: dict[str, str] = {}  # BDD variable → the text a person reads
@@ -388,7 +394,7 @@ class _Encoder:
     def example(self, formula: Function) -> str:
         hidden = [name for name in self.names if name not in self.surface]
         shown = self.bdd.exist(hidden, formula) if hidden else formula
-        assignment: dict[str, Any] = self.bdd.pick(shown) or {}
+        assignment = self._first_path(shown)
         if not assignment:
             return "whatever the inputs"
         parts = [
@@ -396,6 +402,21 @@ class _Encoder:
             for name, value in sorted(assignment.items(), key=lambda item: self.names[item[0]])
         ]
         return ", ".join(parts)
+
+    def _first_path(self, formula: Function) -> dict[str, bool]:
+        """One way to satisfy `formula` (not false), the same whatever the BDD library: from the top
+        variable down, false where that still leaves a way, true otherwise; variables the path does not
+        meet are free."""
+        bdd = self.bdd
+        assignment: dict[str, bool] = {}
+        while formula != bdd.true:
+            name = formula.var
+            assert name is not None, "a constant other than true has no way to satisfy it"
+            low = bdd.let({name: False}, formula)
+            value = low == bdd.false
+            assignment[name] = value
+            formula = bdd.let({name: True}, formula) if value else low
+        return assignment
 
 
 def _constant_order(atom: tuple[str, Constant, Function]) -> tuple[int, Any]:
