@@ -420,7 +420,7 @@ def test_two_long_quantifiers_alike_in_their_first_words_are_two_booleans() -> N
     [
         ("v/ib > 1e16", "v/ib <= 1e16"),
         ("n/ib > 9007199254740992", "n/ib <= 9007199254740992"),
-        ("n/ib > 1" + "0" * 400, "n/ib < -1" + "0" * 400),
+        ("v/ib > 1" + "0" * 400, "v/ib < -1" + "0" * 400),  # beyond every double but infinity; an int never
         ("v/ib < 1e999", "v/ib > 2.0"),
     ],
 )
@@ -650,3 +650,23 @@ def test_the_pure_python_bdds_find_what_cudd_finds_word_for_word(seed: int, monk
     assert any("e.g. when" in message for messages in expected for message in messages)
     monkeypatch.setattr(fsm_analysis, "BDD", dd.autoref.BDD)
     assert [[d.message for d in check(earl.loads(text, "x.earl"))] for text in texts] == expected
+
+
+@pytest.mark.parametrize(
+    ("first", "second", "overlap", "dead"),
+    [
+        ("n/ib > 3 and n/ib < 4", "true", None, "run,a"),  # no whole number between 3 and 4
+        ("n/ib > 3.5", "n/ib < 4", None, None),  # 3 < 3.5: no number in both
+        ("n/ib >= 3", "n/ib <= 3", "n/ib <= 3 = true, n/ib >= 3 = true", None),  # 3 is in both
+        ("u/ib < 0", "true", None, "run,a"),  # a uint8 is never negative
+        ("u/ib > 255", "true", None, "run,a"),  # nor above 255
+        ("u/ib > 200", "u/ib > 254", "u/ib > 200 = true, u/ib > 254 = true", None),  # 255
+        ("v/ib > 3.0 and v/ib < 4.0", "v/ib > 3.5", "v/ib < 4.0 = true, v/ib > 3.0 = true, v/ib > 3.5 = true", None),
+    ],
+)
+def test_a_value_of_an_integer_type_holds_only_whole_numbers_of_its_range(
+    first: str, second: str, overlap: str | None, dead: str | None
+) -> None:
+    found = probe_text(first, second, extra="        n/ib: int\n        u/ib: uint8\n")
+    assert [m.rsplit("e.g. when ", 1)[-1] for m in found.get("EARL-E060", [])] == ([overlap] if overlap else [])
+    assert [m.split("`")[1] for m in found.get("EARL-W062", [])] == ([f"{dead}/t"] if dead else [])

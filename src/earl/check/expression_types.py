@@ -26,7 +26,7 @@ from earl.model.expressions import (
 from earl.model.kinds import Kind
 from earl.model.location import SourceLocation
 from earl.model.text import expression_text
-from earl.model.types import ArrayType, PrimitiveType, StructType, type_text
+from earl.model.types import INTEGER_RANGES, ArrayType, PrimitiveType, StructType, type_text
 
 BOOLEAN = "boolean"
 NUMBER = "number"
@@ -123,6 +123,16 @@ class ExpressionTyper:
                     )
             return BOOLEAN
         return UNKNOWN
+
+    def integer_range(self, expression: Expression) -> tuple[int, int] | None:
+        """The whole numbers a read of an integer type may hold (`uint8`: 0 to 255); None for any other
+        expression. Values are checked against their type where they are written."""
+        if not isinstance(expression, Read):
+            return None
+        structure = self._structure(expression)
+        if isinstance(structure, PrimitiveType):
+            return INTEGER_RANGES.get(structure.name)
+        return None
 
     def _expect(self, expression: Expression, expected: str, role: str, shown: str | None = None) -> None:
         actual = self.type_of(expression)

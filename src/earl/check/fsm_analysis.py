@@ -192,6 +192,8 @@ class _Encoder:
         self.definitions_met: list[Function] = []
         #: per compared value (its text): the comparisons with a constant, as (operator, constant, variable)
         self.comparisons: dict[str, list[tuple[str, Constant, Function]]] = {}
+        #: per compared value of an integer type: the whole numbers it may hold (`uint8`: 0 to 255)
+        self.integer_ranges: dict[str, tuple[int, int]] = {}
         self.calls: dict[tuple[str, str], Function] = {}  # (function, argument text) → variable
         self.call_arguments: dict[str, Read] = {}
         #: per predicate's variable: the variables its definition is written in (`order_variables`)
@@ -287,7 +289,11 @@ class _Encoder:
                 value = self.encode(value_side)
                 return value if (operator == "==") == right else ~value
             variable = self.variable(text)
-            self.comparisons.setdefault(expression_text(value_side), []).append((operator, right, variable))
+            value_text = expression_text(value_side)
+            self.comparisons.setdefault(value_text, []).append((operator, right, variable))
+            whole_numbers = self.typer.integer_range(value_side)
+            if whole_numbers is not None:
+                self.integer_ranges[value_text] = whole_numbers
             return variable
         if operator in ("==", "!=") and BOOLEAN == self.typer.type_of(comparison.left) == self.typer.type_of(
             comparison.right
@@ -327,8 +333,8 @@ class _Encoder:
         meaning = self.bdd.true
         for definition in self.definitions_met:
             meaning &= definition
-        for atoms in self.comparisons.values():
-            meaning &= self._regions(atoms)
+        for value_text, atoms in self.comparisons.items():
+            meaning &= self._regions(atoms, self.integer_ranges.get(value_text))
         depth, self._depth = self._depth, 1  # the buffer's own `newData` is no word of a condition
         try:
             for (function, _), variable in list(self.calls.items()):
@@ -359,9 +365,10 @@ class _Encoder:
             current = self.typer.context.structural(field.data_type)
         return True
 
-    def _regions(self, atoms: list[tuple[str, Constant, Function]]) -> Function:
+    def _regions(self, atoms: list[tuple[str, Constant, Function]], whole_numbers: tuple[int, int] | None) -> Function:
         """One value compared with constants lies in one region of the line (or is one of the strings):
-        the atoms hold together only as in one of the regions."""
+        the atoms hold together only as in one of the regions. A value of an integer type lies only in
+        the regions that hold a whole number of its range (`n/ib > 3 and n/ib < 4` never holds)."""
         # each Boolean once, by its name (dd makes a new wrapper per `var`, so not by identity); two
         # texts of one comparison (`3.0 < v/ib`, `v/ib > 3.0`) are two Booleans, each in the regions
         atoms = list({variable.var: (op, c, variable) for op, c, variable in atoms}.values())
@@ -373,12 +380,16 @@ class _Encoder:
             # infinity (`1e999`) is a value a real may hold, and compares with fractions as it should;
             # a NaN constant (`1e999 - 1e999`) compares false with every value, as at run time
             finite = sorted({Fraction(c) for c in constants if isinstance(c, int) or math.isfinite(c)})  # type: ignore[arg-type]
-            samples: list[object] = [-math.inf, math.inf, *finite]
-            if finite:
-                samples += [finite[0] - 1, finite[-1] + 1]
-                samples += [(low + high) / 2 for low, high in itertools.pairwise(finite)]
+            samples: list[object]
+            if whole_numbers is not None:
+                samples = _whole_number_samples(finite, *whole_numbers)
             else:
-                samples.append(Fraction(0))
+                samples = [-math.inf, math.inf, *finite]
+                if finite:
+                    samples += [finite[0] - 1, finite[-1] + 1]
+                    samples += [(low + high) / 2 for low, high in itertools.pairwise(finite)]
+                else:
+                    samples.append(Fraction(0))
         elif all(isinstance(c, str) for c in constants) and all(op in ("==", "!=") for op, _, _ in atoms):
             samples = [*dict.fromkeys(constants), object()]  # the strings, and any other
         else:
@@ -417,6 +428,17 @@ class _Encoder:
             assignment[name] = value
             formula = bdd.let({name: True}, formula) if value else low
         return assignment
+
+
+def _whole_number_samples(constants: list[Fraction], least: int, greatest: int) -> list[object]:
+    """A whole number of [least, greatest] in every region the constants cut the line into that holds one:
+    an open interval (a, b) holds one exactly when floor(a) + 1 < b, and then floor(a) + 1 is one; a
+    region unbounded below or above holds `least` or `greatest`, if any."""
+    candidates = {least, greatest}
+    for constant in constants:
+        below = math.floor(constant)
+        candidates.update((below - 1, below, below + 1, below + 2))
+    return [n for n in sorted(candidates) if least <= n <= greatest]
 
 
 def _constant_order(atom: tuple[str, Constant, Function]) -> tuple[int, Any]:
