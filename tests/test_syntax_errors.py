@@ -765,6 +765,16 @@ NAMES = [
         hint="did you mean `newData`?",
     ),
     Malformed(
+        "python_as_a_function_of_a_condition",
+        _in_cs("        m/m: int = 0\n        p/pp = python(m/mi)\n"),
+        10,
+        16,
+        "EARL-R040",
+        "`python(…)` is no function of a condition",
+        hint='a predicate computed by Python is declared `NAME/pp(READS) = python "MODULE:FUNCTION"`, '
+        "and named in conditions as `NAME/pp`",
+    ),
+    Malformed(
         "stale_of_a_memory",
         _in_cs("        m/m: int = 0\n        p/pp = stale(m/mi)\n"),
         10,

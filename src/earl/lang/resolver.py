@@ -651,7 +651,9 @@ class Resolver:
                     inner = {**scope, memory.family.index: declared.family}
                 self.expression(memory.initial_value, table, inner, owner, reads_allowed=False)
         for predicate in subsystem.primitive_predicates:
-            self.expression(predicate.expression, table, scope, owner)
+            self.expression(
+                predicate.expression, table, scope, owner, computed_by_python=predicate.implementation is not None
+            )
         for function in subsystem.partial_transition_functions:
             for reference in function.reads:
                 self.reference(
@@ -849,7 +851,10 @@ class Resolver:
         scope: Scope,
         owner: str,
         reads_allowed: bool = True,
+        computed_by_python: bool = False,
     ) -> None:
+        """Names, functions and reads of `expression`; `computed_by_python`: it is the `python(reads)` that
+        stands for a primitive predicate declared `= python "module:function"`, and only there."""
         stack: list[tuple[Expression, Scope]] = [(expression, scope)]
         while stack:
             node, node_scope = stack.pop()
@@ -891,9 +896,23 @@ class Resolver:
                     if index is not None:
                         stack.append((index, node_scope))
                 continue
-            if isinstance(node, Call) and node.function == PYTHON_PREDICATE:
+            if (
+                isinstance(node, Call)
+                and node.function == PYTHON_PREDICATE
+                and node is expression
+                and computed_by_python
+            ):
                 # a Python primitive predicate: its arguments are the reads it declares
                 stack.extend((child, node_scope) for child in children(node))
+                continue
+            if isinstance(node, Call) and node.function == PYTHON_PREDICATE:
+                self.error(
+                    "`python(…)` is no function of a condition",
+                    node.location,
+                    "EARL-R040",
+                    'a predicate computed by Python is declared `NAME/pp(READS) = python "MODULE:FUNCTION"`, '
+                    "and named in conditions as `NAME/pp`",
+                )
                 continue
             if isinstance(node, Call):
                 arity = BUILTIN_FUNCTIONS.get(node.function)
