@@ -223,6 +223,46 @@ def test_an_alias_that_names_itself_or_nests_beyond_the_limits_is_refused_once(
     assert error.location is not None and error.location.line == line
 
 
+@pytest.mark.parametrize(
+    ("text", "line", "message"),
+    [
+        (
+            "struct S0 {\n    v: double\n}\n"
+            + "".join(f"struct S{i} {{\n    a: S{i - 1}\n}}\n" for i in range(1, 3001)),
+            303,
+            "struct `S100` holds structs 101 levels deep: at most 100",
+        ),
+        (
+            "param N: int = 1000\nstruct Frame {\n    pixels: uint8[N][N]\n}\nstruct Video {\n    frames: Frame[100]\n}\n",
+            7,
+            "a value of type `Video` holds 100,000,000 numbers, Booleans and strings: at most 10,000,000",
+        ),
+        (
+            _in_cs("        arr/m: double[1000000000000]\n").removeprefix("system s\n\n"),
+            9,
+            "a value of `double[1000000000000]` holds 1,000,000,000,000 numbers, Booleans and strings",
+        ),
+        (
+            "struct Big {\n    v: double[100000000]\n}\n"
+            + "".join(f"struct B{i} {{\n    a: {'Big' if i == 0 else f'B{i - 1}'}[2]\n}}\n" for i in range(50)),
+            3,
+            "a value of type `Big` holds 100,000,000",
+        ),
+    ],
+    ids=["3000 nested structs", "a video of frames", "a memory of a trillion reals", "once, at the first too large"],
+)
+def test_a_value_too_deep_or_too_large_to_build_is_refused_once(
+    text: str, line: int, message: str, tmp_path: Path
+) -> None:
+    """`earl run` built a `double[1000000000000]` memory's first value element by element (it never ended),
+    and a value of 3,000 nested structs ended in "maximum recursion depth exceeded"; check accepted both."""
+    path = tmp_path / "large.earl"
+    path.write_text("system s\n\n" + text)
+    [error] = _errors(path)
+    assert message in error.message
+    assert error.location is not None and error.location.line == line
+
+
 def test_a_struct_holding_itself_through_a_variable_array_is_a_type(tmp_path: Path) -> None:
     path = tmp_path / "tree.earl"
     path.write_text("system s\n\nstruct Tree {\n    children: Tree[]\n}\n\ntype Forest = Tree[]\n")

@@ -9,7 +9,7 @@ changes the model; `earl.model.expand` can rely on a system it accepted.
 from __future__ import annotations
 
 import itertools
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -55,12 +55,20 @@ from earl.model.types import (
     TypeAlias,
     TypeReference,
     parameter_value_problem,
+    type_text,
 )
 
 Value = bool | int | float | str
 
 #: aliases and arrays nested in a type written out: walks over types recurse once per level
 MAX_ALIAS_NESTING = 100
+#: structs nested in structs (through fields, aliases and fixed-size arrays): the runtime builds, checks and
+#: encodes a value with one call per level
+MAX_STRUCT_NESTING = 100
+#: numbers, Booleans and strings in one value of a type, over its fixed-size arrays and every field: the
+#: runtime builds each buffer's and memory's first value element by element (`double[1000000000000]` would
+#: never end), and ten million take a second or two and 80 MB
+MAX_VALUE_ELEMENTS = 10_000_000
 #: A family larger than this is almost certainly a typo (`1..1000000`), and would exhaust memory.
 MAX_FAMILY_MEMBERS = 100_000
 #: subsystems and their elements once every family is expanded: nested families multiply (100,000
@@ -130,6 +138,8 @@ class Resolver:
         self.diagnostics: list[Diagnostic] = []
         self._said: set[tuple[str, str, SourceLocation | None]] = set()
         self.types: dict[str, Any] = {}
+        #: per named type: (structs nested, numbers/Booleans/strings in one value), once every type is read
+        self._type_sizes: dict[str, tuple[int, int]] | None = None
         self.agents: dict[str, _AgentTable] = {}
         #: elements the system will have once its families are expanded, counted as they are declared
         self._expanded = 0
@@ -293,7 +303,9 @@ class Resolver:
                     self.data_type(member.data_type, scope, member.location)
             else:
                 self.data_type(definition.data_type, scope, definition.location)
-        self._alias_depths(self._type_cycles())
+        reported = self._type_cycles()
+        self._alias_depths(reported)
+        self._value_sizes(scope, reported)
 
     def _alias_depths(self, reported: set[str]) -> None:
         """An alias is written out wherever it is used (the SysML export, a document's types): one that
@@ -361,6 +373,110 @@ class Resolver:
                     "EARL-R019",
                     "flatten the dimensions (`double[N * M]`), or group them in a struct",
                 )
+
+    def _value_sizes(self, scope: Scope, reported: set[str]) -> None:
+        """Structs nested too deep (EARL-R019) and values too large (EARL-R013), per named type, measured in
+        one walk over the types without recursion; the uses of types (buffers, memory) are measured by
+        `value_too_large`. A variable-size array counts as empty and is not followed: a struct may hold
+        itself through one (`children: T[]`), and what it holds is the messages' business."""
+        sizes: dict[str, tuple[int, int]] = {}
+        state: dict[str, bool] = {}  # False while being measured (a cycle R011 reported), True once measured
+
+        def named_inside(data_type: DataType) -> Iterator[str]:
+            while isinstance(data_type, ArrayType) and data_type.size is not None:
+                data_type = data_type.element
+            if isinstance(data_type, TypeReference) and data_type.name in self.types:
+                yield data_type.name
+
+        def successors(name: str) -> list[str]:
+            definition = self.types[name]
+            if isinstance(definition, StructType):
+                return [inner for field in definition.fields for inner in named_inside(field.data_type)]
+            return list(named_inside(definition.data_type))
+
+        for root in self.types:
+            if root in state:
+                continue
+            stack = [(root, iter(successors(root)))]
+            state[root] = False
+            while stack:
+                name, pending = stack[-1]
+                child = next(pending, None)
+                if child is None:
+                    stack.pop()
+                    state[name] = True
+                    sizes[name] = self._measure_definition(self.types[name], sizes, scope)
+                elif child not in state and child not in reported:
+                    state[child] = False
+                    stack.append((child, iter(successors(child))))
+        self._type_sizes = sizes
+        for name, definition in self.types.items():
+            if name in reported or name not in sizes:
+                continue
+            nesting, elements = sizes[name]
+            inner = [sizes.get(n, (0, 0)) for n in successors(name)]
+            if isinstance(definition, StructType) and nesting > MAX_STRUCT_NESTING:
+                if all(n <= MAX_STRUCT_NESTING for n, _ in inner):  # the first struct too deep, not each above it
+                    self.error(
+                        f"struct `{name}` holds structs {nesting} levels deep: at most {MAX_STRUCT_NESTING}",
+                        definition.location,
+                        "EARL-R019",
+                        "flatten the nesting, or hold the inner structs in a variable-size array (`parts: Part[]`)",
+                    )
+            elif elements > MAX_VALUE_ELEMENTS and all(e <= MAX_VALUE_ELEMENTS for _, e in inner):
+                self.error(
+                    f"a value of type `{name}` holds {elements:,} numbers, Booleans and strings: at most "
+                    f"{MAX_VALUE_ELEMENTS:,}",
+                    definition.location,
+                    "EARL-R013",
+                    "make its fixed-size arrays smaller, or variable-size (`double[]`)",
+                )
+
+    def _measure_definition(self, definition: Any, sizes: dict[str, tuple[int, int]], scope: Scope) -> tuple[int, int]:
+        if isinstance(definition, StructType):
+            measured = [self._measure(f.data_type, sizes, scope) for f in definition.fields]
+            return 1 + max((n for n, _ in measured), default=0), sum(e for _, e in measured)
+        return self._measure(definition.data_type, sizes, scope)
+
+    def _measure(self, data_type: DataType, sizes: dict[str, tuple[int, int]], scope: Scope) -> tuple[int, int]:
+        """(structs nested, numbers/Booleans/strings) of one value of a type as written; named types from `sizes`."""
+        count = 1
+        while isinstance(data_type, ArrayType):
+            if data_type.size is None:
+                return 0, 0
+            try:
+                length = evaluate_constant(data_type.size, _values(scope))
+            except ConstantError:
+                return 0, 0  # reported where the type is read, or depends on a family index
+            if isinstance(length, bool) or not isinstance(length, int) or length < 0:
+                return 0, 0
+            count *= length
+            data_type = data_type.element
+        if isinstance(data_type, TypeReference):
+            nesting, elements = sizes.get(data_type.name, (0, 0))
+            return nesting, count * elements
+        return 0, count
+
+    def value_too_large(self, data_type: DataType, scope: Scope, where: SourceLocation | None) -> None:
+        """EARL-R013 for a buffer or memory whose type, as written there, holds too many elements (a named
+        type too large is reported once, at its definition)."""
+        if self._type_sizes is None or isinstance(data_type, TypeReference):
+            return
+        _, elements = self._measure(data_type, self._type_sizes, scope)
+        inner: DataType = data_type
+        while isinstance(inner, ArrayType):
+            inner = inner.element
+        if isinstance(inner, TypeReference) and self._type_sizes.get(inner.name, (0, 0))[1] > MAX_VALUE_ELEMENTS:
+            return
+        if elements > MAX_VALUE_ELEMENTS:
+            self.error(
+                f"a value of `{type_text(data_type)}` holds {elements:,} numbers, Booleans and strings: at most "
+                f"{MAX_VALUE_ELEMENTS:,}",
+                (data_type.size.location if isinstance(data_type, ArrayType) and data_type.size is not None else None)
+                or where,
+                "EARL-R013",
+                "make the fixed-size arrays smaller, or variable-size (`double[]`)",
+            )
 
     def _alias_cycle(self, cycle: list[str], reported: set[str]) -> None:
         if cycle[0] in reported:
@@ -623,6 +739,7 @@ class Resolver:
                 self._count_expanded(subsystems * _size(family), element.location)
                 if hasattr(element, "data_type"):
                     self.data_type(element.data_type, scope, element.location)
+                    self.value_too_large(element.data_type, scope, element.location)
         return table
 
     def _agent_body(self, table: _AgentTable) -> None:
