@@ -44,7 +44,11 @@ class EarlError(Exception):
         self.diagnostics = list(diagnostics)
         self.sources = sources or SourceMap()
         first = self.diagnostics[0] if self.diagnostics else None
-        super().__init__(str(first) if first else "invalid specification")
+        said = str(first) if first else "invalid specification"
+        if len(self.diagnostics) > 1:
+            # an uncaught error prints only this: the rest are in `.diagnostics`
+            said += f" (and {len(self.diagnostics) - 1} more in .diagnostics)"
+        super().__init__(said)
 
 
 @dataclass

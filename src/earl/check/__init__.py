@@ -19,7 +19,7 @@ from earl.diagnostics import Diagnostic, Severity, did_you_mean
 from earl.lang.resolver import resolve
 from earl.model.elements import System
 from earl.model.expand import expand
-from earl.model.types import PARAMETER_TYPES, parameter_value_problem
+from earl.model.types import PARAMETER_TYPES, parameter_value_problem, refuse_wrong_parameters
 
 # The rule modules register themselves on import; they are listed here so that none is forgotten.
 RULE_MODULES = (rules_structure, rules_communication, rules_behaviour, rules_optional_fields, fsm_analysis)
@@ -36,6 +36,11 @@ def check(system: System, parameters: Mapping[str, bool | int | float | str] | N
 
     A parameter the system does not declare is EARL-R001, as `load(path, parameters)` reports it:
     a misspelt `N` must not leave the default in place without a word."""
+    if not isinstance(system, System):
+        raise TypeError(
+            f"check takes a System, as earl.load(path) returns it, not {type(system).__name__} {system!r:.60}"
+        )
+    refuse_wrong_parameters(parameters)
     unknown = unknown_parameters(system, parameters or {}) + wrong_parameter_values(system, parameters or {})
     if unknown:
         return unknown

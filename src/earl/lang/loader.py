@@ -18,7 +18,7 @@ from earl.lang.transformer import ParsedFile
 from earl.model.elements import Agent, Import, Link, Parameter, Robot, System
 from earl.model.expressions import Literal
 from earl.model.location import SourceLocation
-from earl.model.types import REAL_TYPES, StructType, TypeAlias
+from earl.model.types import REAL_TYPES, StructType, TypeAlias, refuse_wrong_parameters
 
 ParameterValue = bool | int | float | str
 
@@ -199,10 +199,17 @@ def merge(root: ParsedFile, imported: list[ParsedFile], sources: SourceMap, libr
     return system
 
 
+def _refuse_path(path: object, what: str) -> None:
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"{what} takes a file name (a str or a Path), not {type(path).__name__} {path!r:.60}")
+
+
 def load(path: str | Path, parameters: Mapping[str, ParameterValue] | None = None) -> System:
     """Read, parse and resolve a specification; raise `EarlError` with every problem found."""
     from earl.lang.resolver import resolve
 
+    _refuse_path(path, "load")
+    refuse_wrong_parameters(parameters)
     sources = SourceMap()
     spec = locate_spec(Path(path))
     with collection_paused():
@@ -270,6 +277,11 @@ def save(system: System, path: str | Path) -> None:
     link), the file keeps its permissions, and only a regular file is ever replaced — renaming
     over `/dev/null` would put a file in the device's place.  An OSError says what went wrong.
     """
+    if not isinstance(system, System):
+        raise TypeError(
+            f"save writes a System, as earl.load(path) returns it, not {type(system).__name__} {system!r:.60}"
+        )
+    _refuse_path(path, "save")
     target = Path(path)
     if target.is_symlink():
         target = _resolved(target)
@@ -308,7 +320,20 @@ def _umask() -> int:
 
 
 def loads(text: str, path: str = "<text>", parameters: Mapping[str, ParameterValue] | None = None) -> System:
-    """Like `load`, for text in memory; imports are resolved against the working directory."""
+    """Like `load`, for text in memory; imports are resolved against the working directory. `path` is the
+    name messages give the text."""
+    if isinstance(text, (bytes, bytearray)):
+        raise TypeError("loads takes the text of a specification (a str): decode the bytes first, `data.decode()`")
+    if not isinstance(text, str):
+        raise TypeError(f"loads takes the text of a specification (a str), not {type(text).__name__} {text!r:.60}")
+    if isinstance(path, Mapping):
+        raise TypeError(
+            "the second argument of loads is the name messages give the text; pass parameters by name: "
+            "loads(text, parameters={...})"
+        )
+    if not isinstance(path, str):
+        raise TypeError(f"loads names the text by a str, not {type(path).__name__} {path!r:.60}")
+    refuse_wrong_parameters(parameters)
     sources = SourceMap()
     with collection_paused():
         return _loads(text, path, parameters, sources)

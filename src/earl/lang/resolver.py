@@ -26,7 +26,9 @@ from earl.model.elements import (
     duration_problems,
 )
 from earl.model.expressions import (
+    ARITHMETIC_OPERATORS,
     BUILTIN_FUNCTIONS,
+    COMPARISON_OPERATORS,
     PYTHON_PREDICATE,
     Call,
     ConstantError,
@@ -59,6 +61,20 @@ from earl.model.types import (
 )
 
 Value = bool | int | float | str
+
+#: the operators of each kind of expression, and the quantifiers (EARL-R047)
+OPERATORS: dict[str, tuple[str, ...]] = {
+    "Comparison": COMPARISON_OPERATORS,
+    "Arithmetic": ARITHMETIC_OPERATORS,
+    "BooleanOperation": ("and", "or"),
+    "Quantifier": ("any", "all"),
+}
+_OPERATOR_ROLES = {
+    "Comparison": "comparison operator",
+    "Arithmetic": "arithmetic operator",
+    "BooleanOperation": "Boolean operator",
+    "Quantifier": "quantifier",
+}
 
 #: aliases and arrays nested in a type written out: walks over types recurse once per level
 MAX_ALIAS_NESTING = 100
@@ -759,6 +775,16 @@ class Resolver:
                         buffer.queue.capacity.location,
                         "EARL-R018",
                     )
+                policies = buffer.queue.OVERFLOW_POLICIES
+                if buffer.queue.overflow not in policies:
+                    # only a model built in Python can say this: the reader refuses it (EARL-S013)
+                    self.error(
+                        f"`{buffer.name}/ib` of {owner} has the overflow policy {buffer.queue.overflow!r}",
+                        buffer.location,
+                        "EARL-R018",
+                        did_you_mean(str(buffer.queue.overflow), policies)
+                        or f"a FIFO's overflow policy is one of {', '.join(policies)}",
+                    )
         for memory in subsystem.memories:
             if memory.initial_value is not None:
                 # a family's index is known in its own initial value: `history[J in 1..N]/m: double = J`
@@ -975,6 +1001,7 @@ class Resolver:
         stack: list[tuple[Expression, Scope]] = [(expression, scope)]
         while stack:
             node, node_scope = stack.pop()
+            self._operator(node, owner)
             if isinstance(node, Name):
                 if node.name not in node_scope:
                     self.unknown_name(node, node_scope)
@@ -1058,6 +1085,21 @@ class Resolver:
                     )
                     continue
             stack.extend((child, node_scope) for child in children(node))
+
+    def _operator(self, node: Expression, owner: str) -> None:
+        """EARL-R047: an operator or quantifier the language does not have (only a model built in Python
+        can hold one: the grammar reads none other)."""
+        operator = getattr(node, "operator", None) if not isinstance(node, Quantifier) else node.quantifier
+        if operator is None:
+            return
+        known = OPERATORS.get(type(node).__name__, ())
+        if operator not in known:
+            self.error(
+                f"`{operator}` is no {_OPERATOR_ROLES[type(node).__name__]} of EARL (in {owner})",
+                node.location,
+                "EARL-R047",
+                did_you_mean(str(operator), known) or f"EARL has {', '.join(f'`{k}`' for k in known)}",
+            )
 
     def _path(self, read: Read, declared: _Declared, scope: Scope) -> None:
         if not read.path:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from earl.model.expressions import Expression
@@ -205,3 +206,18 @@ def type_text(data_type: DataType) -> str:
         size = "" if data_type.size is None else expression_text(data_type.size)
         return f"{type_text(data_type.element)}[{size}]"
     return data_type.name
+
+
+def refuse_wrong_parameters(parameters: object) -> None:
+    """A TypeError saying what `parameters` takes, before a misuse fails deep inside with Python's words."""
+    if parameters is None:
+        return
+    if not isinstance(parameters, Mapping):
+        raise TypeError(
+            f"parameters takes a mapping of parameter names to values, e.g. {{'N': 3}}, not "
+            f"{type(parameters).__name__} {parameters!r:.60}"
+        )
+    for name in parameters:
+        # a value of the wrong type is EARL-R005, said with the parameter's declared type
+        if not isinstance(name, str):
+            raise TypeError(f"a parameter is named by a str, e.g. {{'N': 3}}, not {type(name).__name__} {name!r:.60}")

@@ -20,6 +20,8 @@ from collections.abc import Set as AbstractSet
 from typing import Any
 
 from earl.model.expressions import (
+    ARITHMETIC_OPERATORS,
+    COMPARISON_OPERATORS,
     Arithmetic,
     BooleanOperation,
     Call,
@@ -107,9 +109,15 @@ def _source(expression: Expression) -> str:
     if isinstance(expression, Negate):
         return f"(-{_source(expression.operand)})"
     if isinstance(expression, BooleanOperation):
+        if expression.operator not in ("and", "or"):
+            raise PredicateCompileError(f"`{expression.operator}` is no Boolean operator of EARL (`and`, `or`)")
         joiner = f" {expression.operator} "
         return "(" + joiner.join(_source(operand) for operand in expression.operands) + ")"
     if isinstance(expression, (Comparison, Arithmetic)):
+        known = COMPARISON_OPERATORS if isinstance(expression, Comparison) else ARITHMETIC_OPERATORS
+        if expression.operator not in known:
+            # a model built in Python and run unchecked: the operator would go into the generated code as it is
+            raise PredicateCompileError(f"`{expression.operator}` is no operator of EARL ({', '.join(known)})")
         return f"({_source(expression.left)} {expression.operator} {_source(expression.right)})"
     if isinstance(expression, Name):
         raise PredicateCompileError(f"`{expression.name}` is not a parameter or index with a known value")

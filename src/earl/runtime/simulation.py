@@ -23,6 +23,7 @@ from typing import Any, Protocol
 from earl.diagnostics import Diagnostic, EarlError, Severity
 from earl.model.elements import Duration, System
 from earl.model.expand import expand
+from earl.model.types import refuse_wrong_parameters
 from earl.runtime.binding import BindingProblem, resolve_callable, user_code_path
 from earl.runtime.builder import NANOSECONDS, Network, RemoteLinks, build_network, to_nanoseconds
 from earl.runtime.engine import exception_text
@@ -92,6 +93,7 @@ class Simulation:
         transport: Transport | None = None,
     ) -> None:
         _refuse_wrong_arguments(system, trace, record_memory=record_memory, record_links=record_links, agents=agents)
+        refuse_wrong_parameters(parameters)
         parameters = dict(parameters or {})
         if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
             # NumPy's seed sequences take whole numbers >= 0; anything else would fail inside the first

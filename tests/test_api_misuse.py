@@ -1,0 +1,125 @@
+"""The Python API refuses what the language cannot say, and arguments of the wrong kind, in plain words.
+
+A model built in Python never meets the grammar: an operator EARL does not have (`xor`, `=>`, `/`),
+an overflow policy it does not know, must be refused by the resolver as the reader refuses their
+text, not crash the checker or go into the run's generated code."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+import earl
+from earl import (
+    Arithmetic,
+    BooleanOperation,
+    Comparison,
+    ElementReference,
+    InputBuffer,
+    Kind,
+    Literal,
+    Predicate,
+    PrimitiveType,
+    Quantifier,
+    Queue,
+    Read,
+)
+from earl.check import check
+from earl.diagnostics import EarlError
+
+TEXT = """\
+system demo
+a/a {
+    cs {
+        period 10 ms
+        x/m: double = 0.0
+        never/pp = false
+        idle/bb {
+            tf = {}
+            tc = never/pp
+        }
+        fsm {
+            initial run
+            state run: idle/bb
+            state other: idle/bb
+            run -> other when never/pp
+        }
+    }
+}
+r/r {
+    a/a
+}
+"""
+
+X = Read(ElementReference("x", Kind.MEMORY_INPUT))
+NEVER = Read(ElementReference("never", Kind.PRIMITIVE_PREDICATE))
+
+
+@pytest.mark.parametrize(
+    ("condition", "message", "hint"),
+    [
+        (Comparison("=>", X, Literal(3.0)), "`=>` is no comparison operator of EARL (in a/a.cs)", "did you mean `>`?"),
+        (BooleanOperation("xor", (NEVER, Literal(True))), "`xor` is no Boolean operator of EARL", "did you mean `or`?"),
+        (
+            Comparison(">", Arithmetic("/", X, Literal(2.0)), Literal(1.0)),
+            "`/` is no arithmetic operator of EARL",
+            "EARL has `+`, `-`, `*`",
+        ),
+        (Quantifier("some", "K", Literal(1), Literal(2), NEVER), "`some` is no quantifier of EARL", None),
+    ],
+)
+def test_an_operator_the_language_does_not_have_is_r047(condition: Any, message: str, hint: str | None) -> None:
+    system = earl.loads(TEXT)
+    assert system.agents[0].subsystems[0].fsm is not None
+    system.agents[0].subsystems[0].fsm.transitions[0].condition = Predicate(condition)
+    [diagnostic] = check(system)
+    assert diagnostic.code == "EARL-R047" and diagnostic.message.startswith(message)
+    if hint is not None:
+        assert diagnostic.hint == hint
+    with pytest.raises(EarlError) as raised:
+        earl.simulate(system)
+    assert raised.value.diagnostics[0].code == "EARL-R047"
+
+
+def test_an_unchecked_run_refuses_an_unknown_operator_instead_of_generating_code_with_it() -> None:
+    system = earl.loads(TEXT)
+    assert system.agents[0].subsystems[0].fsm is not None
+    system.agents[0].subsystems[0].fsm.transitions[0].condition = Predicate(BooleanOperation("xor", (NEVER, NEVER)))
+    with pytest.raises(EarlError, match="`xor` is no Boolean operator of EARL"):
+        earl.simulate(system, check=False)
+
+
+def test_an_unknown_overflow_policy_is_r018() -> None:
+    system = earl.loads(TEXT)
+    subsystem = system.agents[0].subsystems[0]
+    subsystem.input_buffers.append(InputBuffer("inp", PrimitiveType("double"), queue=Queue(Literal(3), "dropAll")))
+    [diagnostic] = [d for d in check(system) if d.code == "EARL-R018"]
+    assert diagnostic.message == "`inp/ib` of a/a.cs has the overflow policy 'dropAll'"
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        (lambda: earl.loads(TEXT, {"N": 3}), "the second argument of loads is the name messages give the text"),
+        (lambda: earl.loads(TEXT.encode()), "decode the bytes first"),
+        (lambda: earl.loads(None), "loads takes the text of a specification (a str), not NoneType"),
+        (lambda: earl.loads("system x", path=5), "loads names the text by a str, not int 5"),
+        (lambda: earl.loads(TEXT, parameters={3: 4}), "a parameter is named by a str"),
+        (lambda: earl.load("x.earl", "N=3"), "parameters takes a mapping of parameter names to values"),
+        (lambda: earl.load(5), "load takes a file name (a str or a Path), not int 5"),
+        (lambda: earl.save("x", "x.earl"), "save writes a System, as earl.load(path) returns it, not str"),
+        (lambda: check("x"), "check takes a System, as earl.load(path) returns it, not str"),  # type: ignore[arg-type]
+        (lambda: earl.simulate(earl.loads(TEXT), parameters={3: 4}), "a parameter is named by a str"),
+    ],
+)
+def test_arguments_of_the_wrong_kind_are_a_type_error_that_says_what_is_taken(
+    call: Callable[[], object], message: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(TypeError) as raised:
+        call()
+    assert message in str(raised.value)
+    assert not list(tmp_path.iterdir())  # nothing written
