@@ -123,3 +123,40 @@ def test_arguments_of_the_wrong_kind_are_a_type_error_that_says_what_is_taken(
         call()
     assert message in str(raised.value)
     assert not list(tmp_path.iterdir())  # nothing written
+
+
+@pytest.mark.parametrize(
+    ("name", "hint"),
+    [
+        ("my arm", "e.g. `my_arm`"),
+        ("a1/a", "write the name without its kind: `a1`"),
+        ("", "a name is a letter or `_`, then letters, digits and `_`"),
+        ("1a", "e.g. `_1a`"),
+        ("système", "e.g. `syst_me`"),
+    ],
+)
+def test_a_name_the_language_could_not_read_back_is_r006(name: str, hint: str) -> None:
+    """`to_earl()` wrote such names as they are, and the text did not load; the run went ahead."""
+    system = earl.loads(TEXT)
+    system.agents[0].name = name
+    system.robots[0].agents[0] = ElementReference(name, Kind.AGENT)
+    [diagnostic] = [d for d in check(system) if d.code == "EARL-R006"]
+    assert diagnostic.message == f"{name!r} is no EARL name (an agent)"
+    assert diagnostic.hint is not None and hint in diagnostic.hint
+    with pytest.raises(EarlError):
+        earl.simulate(system)
+
+
+def test_every_kind_of_declared_name_is_checked() -> None:
+    system = earl.loads(TEXT)
+    subsystem = system.agents[0].subsystems[0]
+    subsystem.memories[0].name = "x y"
+    assert subsystem.fsm is not None
+    subsystem.fsm.states[1].name = "other state"
+    system.name = "my system"
+    said = [d.message for d in check(system) if d.code == "EARL-R006"]
+    assert said == [
+        "'my system' is no EARL name (the system)",
+        "'x y' is no EARL name (a memory of a/a.cs)",
+        "'other state' is no EARL name (a state of the FSM of a/a.cs)",
+    ]

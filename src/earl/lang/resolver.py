@@ -9,6 +9,7 @@ changes the model; `earl.model.expand` can rely on a system it accepted.
 from __future__ import annotations
 
 import itertools
+import re
 from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -188,6 +189,7 @@ class Resolver:
                     "EARL-R001",
                     did_you_mean(name, known) or f"system parameters: {', '.join(known) or 'none'}",
                 )
+        self._names()
         self._types(scope)
         for agent in self.system.agents:
             self._declare_agent(agent, scope)
@@ -196,6 +198,23 @@ class Resolver:
         self._links(self.system.links, scope, agent=None)
         self._robots()
         return self.diagnostics
+
+    def _names(self) -> None:
+        """EARL-R006: a declared name the language could not read back (`my arm`, `a1/a`, `système`); only
+        a model built in Python can hold one, and `to_earl()` would write text that does not load."""
+        for name, what, location in _declared_names(self.system):
+            if isinstance(name, str) and _NAME.fullmatch(name):
+                continue
+            if isinstance(name, str) and "/" in name and _NAME.fullmatch(name.split("/")[0]):
+                hint = f"write the name without its kind: `{name.split('/')[0]}` (the kind is the element's class)"
+            else:
+                suggestion = re.sub(r"\W", "_", name, flags=re.ASCII) if isinstance(name, str) and name else ""
+                if suggestion[:1].isdigit():
+                    suggestion = "_" + suggestion
+                hint = "a name is a letter or `_`, then letters, digits and `_`" + (
+                    f", e.g. `{suggestion}`" if suggestion else ""
+                )
+            self.error(f"{name!r} is no EARL name ({what})", location, "EARL-R006", hint)
 
     def _parameters(self, parameters: Sequence[Parameter], scope: Scope, overrides: Mapping[str, Value] = {}) -> None:
         seen: dict[str, Parameter] = {}
@@ -1277,6 +1296,51 @@ def _product_size(ranges: Sequence[range]) -> int:
 def resolve(system: System, overrides: Mapping[str, Value] | None = None) -> list[Diagnostic]:
     """Every name-resolution problem of a declared system, in the order found."""
     return Resolver(system, overrides or {}).run()
+
+
+_ELEMENT_LISTS = {
+    "input_buffers": "an input buffer",
+    "output_buffers": "an output buffer",
+    "memories": "a memory",
+    "primitive_predicates": "a primitive predicate",
+    "partial_transition_functions": "a partial transition function",
+    "basic_behaviours": "a basic behaviour",
+}
+#: a name as the grammar reads it (earl.lark's NAME)
+_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+
+
+def _declared_names(system: System) -> Iterator[tuple[object, str, SourceLocation | None]]:
+    """Every name the system declares, with what it names (for a message without a location)."""
+    yield system.name, "the system", system.location
+    for parameter in system.parameters:
+        yield parameter.name, "a system parameter", parameter.location
+    for definition in system.types:
+        yield definition.name, "a type", definition.location
+        for member in getattr(definition, "fields", ()):
+            yield member.name, f"a field of `{definition.name}`", member.location
+    for robot in system.robots:
+        yield robot.name, "a robot", robot.location
+    for agent in system.agents:
+        yield agent.name, "an agent", agent.location
+        if agent.family is not None:
+            yield agent.family.index, f"the family index of `{agent.name}/a`", agent.family.location
+        for parameter in agent.parameters:
+            yield parameter.name, f"a parameter of `{agent.name}/a`", parameter.location
+        for subsystem in agent.subsystems:
+            owner = f"{agent.name}/a.{subsystem.name}"
+            yield subsystem.name, f"a subsystem of `{agent.name}/a`", subsystem.location
+            if subsystem.family is not None:
+                yield subsystem.family.index, f"the family index of `{owner}`", subsystem.family.location
+            for kind, called in _ELEMENT_LISTS.items():
+                for element in getattr(subsystem, kind):
+                    yield element.name, f"{called} of {owner}", element.location
+                    family = getattr(element, "family", None)
+                    if family is not None:
+                        yield family.index, f"the family index of `{element.name}` in {owner}", family.location
+            if subsystem.fsm is not None:
+                for state in subsystem.fsm.states:
+                    yield state.name, f"a state of the FSM of {owner}", state.location
 
 
 def _size(family: IndexRange | None) -> int:
