@@ -160,3 +160,32 @@ def test_every_kind_of_declared_name_is_checked() -> None:
         "'x y' is no EARL name (a memory of a/a.cs)",
         "'other state' is no EARL name (a state of the FSM of a/a.cs)",
     ]
+
+
+@pytest.mark.parametrize(
+    ("options", "error", "message"),
+    [
+        ({"check": "no"}, TypeError, "check takes True or False, not str 'no'"),
+        ({"realtime": "yes"}, TypeError, "realtime takes True or False, not str 'yes'"),
+        ({"trace": "missing/run.mcap"}, FileNotFoundError, "the directory `missing` does not exist"),
+        ({"record_outputs": ["zz/a.cs.out"]}, ValueError, "record_outputs: `zz/a.cs.out` is no output buffer"),
+    ],
+)
+def test_simulation_options_of_the_wrong_kind_are_refused_before_the_run(
+    options: dict[str, Any], error: type[Exception], message: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(error) as raised:
+        earl.simulate(earl.loads(TEXT), environment=None, **options)
+    assert message in str(raised.value)
+
+
+def test_a_link_pattern_matching_nothing_is_a_warning_and_an_unknown_subsystem_a_plain_key_error() -> None:
+    from earl.runtime import RecordingWarning, UnknownSubsystem
+
+    with pytest.warns(RecordingWarning, match="record_links: `nomatch\\*` matches no link"):
+        simulation = earl.simulate(earl.loads(TEXT), environment=None, record_links=["nomatch*"])
+    with simulation, pytest.raises(UnknownSubsystem) as raised:
+        simulation.state_of("a/a.c")
+    assert isinstance(raised.value, KeyError)
+    assert str(raised.value) == "no subsystem `a/a.c` in this run. did you mean `a/a.cs`?"

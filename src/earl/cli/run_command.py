@@ -10,6 +10,7 @@ import signal
 import statistics
 import sys
 import time
+import warnings
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
@@ -155,7 +156,7 @@ def _run(arguments: argparse.Namespace) -> int:
 
     watch_supervisor()
     from earl.runtime.durations import parse_duration
-    from earl.runtime.simulation import Simulation, read_run_settings
+    from earl.runtime.simulation import RecordingWarning, Simulation, read_run_settings
 
     try:
         path = spec_path(arguments.spec)
@@ -240,19 +241,22 @@ def _run(arguments: argparse.Namespace) -> int:
             if agents:
                 plotted = [name for name in plotted if name.split(".", 1)[0] in agents]
             record_memory = sorted({*(record_memory or []), *plotted})
-        simulation = Simulation(
-            system,
-            parameters=parameters,
-            seed=seed,
-            environment=environment,
-            trace=arguments.trace,
-            record_memory=record_memory,
-            record_links=arguments.record_links if arguments.record_links is not None else settings.record_links,
-            record_outputs=plotted_outputs,
-            realtime=arguments.realtime,
-            agents=agents,
-            transport=transport,
-        )
+        with warnings.catch_warnings():
+            # a link pattern that matches nothing is said by `_say_what_is_not_recorded`, in the CLI's words
+            warnings.simplefilter("ignore", RecordingWarning)
+            simulation = Simulation(
+                system,
+                parameters=parameters,
+                seed=seed,
+                environment=environment,
+                trace=arguments.trace,
+                record_memory=record_memory,
+                record_links=arguments.record_links if arguments.record_links is not None else settings.record_links,
+                record_outputs=plotted_outputs,
+                realtime=arguments.realtime,
+                agents=agents,
+                transport=transport,
+            )
     except KeyboardInterrupt:  # a stop signal while the spec was read and the run set up
         _close(transport)
         said = "nothing was executed"

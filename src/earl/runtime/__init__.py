@@ -15,15 +15,17 @@ from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from earl.runtime.events import Fault
-    from earl.runtime.simulation import Simulation, SubsystemState, simulate
+    from earl.runtime.simulation import RecordingWarning, Simulation, SubsystemState, UnknownSubsystem, simulate
     from earl.runtime.values import Record
 
-__all__ = ["Fault", "Record", "Simulation", "SubsystemState", "simulate"]
+__all__ = ["Fault", "Record", "RecordingWarning", "Simulation", "SubsystemState", "UnknownSubsystem", "simulate"]
 
 _HOMES = {
     "Fault": "earl.runtime.events",
     "Record": "earl.runtime.values",
+    "RecordingWarning": "earl.runtime.simulation",
     "Simulation": "earl.runtime.simulation",
+    "UnknownSubsystem": "earl.runtime.simulation",
     "SubsystemState": "earl.runtime.simulation",
     "simulate": "earl.runtime.simulation",
 }

@@ -99,6 +99,13 @@ class Simulation:
             # NumPy's seed sequences take whole numbers >= 0; anything else would fail inside the first
             # function that draws a random number, and look like that function's fault
             raise ValueError(f"the seed is a whole number >= 0, not {seed!r}")
+        for flag, value in (("realtime", realtime), ("check", check)):
+            if not isinstance(value, bool):
+                # `check="no"` is truthy: it would check, and `realtime="yes"` would run paced by the clock
+                raise TypeError(f"{flag} takes True or False, not {type(value).__name__} {value!r:.60}")
+        if isinstance(trace, (str, Path)) and not Path(trace).parent.is_dir():
+            # said before the network is built and user code imported, not when the trace file is opened
+            raise FileNotFoundError(f"the trace cannot be written: the directory `{Path(trace).parent}` does not exist")
         if transport is not None and not realtime:
             raise ValueError("a run over a transport between processes runs in real time only (realtime=True)")
         if check:
@@ -138,6 +145,8 @@ class Simulation:
                 f"record_memory (--record-memory, run.toml's record_memory) names no subsystem of this run: {', '.join(unknown)} "
                 f"(subsystems are named like {next(iter(self.network.by_name), 'manip/a.cs')})"
             )
+        _refuse_unknown_outputs(record_outputs, self.expanded)
+        _warn_of_patterns_matching_nothing(record_links, self.network.link_types)
         self.trace: TraceWriter | None = None
         if trace is not None:
             self.trace = TraceWriter(
@@ -269,7 +278,7 @@ class Simulation:
 
             hint = did_you_mean(subsystem, list(self.network.by_name)) if isinstance(subsystem, str) else None
             hint = hint or f"subsystems are named like `{next(iter(self.network.by_name), 'manip/a.cs')}`"
-            raise KeyError(f"no subsystem `{subsystem}` in this run. {hint}".strip())
+            raise UnknownSubsystem(f"no subsystem `{subsystem}` in this run. {hint}".strip())
         state = engine.state
         return SubsystemState(
             engine.name,
@@ -313,6 +322,40 @@ def _code_directories(system: System) -> list[Path]:
     return [Path(system.source_file).resolve().parent] if system.source_file else []
 
 
+def _refuse_unknown_outputs(outputs: list[str] | None, expanded: System) -> None:
+    """record_outputs names output buffers whose links the trace records: a misspelt one would record nothing."""
+    if not outputs:
+        return
+    from earl.diagnostics import did_you_mean
+    from earl.runtime.names import subsystem_name
+
+    known = [
+        f"{subsystem_name(a, s)}.{o.name}" for a in expanded.agents for s in a.subsystems for o in s.output_buffers
+    ]
+    for name in outputs:
+        if name not in known:
+            hint = (
+                did_you_mean(name, known)
+                or f"output buffers are named like `{known[0] if known else 'manip/a.cs.manipulatorState'}`"
+            )
+            raise ValueError(f"record_outputs: `{name}` is no output buffer of this run; {hint}")
+
+
+def _warn_of_patterns_matching_nothing(patterns: list[str] | None, links: Mapping[str, object]) -> None:
+    """A misspelt glob would leave the trace quietly without the links meant (`earl run` says the same)."""
+    import warnings
+    from fnmatch import fnmatchcase
+
+    for pattern in patterns or []:
+        if not any(fnmatchcase(link, pattern) for link in links):
+            shown = ", ".join(sorted(links)[:8]) + (" …" if len(links) > 8 else "")
+            warnings.warn(
+                f"record_links: `{pattern}` matches no link (the links: {shown or 'none'})",
+                RecordingWarning,
+                stacklevel=3,
+            )
+
+
 def _refuse_wrong_arguments(system: object, trace: object, **lists: object) -> None:
     """A TypeError that says what an argument takes, before anything fails deeper with Python's own words."""
     if not isinstance(system, System):
@@ -324,6 +367,17 @@ def _refuse_wrong_arguments(system: object, trace: object, **lists: object) -> N
     for name, value in lists.items():
         if isinstance(value, (str, bytes)):
             raise TypeError(f"{name} takes a list of names, e.g. [{value!r:.60}], not a single string")
+
+
+class RecordingWarning(UserWarning):
+    """An option that chooses what the trace records chooses nothing (`earl run` says it in its own words)."""
+
+
+class UnknownSubsystem(KeyError):
+    """`state_of` a name no subsystem of the run has; a KeyError whose message prints without quotes."""
+
+    def __str__(self) -> str:
+        return str(self.args[0]) if self.args else ""
 
 
 class EnvironmentFailed(RuntimeError):
