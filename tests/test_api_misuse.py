@@ -61,7 +61,11 @@ NEVER = Read(ElementReference("never", Kind.PRIMITIVE_PREDICATE))
 @pytest.mark.parametrize(
     ("condition", "message", "hint"),
     [
-        (Comparison("=>", X, Literal(3.0)), "`=>` is no comparison operator of EARL (in a/a.cs)", "did you mean `>`?"),
+        (
+            Comparison("=>", X, Literal(3.0)),
+            "`=>` is no comparison operator of EARL (in `a/a.cs`)",
+            "did you mean `>`?",
+        ),
         (BooleanOperation("xor", (NEVER, Literal(True))), "`xor` is no Boolean operator of EARL", "did you mean `or`?"),
         (
             Comparison(">", Arithmetic("/", X, Literal(2.0)), Literal(1.0)),
@@ -97,7 +101,7 @@ def test_an_unknown_overflow_policy_is_r018() -> None:
     subsystem = system.agents[0].subsystems[0]
     subsystem.input_buffers.append(InputBuffer("inp", PrimitiveType("double"), queue=Queue(Literal(3), "dropAll")))
     [diagnostic] = [d for d in check(system) if d.code == "EARL-R018"]
-    assert diagnostic.message == "`inp/ib` of a/a.cs has the overflow policy 'dropAll'"
+    assert diagnostic.message == "`inp/ib` has the overflow policy 'dropAll' (in `a/a.cs`)"
 
 
 @pytest.mark.parametrize(
@@ -189,3 +193,25 @@ def test_a_link_pattern_matching_nothing_is_a_warning_and_an_unknown_subsystem_a
         simulation.state_of("a/a.c")
     assert isinstance(raised.value, KeyError)
     assert str(raised.value) == "no subsystem `a/a.c` in this run. did you mean `a/a.cs`?"
+
+
+def test_a_finding_in_an_element_built_in_python_says_which_declaration_it_is_about() -> None:
+    """Such elements have no location: `a FIFO holds at least one message, not 0` did not say whose."""
+    from earl import ArrayType, Memory
+
+    system = earl.loads(TEXT)
+    subsystem = system.agents[0].subsystems[0]
+    subsystem.input_buffers.append(InputBuffer("inp", PrimitiveType("double"), queue=Queue(Literal(0))))
+    subsystem.memories.append(Memory("y", PrimitiveType("real")))
+    subsystem.memories.append(Memory("z", ArrayType(PrimitiveType("double"), Literal(-1))))
+    said = {(d.code, d.message, d.hint) for d in check(system)}
+    assert said == {
+        (
+            "EARL-R012",
+            "unknown primitive type `real` (in `a/a.cs`)",
+            "the primitive types: boolean, int8, int16, int32, int64, uint8, uint16, uint32, uint64, int, float32, "
+            "float64, double, string, bytes; a struct or alias is a `TypeReference`",
+        ),
+        ("EARL-R013", "an array size must not be negative, here it is -1 (in `a/a.cs`)", None),
+        ("EARL-R018", "a FIFO holds at least one message, not 0 (in `a/a.cs`)", None),
+    }

@@ -155,6 +155,8 @@ class Resolver:
         self.diagnostics: list[Diagnostic] = []
         self._said: set[tuple[str, str, SourceLocation | None]] = set()
         self.types: dict[str, Any] = {}
+        #: the declaration being resolved (`a/a.cs`), named by a message that has no location
+        self._place: str | None = None
         #: per named type: (structs nested, numbers/Booleans/strings in one value), once every type is read
         self._type_sizes: dict[str, tuple[int, int]] | None = None
         self.agents: dict[str, _AgentTable] = {}
@@ -166,6 +168,9 @@ class Resolver:
     def error(self, message: str, location: SourceLocation | None, code: str, hint: str | None = None) -> None:
         # An element of a family, or a link resolved from both of its ends, can meet the same problem
         # more than once: the reader is told once, at the place it was written.
+        if location is None and self._place is not None and self._place not in message:
+            # a model built in Python has no locations: the message says which element it is about
+            message = f"{message} (in {self._place})"
         key = (code, message, location)
         if key in self._said:
             return
@@ -195,8 +200,10 @@ class Resolver:
             self._declare_agent(agent, scope)
         for table in self.agents.values():
             self._agent_body(table)
+        self._place = "the links between agents"
         self._links(self.system.links, scope, agent=None)
         self._robots()
+        self._place = None
         return self.diagnostics
 
     def _names(self) -> None:
@@ -325,6 +332,7 @@ class Resolver:
             else:
                 self.types[definition.name] = definition
         for definition in self.system.types:
+            self._place = f"type `{definition.name}`"
             if isinstance(definition, StructType):
                 names: dict[str, Any] = {}
                 for member in definition.fields:
@@ -338,6 +346,7 @@ class Resolver:
                     self.data_type(member.data_type, scope, member.location)
             else:
                 self.data_type(definition.data_type, scope, definition.location)
+        self._place = None
         reported = self._type_cycles()
         self._alias_depths(reported)
         self._value_sizes(scope, reported)
@@ -577,6 +586,16 @@ class Resolver:
                     self.error(
                         f"an array size must not be negative, here it is {size}", data_type.size.location, "EARL-R013"
                     )
+        elif isinstance(data_type, PrimitiveType):
+            if data_type.name not in PRIMITIVE_TYPES:
+                # only a model built in Python can hold this: the reader makes a TypeReference of a name
+                self.error(
+                    f"unknown primitive type `{data_type.name}`",
+                    data_type.location or where,
+                    "EARL-R012",
+                    did_you_mean(str(data_type.name), PRIMITIVE_TYPES)
+                    or f"the primitive types: {', '.join(PRIMITIVE_TYPES)}; a struct or alias is a `TypeReference`",
+                )
         elif not isinstance(data_type, PrimitiveType):
             # only a model built in Python can hold this (`data_type="double"`); the reader makes types
             written = f"`{data_type}`" if isinstance(data_type, str) else type(data_type).__name__
@@ -705,6 +724,7 @@ class Resolver:
             self.duplicate(f"agent `{agent.name}/a`", agent.location, self.agents[agent.name].agent.location)
             return
         inner: Scope = dict(scope)
+        self._place = f"`{agent.name}/a`"
         family = self.family_range(agent.family, scope)
         if agent.family is not None and family is not None:
             inner[agent.family.index] = family
@@ -726,6 +746,7 @@ class Resolver:
                 table.declared_twice.add(key)
                 continue
             sub_scope = dict(inner)
+            self._place = f"`{_owner(agent, subsystem)}`"
             sub_family = self.family_range(subsystem.family, inner)
             if subsystem.family is not None and sub_family is not None:
                 sub_scope[subsystem.family.index] = sub_family
@@ -735,6 +756,7 @@ class Resolver:
             sub_table = self._subsystem_table(subsystem, sub_scope, subsystems)
             sub_table.scope = sub_scope  # type: ignore[attr-defined]
             table.subsystems[key] = (sub_table, sub_family)
+        self._place = None
 
     def _count_expanded(self, count: int, location: SourceLocation | None) -> None:
         """EARL-R017, once, when the expanded system passes MAX_EXPANDED_ELEMENTS: each family is within
@@ -779,12 +801,15 @@ class Resolver:
 
     def _agent_body(self, table: _AgentTable) -> None:
         for sub_table, _family in table.subsystems.values():
+            self._place = f"`{_owner(table.agent, sub_table.subsystem)}`"
             self._subsystem_body(table, sub_table, sub_table.scope)  # type: ignore[attr-defined]
+        self._place = f"the links of `{table.agent.name}/a`"
         self._links(table.agent.links, table.scope, agent=table)
+        self._place = None
 
     def _subsystem_body(self, agent: _AgentTable, table: _SubsystemTable, scope: Scope) -> None:
         subsystem = table.subsystem
-        owner = f"{agent.agent.name}/a.{'cs' if subsystem.kind is Kind.CONTROL_SUBSYSTEM else subsystem.name + '/' + subsystem.kind.value}"
+        owner = _owner(agent.agent, subsystem)
         for buffer in subsystem.input_buffers:
             if buffer.queue is not None:
                 capacity = self.constant_integer(buffer.queue.capacity, scope, "a FIFO capacity")
@@ -798,7 +823,7 @@ class Resolver:
                 if buffer.queue.overflow not in policies:
                     # only a model built in Python can say this: the reader refuses it (EARL-S013)
                     self.error(
-                        f"`{buffer.name}/ib` of {owner} has the overflow policy {buffer.queue.overflow!r}",
+                        f"`{buffer.name}/ib` has the overflow policy {buffer.queue.overflow!r}",
                         buffer.location,
                         "EARL-R018",
                         did_you_mean(str(buffer.queue.overflow), policies)
@@ -1020,7 +1045,7 @@ class Resolver:
         stack: list[tuple[Expression, Scope]] = [(expression, scope)]
         while stack:
             node, node_scope = stack.pop()
-            self._operator(node, owner)
+            self._operator(node)
             if isinstance(node, Name):
                 if node.name not in node_scope:
                     self.unknown_name(node, node_scope)
@@ -1105,7 +1130,7 @@ class Resolver:
                     continue
             stack.extend((child, node_scope) for child in children(node))
 
-    def _operator(self, node: Expression, owner: str) -> None:
+    def _operator(self, node: Expression) -> None:
         """EARL-R047: an operator or quantifier the language does not have (only a model built in Python
         can hold one: the grammar reads none other)."""
         operator = getattr(node, "operator", None) if not isinstance(node, Quantifier) else node.quantifier
@@ -1114,7 +1139,7 @@ class Resolver:
         known = OPERATORS.get(type(node).__name__, ())
         if operator not in known:
             self.error(
-                f"`{operator}` is no {_OPERATOR_ROLES[type(node).__name__]} of EARL (in {owner})",
+                f"`{operator}` is no {_OPERATOR_ROLES[type(node).__name__]} of EARL",
                 node.location,
                 "EARL-R047",
                 did_you_mean(str(operator), known) or f"EARL has {', '.join(f'`{k}`' for k in known)}",
@@ -1249,6 +1274,7 @@ class Resolver:
         seen: dict[str, Any] = {}
         links = {link.name_text for link in self.system.links}
         for robot in self.system.robots:
+            self._place = f"`{robot.name}/r`"
             if robot.name in seen:
                 self.duplicate(f"robot `{robot.name}/r`", robot.location, seen[robot.name].location)
                 continue
@@ -1308,6 +1334,12 @@ _ELEMENT_LISTS = {
 }
 #: a name as the grammar reads it (earl.lark's NAME)
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+
+
+def _owner(agent: Agent, subsystem: Subsystem) -> str:
+    """`manip/a.cs`, `manip/a.motorController/ve`: a subsystem as messages name it."""
+    kind = "cs" if subsystem.kind is Kind.CONTROL_SUBSYSTEM else f"{subsystem.name}/{subsystem.kind.value}"
+    return f"{agent.name}/a.{kind}"
 
 
 def _declared_names(system: System) -> Iterator[tuple[object, str, SourceLocation | None]]:
