@@ -144,3 +144,38 @@ def test_new_data_of_a_field_inside_an_absent_field_is_false_not_a_fault(
     key = reference_key(target)
     assert predicate({key: message}, {key: True}, {}, {}, {}) is carried
     assert predicate({key: message}, {key: False}, {}, {}, {}) is False
+
+
+def test_predicates_named_twice_or_through_themselves_are_followed_once() -> None:
+    """`odd/pp = odd/pp and odd/pp` made the rule expand without end (earl check hung); a chain whose
+    every predicate names the next twice doubled the walk at each link."""
+    import time
+
+    doubled = "".join(f"d{i}/pp = d{i + 1}/pp and d{i + 1}/pp\n" for i in range(40)) + "d40/pp = c[1]/ib.t.z > 3.0\n"
+    started = time.monotonic()
+    assert warned("odd/pp", "odd/pp = odd/pp and odd/pp\n") == []
+    [message] = warned("d0/pp", doubled)
+    assert time.monotonic() - started < 10
+    assert "(through `d40/pp`) reads `c[1]/ib.t.z`" in message
+
+
+def test_a_read_deep_inside_predicates_and_nots_is_still_found() -> None:
+    chain = "".join(f"p{i}/pp = c[2]/ib.speed < 1.0 and p{i + 1}/pp\n" for i in range(1, 21))
+    chain += "p21/pp = c[1]/ib.t.z > 3.0\n"
+    assert len(warned("p1/pp", chain)) == 1
+    assert len(warned("not (" * 34 + "c[1]/ib.t.z > 3.0" + ")" * 34)) == 1
+
+
+def test_an_optional_boolean_taken_as_a_condition_reads_as_false_and_the_warning_says_so() -> None:
+    text = SPEC.replace("    speed: double\n", "    speed: double\n    flag: boolean?\n")
+    for condition in ("c[1]/ib.flag", "not c[1]/ib.flag", "c[1]/ib.flag or c[2]/ib.speed < 1.0"):
+        system = earl.loads(text.replace("CONDITION", condition).replace("        PREDICATES\n", ""), "o.earl")
+        [message] = [d.message for d in check(system) if d.code == "EARL-W046"]
+        assert message.endswith("an absent field reads as false (and `not` of it as true)")
+    assert [
+        d
+        for d in check(
+            earl.loads(text.replace("CONDITION", "c[1]/ib.flag == true").replace("        PREDICATES\n", ""), "o.earl")
+        )
+        if d.code == "EARL-W046"
+    ] == []

@@ -655,6 +655,31 @@ CASES: list[Case] = [
         ),
     ),
     Case(
+        "EARL-E047",
+        edit(
+            (
+                "        go/pp = x/mi > 1.0\n",
+                "        go/pp = x/mi > 1.0\n"
+                + "".join(f"        q{i}/pp = x/mi > 0.0 and q{i + 1}/pp\n" for i in range(80))
+                + "        q80/pp = x/mi > 0.0\n",
+            ),
+            ("tc = go/pp", "tc = q0/pp"),
+        ),
+        13,
+        9,
+        "primitive predicate `q5/pp` of a1/a.cs is 152 levels deep written out through the predicates it names: "
+        "at most 150",
+        edit(
+            (
+                "        go/pp = x/mi > 1.0\n",
+                "        go/pp = x/mi > 1.0\n"
+                + "".join(f"        q{i}/pp = x/mi > 0.0 and q{i + 1}/pp\n" for i in range(60))
+                + "        q60/pp = x/mi > 0.0\n",
+            ),
+            ("tc = go/pp", "tc = q0/pp"),
+        ),
+    ),
+    Case(
         "EARL-E017",
         edit(("    cs { period 1 ms\n        inp/ib", "    cs {\n        inp/ib")),
         34,

@@ -49,6 +49,7 @@ from typing import TYPE_CHECKING, Any
 from earl.check.context import CheckContext, subsystem_name
 from earl.check.expression_types import BOOLEAN, ExpressionTyper
 from earl.check.registry import Finding, rule
+from earl.check.rules_behaviour import MAX_PREDICATE_NESTING, predicate_depths
 from earl.diagnostics import Severity
 from earl.model.elements import FSM, Agent, State, Subsystem, Transition
 from earl.model.expressions import (
@@ -178,8 +179,13 @@ class _Encoder:
         self._depth = 0  # > 0 while encoding a predicate's definition
         #: what each predicate stands for; one computed by Python is a Boolean of its own (its
         #: `python(reads)` says only what it reads, which two different predicates may share)
+        #: a predicate too deep written out (EARL-E047) stays a Boolean of its own: following it to its
+        #: definition would recurse past Python's limit
+        depths = predicate_depths(subsystem)
         self.definitions: dict[str, Expression] = {
-            p.name: p.expression for p in subsystem.primitive_predicates if p.implementation is None
+            p.name: p.expression
+            for p in subsystem.primitive_predicates
+            if p.implementation is None and depths.get(p.name, 0) <= MAX_PREDICATE_NESTING
         }
         self._defining: set[str] = set()
         #: predicates reached again while their own definition was being encoded: defined through

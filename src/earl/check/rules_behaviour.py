@@ -10,7 +10,7 @@ from earl.check.expression_types import BOOLEAN, ExpressionTyper
 from earl.check.registry import Finding, rule
 from earl.diagnostics import Severity
 from earl.model.elements import BasicBehaviour, Subsystem
-from earl.model.expressions import Call, ElementReference, Expression, Read, reads, walk
+from earl.model.expressions import Call, ElementReference, Expression, Read, children, reads, walk
 from earl.model.graphs import cycles
 from earl.model.kinds import Kind
 from earl.model.location import SourceLocation
@@ -459,6 +459,81 @@ def timeouts_that_can_happen(context: CheckContext) -> Iterator[Finding]:
                         f"make it obligatory where it is awaited: `state S: B/bb {{ obligatory {target.name}/ib "
                         "timeout 50 ms }`",
                     )
+
+
+#: levels an expression may have written out through the predicates it names: the checker's walks over a
+#: condition recurse once per level, and a condition holds 100 levels of its own (the reader's limit)
+MAX_PREDICATE_NESTING = 150
+
+
+def predicate_depths(subsystem: Subsystem) -> dict[str, int]:
+    """Per primitive predicate defined by an expression and not through itself (EARL-E045): how many levels
+    its expression has written out, each predicate it names replaced by its definition. One walk, without
+    recursion, over the predicates in the order they depend on each other."""
+    definitions = {p.name: p.expression for p in subsystem.primitive_predicates if p.implementation is None}
+    own: dict[str, list[tuple[int, str | None]]] = {}  # per predicate: (level, predicate named there or None)
+    for name, expression in definitions.items():
+        found: list[tuple[int, str | None]] = []
+        stack = [(expression, 1)]
+        while stack:
+            node, level = stack.pop()
+            named = (
+                node.target.name if isinstance(node, Read) and node.target.kind is Kind.PRIMITIVE_PREDICATE else None
+            )
+            found.append((level, named if named in definitions else None))
+            stack.extend((child, level + 1) for child in children(node))
+        own[name] = found
+    depths: dict[str, int] = {}
+    open_: set[str] = set()
+    for root in definitions:
+        if root in depths:
+            continue
+        stack2: list[tuple[str, Iterator[str]]] = [(root, iter([n for _, n in own[root] if n is not None]))]
+        open_.add(root)
+        while stack2:
+            name, pending = stack2[-1]
+            inner = next(pending, None)
+            if inner is None:
+                stack2.pop()
+                open_.discard(name)
+                depths[name] = max(level + (depths.get(n, 0) if n is not None else 0) for level, n in own[name])
+            elif inner not in depths and inner not in open_:
+                open_.add(inner)
+                stack2.append((inner, iter([n for _, n in own[inner] if n is not None])))
+            # a predicate met again while open is defined through itself: EARL-E045, counted as a leaf
+    return depths
+
+
+@rule(
+    "EARL-E047",
+    Severity.ERROR,
+    "a primitive predicate written out is at most 150 levels deep",
+    "§2.2, Table 4",
+)
+def predicates_nested_too_deep(context: CheckContext) -> Iterator[Finding]:
+    """A predicate defined through a long chain of others (`p1/pp = p2/pp and …`, thousands of them) is
+    one expression thousands of levels deep once written out: the FSM analysis, which follows each
+    predicate to its definition, would exceed Python's recursion limit. Reported at the first predicate
+    too deep, not at each built on it."""
+    for agent, subsystem in context.distinct_subsystems():
+        depths = predicate_depths(subsystem)
+        for predicate in subsystem.primitive_predicates:
+            depth = depths.get(predicate.name, 0)
+            if depth <= MAX_PREDICATE_NESTING:
+                continue
+            named = {
+                node.target.name
+                for node in walk(predicate.expression)
+                if isinstance(node, Read) and node.target.kind is Kind.PRIMITIVE_PREDICATE
+            }
+            if any(depths.get(n, 0) > MAX_PREDICATE_NESTING for n in named):
+                continue  # one it names is too deep already: said there
+            yield Finding(
+                f"primitive predicate `{predicate.name}/pp` of {subsystem_name(agent, subsystem)} is {depth} levels "
+                f"deep written out through the predicates it names: at most {MAX_PREDICATE_NESTING}",
+                predicate.location,
+                "define it from fewer predicates in a row, e.g. an `and` of them side by side",
+            )
 
 
 @rule("EARL-E045", Severity.ERROR, "a primitive predicate is not defined through itself", "§2.2, Table 4")

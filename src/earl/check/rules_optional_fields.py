@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 from earl.check.context import CheckContext
 from earl.check.registry import Finding, rule
-from earl.check.rules_behaviour import _conditions
+from earl.check.rules_behaviour import MAX_PREDICATE_NESTING, _conditions, predicate_depths
 from earl.diagnostics import Severity
 from earl.model.elements import Subsystem
 from earl.model.expressions import (
@@ -30,6 +30,7 @@ from earl.model.expressions import (
     FieldAccess,
     IndexAccess,
     Not,
+    Quantifier,
     Read,
     children,
 )
@@ -41,42 +42,66 @@ from earl.model.types import ArrayType, StructType
 #: a field path of an input buffer: its name and the accessors' texts (`("cmd", ".target")`)
 Path = tuple[str, ...]
 
-#: how deep predicates naming predicates are followed (deeper ones prove nothing present)
-_MOST_DEPTH = 32
+
+#: how a read's value is used: compared for order, computed with or read into (`value`), taken as a
+#: Boolean (`boolean`: an absent field reads as false, so `not` of it as true), or compared for equality
+#: (`equality`: an absent field equals no value, which is what it should be)
+Use = str
 
 
 @dataclass(frozen=True)
 class _Unguarded:
     read: Read
     needed: Path  # the optional field that must be present
+    faults: bool  # reading it absent raises; otherwise the absent Boolean reads as false
     predicate: str | None  # the primitive predicate whose definition holds the read, if any
 
 
 class _Reader:
-    """The reads of optional fields that a subsystem's conditions may make while the field is absent."""
+    """The reads of optional fields that a subsystem's conditions may make while the field is absent.
+
+    A predicate is followed into its definition where a condition names it, with that condition's
+    guards; each (predicate, guards) once, and never into itself (EARL-E045) nor into one too deep to
+    follow (EARL-E047), so that neither `p/pp = p/pp and p/pp` nor a chain of thousands is walked."""
 
     def __init__(self, context: CheckContext, subsystem: Subsystem) -> None:
         self.context = context
         self.subsystem = subsystem
-        self.definitions = {p.name: p.expression for p in subsystem.primitive_predicates if p.implementation is None}
+        depths = predicate_depths(subsystem)
+        self.definitions = {
+            p.name: p.expression
+            for p in subsystem.primitive_predicates
+            if p.implementation is None and depths.get(p.name, 0) <= MAX_PREDICATE_NESTING
+        }
+        self._present: dict[tuple[str, bool], frozenset[Path]] = {}
+        self._opened: set[str] = set()  # predicates whose definitions are being followed
+        self._followed: set[tuple[str, frozenset[Path]]] = set()
 
     # ---------------------------------------------------------------- what a formula proves present
-    def present_if(self, expression: Expression, holds: bool, depth: int = 0) -> frozenset[Path]:
+    def present_if(self, expression: Expression, holds: bool) -> frozenset[Path]:
         """The fields every message in question carries whenever `expression` is `holds`."""
-        if depth > _MOST_DEPTH:
-            return frozenset()
         if isinstance(expression, Not):
-            return self.present_if(expression.operand, not holds, depth + 1)
+            return self.present_if(expression.operand, not holds)
         if isinstance(expression, Call) and expression.function == "newData" and holds:
             [argument] = expression.arguments or (None,)
             if isinstance(argument, Read) and argument.target.kind is Kind.INPUT_BUFFER and argument.path:
                 return frozenset(_prefixes(_path_of(argument)))
             return frozenset()
         if isinstance(expression, Read) and expression.target.kind is Kind.PRIMITIVE_PREDICATE:
-            definition = self.definitions.get(expression.target.name)
-            return frozenset() if definition is None else self.present_if(definition, holds, depth + 1)
+            name = expression.target.name
+            definition = self.definitions.get(name)
+            if definition is None or name in self._opened:
+                return frozenset()
+            key = (name, holds)
+            if key not in self._present:
+                self._opened.add(name)
+                try:
+                    self._present[key] = self.present_if(definition, holds)
+                finally:
+                    self._opened.discard(name)
+            return self._present[key]
         if isinstance(expression, BooleanOperation):
-            parts = [self.present_if(operand, holds, depth + 1) for operand in expression.operands]
+            parts = [self.present_if(operand, holds) for operand in expression.operands]
             if not parts:
                 return frozenset()
             # `a and b` holds when both do; `a or b` fails when both do: the facts of every part add up.
@@ -89,86 +114,92 @@ class _Reader:
 
     # ---------------------------------------------------------------- the reads, in evaluation order
     def unguarded(
-        self, expression: Expression, present: frozenset[Path], predicate: str | None = None, depth: int = 0
+        self, expression: Expression, present: frozenset[Path], predicate: str | None = None, use: Use = "boolean"
     ) -> Iterator[_Unguarded]:
-        """Reads of optional fields `expression` may make while they are absent, given the fields `present`."""
-        if depth > _MOST_DEPTH:
-            return
+        """Reads of optional fields `expression` may make while they are absent, given the fields `present`;
+        `use`: how the value of `expression` itself is used."""
         if isinstance(expression, BooleanOperation):
             known = present
             for operand in expression.operands:
-                yield from self.unguarded(operand, known, predicate, depth + 1)
+                yield from self.unguarded(operand, known, predicate, "boolean")
                 # the next operand runs only when this one did not decide: true before `and`, false before `or`
                 known = known | self.present_if(operand, expression.operator == "and")
             return
-        if isinstance(expression, Comparison) and expression.operator in ("==", "!="):
-            # an absent field compares as unequal to every value: only reading *into* it raises
+        if isinstance(expression, Not):
+            yield from self.unguarded(expression.operand, present, predicate, "boolean")
+            return
+        if isinstance(expression, Comparison):
+            side_use = "equality" if expression.operator in ("==", "!=") else "value"
             for side in (expression.left, expression.right):
-                if isinstance(side, Read):
-                    yield from self._read(side, present, predicate, whole_value_needed=False)
-                else:
-                    yield from self.unguarded(side, present, predicate, depth + 1)
+                yield from self.unguarded(side, present, predicate, side_use)
             return
         if isinstance(expression, Call):
             # `newData(x/ib.a.b)` is false, not a fault, when `a` is absent; `timeout` and `stale` read no field
             for argument in expression.arguments:
                 for accessor in argument.path if isinstance(argument, Read) else ():
                     if isinstance(accessor, IndexAccess):
-                        yield from self.unguarded(accessor.index, present, predicate, depth + 1)
+                        yield from self.unguarded(accessor.index, present, predicate, "value")
             return
         if isinstance(expression, Read):
-            yield from self._read(expression, present, predicate, whole_value_needed=True, depth=depth)
+            yield from self._read(expression, present, predicate, use)
             return
-        for child in children(expression):
-            yield from self.unguarded(child, present, predicate, depth + 1)
+        if isinstance(expression, Quantifier):
+            yield from self.unguarded(expression.body, present, predicate, "boolean")
+            return
+        for child in children(expression):  # arithmetic, `-`, lists: their operands are values
+            yield from self.unguarded(child, present, predicate, "value")
 
-    def _read(
-        self,
-        read: Read,
-        present: frozenset[Path],
-        predicate: str | None,
-        whole_value_needed: bool,
-        depth: int = 0,
-    ) -> Iterator[_Unguarded]:
+    def _read(self, read: Read, present: frozenset[Path], predicate: str | None, use: Use) -> Iterator[_Unguarded]:
         for accessor in read.path:
             if isinstance(accessor, IndexAccess):
-                yield from self.unguarded(accessor.index, present, predicate, depth + 1)
+                yield from self.unguarded(accessor.index, present, predicate, "value")
         if read.target.kind is Kind.PRIMITIVE_PREDICATE:
-            definition = self.definitions.get(read.target.name)
-            if definition is not None and not read.path:
-                # evaluated where it is named: the caller's guards hold inside it
-                yield from self.unguarded(definition, present, read.target.name, depth + 1)
+            name = read.target.name
+            definition = self.definitions.get(name)
+            if definition is None or read.path or name in self._opened or (name, present) in self._followed:
+                return
+            # evaluated where it is named: the caller's guards hold inside it
+            self._followed.add((name, present))
+            self._opened.add(name)
+            try:
+                yield from self.unguarded(definition, present, name, "boolean")
+            finally:
+                self._opened.discard(name)
             return
         if read.target.kind is not Kind.INPUT_BUFFER:
             return  # memory has no `newData`: nothing could guard it
-        needed = self._needed(read, whole_value_needed)
-        if needed is not None and needed not in present:
-            yield _Unguarded(read, needed, predicate)
+        needed = self._needed(read, use)
+        if needed is not None and needed[0] not in present:
+            yield _Unguarded(read, needed[0], needed[1], predicate)
 
-    def _needed(self, read: Read, whole_value_needed: bool) -> Path | None:
-        """The deepest optional field that must be present for `read` not to raise (None: nothing must)."""
+    def _needed(self, read: Read, use: Use) -> tuple[Path, bool] | None:
+        """The deepest optional field that must be present for `read` to read a value, and whether reading it
+        absent raises (None: nothing must be present)."""
         buffer = self.context.input_buffer(self.subsystem, read.target)
         if buffer is None:
             return None
         current = self.context.structural(buffer.data_type)
         path = _path_of(read)
         needed: Path | None = None
+        faults = False
         last = len(read.path) - 1
         for position, accessor in enumerate(read.path):
             if isinstance(accessor, FieldAccess):
                 if not isinstance(current, StructType):
-                    return needed
+                    break
                 field = current.field_named(accessor.name)
                 if field is None:
-                    return needed
-                if field.optional and (position < last or whole_value_needed):
+                    break
+                if field.optional and (position < last or use != "equality"):
                     needed = path[: position + 2]
+                    # read into, compared for order or computed with: raises; taken as a Boolean: false
+                    faults = faults or position < last or use == "value"
                 current = self.context.structural(field.data_type)
             elif isinstance(current, ArrayType):
                 current = self.context.structural(current.element)
             else:
-                return needed
-        return needed
+                break
+        return None if needed is None else (needed, faults)
 
 
 def _path_of(read: Read) -> Path:
@@ -190,9 +221,10 @@ def _prefixes(path: Path) -> Iterator[Path]:
 )
 def optional_fields_read_only_when_present(context: CheckContext) -> Iterator[Finding]:
     """An optional field may be absent; a condition that compares it (`<`, `>`), computes with it or reads
-    into it then faults and counts as false. Guard the read with `newData(x/ib.field) and …`, as Table 4
-    does; `==` and `!=` need no guard (an absent field equals no value). Assumptions are not evaluated
-    at run time and are not checked."""
+    into it then faults and counts as false, and an optional Boolean taken as a condition reads as false
+    (`not` of it as true). Guard the read with `newData(x/ib.field) and …`, as Table 4 does; `==` and `!=`
+    need no guard (an absent field equals no value). Assumptions are not evaluated at run time and are
+    not checked."""
 
     reported: set[SourceLocation | None] = set()  # each read once, named with the first condition that reaches it
     for _agent, subsystem in context.distinct_subsystems():
@@ -209,10 +241,15 @@ def optional_fields_read_only_when_present(context: CheckContext) -> Iterator[Fi
 
 def _finding(found: _Unguarded, role: str, location: SourceLocation | None) -> Finding:
     inside = f" (through `{found.predicate}/pp`)" if found.predicate else ""
+    field = "".join(found.needed[1:]).removeprefix(".")
+    outcome = (
+        "reading an absent field faults, and the condition counts as false"
+        if found.faults
+        else "an absent field reads as false (and `not` of it as true)"
+    )
     return Finding(
         f"{role}{inside} reads `{expression_text(found.read)}` even when no message that carries the optional "
-        f"field `{''.join(found.needed[1:]).removeprefix('.')}` has arrived: reading an absent field faults, "
-        "and the condition counts as false",
+        f"field `{field}` has arrived: {outcome}",
         location,
         f"guard it: `newData({''.join(found.needed)}) and …`, as Table 4 does, or make the field non-optional",
     )
