@@ -110,7 +110,7 @@ def test_an_unknown_overflow_policy_is_r018() -> None:
         (lambda: earl.loads(TEXT, {"N": 3}), "the second argument of loads is the name messages give the text"),
         (lambda: earl.loads(TEXT.encode()), "decode the bytes first"),
         (lambda: earl.loads(None), "loads takes the text of a specification (a str), not NoneType"),
-        (lambda: earl.loads("system x", path=5), "loads names the text by a str, not int 5"),
+        (lambda: earl.loads("system x", path=5), "loads names the text by a str or a Path, not int 5"),
         (lambda: earl.loads(TEXT, parameters={3: 4}), "a parameter is named by a str"),
         (lambda: earl.load("x.earl", "N=3"), "parameters takes a mapping of parameter names to values"),
         (lambda: earl.load(5), "load takes a file name (a str or a Path), not int 5"),
@@ -215,3 +215,65 @@ def test_a_finding_in_an_element_built_in_python_says_which_declaration_it_is_ab
         ("EARL-R013", "an array size must not be negative, here it is -1 (in `a/a.cs`)", None),
         ("EARL-R018", "a FIFO holds at least one message, not 0 (in `a/a.cs`)", None),
     }
+
+
+FAMILY = """\
+system fam
+w[I in 1..2]/a {
+    cs {
+        period 10 ms
+        out[J in 1..2]/ob: double
+        go/pp = true
+        run/bb {
+            tf = {}
+            tc = go/pp
+        }
+        fsm {
+            initial run
+            state run: run/bb
+            run -> run when go/pp
+        }
+    }
+}
+boss/a {
+    cs {
+        period 10 ms
+        in[I in 1..2]/ib: double
+        go/pp = true
+        run/bb {
+            tf = {}
+            tc = go/pp
+        }
+        fsm {
+            initial run
+            state run: run/bb
+            run -> run when go/pp
+        }
+    }
+}
+link w[I in 1..2],boss: w[I]/a.cs.out[1] -> boss/a.cs.in[I]
+r/r {
+    w[1]/a
+    w[2]/a
+    boss/a
+}
+"""
+
+
+def test_what_the_checks_of_arguments_still_take(tmp_path: Path) -> None:
+    """Values the checks above must not refuse: a Path naming text, NumPy's Booleans and 0/1 for flags,
+    a member of an output-buffer family in record_outputs."""
+    import numpy
+
+    path = tmp_path / "demo.earl"
+    path.write_text(TEXT)
+    with pytest.raises(EarlError) as raised:
+        earl.loads("system 1", path)
+    assert raised.value.diagnostics[0].location is not None
+    assert raised.value.diagnostics[0].location.file == str(path)
+    for flag in (numpy.bool_(False), 0):
+        earl.simulate(earl.loads(TEXT), environment=None, realtime=flag, check=numpy.bool_(True)).close()
+    with earl.simulate(
+        earl.loads(FAMILY), environment=None, trace=tmp_path / "t.mcap", record_outputs=["w[1]/a.cs.out[1]"]
+    ) as simulation:
+        assert simulation.trace is not None and simulation.trace.links_also_recorded

@@ -474,3 +474,5 @@ def test_a_comment_that_closes_a_block_is_in_the_element_s_doc() -> None:
     for said in ("the last word on the limits", "the subsystem's last word", "the agent's last word"):
         assert said in exported
     assert exported.index("the agent's last word") < exported.index("the subsystem's last word")
+    # what ends the file is about no element: an editor's mode line is no doc of the system
+    assert "vim" not in export_sysml(earl.loads(text + "// vim: set ft=earl:\n", "closing.earl"))

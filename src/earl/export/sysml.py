@@ -95,12 +95,17 @@ def export_sysml(system: System, parameters: Mapping[str, Value] | None = None) 
 
 
 # ---------------------------------------------------------------------- small helpers
-def _comment_lines(comments: Comments | None) -> list[str]:
-    """A person's `//` comments as plain sentences: markers and separator rules dropped."""
+def _comment_lines(comments: Comments | None, closing: bool = True) -> list[str]:
+    """A person's `//` comments as plain sentences: markers and separator rules dropped. `closing`: with
+    those that close the element's block (`// end of the arm's limits` before its `}`), written about it
+    too; not the system's, which end the file (`// vim: set ft=earl:`)."""
     if comments is None:
         return []
-    # what closes a block (`// end of the arm's limits` before its `}`) was written about the element too
-    lines = [*comments.leading, *([comments.trailing] if comments.trailing else []), *comments.closing]
+    lines = [
+        *comments.leading,
+        *([comments.trailing] if comments.trailing else []),
+        *(comments.closing if closing else []),
+    ]
     result = []
     for line in lines:
         text = line.strip()
@@ -226,7 +231,7 @@ class _Writer:
         with self.block(f"package {name_text(package)}"):
             settings = ", ".join(f"{p.name} = {literal(_parameter_value(p))}" for p in self.system.parameters)
             self.doc(
-                *_comment_lines(self.declared.comments),
+                *_comment_lines(self.declared.comments, closing=False),
                 f"EARL system `{self.system.name}`{origin}"
                 + (f", exported with {settings}" if settings else "")
                 + ". Every indexed family is expanded into its members; the short name of each element is its "

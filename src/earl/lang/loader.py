@@ -331,8 +331,10 @@ def loads(text: str, path: str = "<text>", parameters: Mapping[str, ParameterVal
             "the second argument of loads is the name messages give the text; pass parameters by name: "
             "loads(text, parameters={...})"
         )
+    if isinstance(path, os.PathLike):
+        path = os.fspath(path)  # `loads(p.read_text(), p)`: named by its file
     if not isinstance(path, str):
-        raise TypeError(f"loads names the text by a str, not {type(path).__name__} {path!r:.60}")
+        raise TypeError(f"loads names the text by a str or a Path, not {type(path).__name__} {path!r:.60}")
     refuse_wrong_parameters(parameters)
     sources = SourceMap()
     with collection_paused():

@@ -100,7 +100,7 @@ class Simulation:
             # function that draws a random number, and look like that function's fault
             raise ValueError(f"the seed is a whole number >= 0, not {seed!r}")
         for flag, value in (("realtime", realtime), ("check", check)):
-            if not isinstance(value, bool):
+            if isinstance(value, (str, bytes)):
                 # `check="no"` is truthy: it would check, and `realtime="yes"` would run paced by the clock
                 raise TypeError(f"{flag} takes True or False, not {type(value).__name__} {value!r:.60}")
         if isinstance(trace, (str, Path)) and not Path(trace).parent.is_dir():
@@ -327,10 +327,13 @@ def _refuse_unknown_outputs(outputs: list[str] | None, expanded: System) -> None
     if not outputs:
         return
     from earl.diagnostics import did_you_mean
-    from earl.runtime.names import subsystem_name
+    from earl.runtime.names import indexed, subsystem_name
 
     known = [
-        f"{subsystem_name(a, s)}.{o.name}" for a in expanded.agents for s in a.subsystems for o in s.output_buffers
+        f"{subsystem_name(a, s)}.{indexed(o.name, o.index)}"
+        for a in expanded.agents
+        for s in a.subsystems
+        for o in s.output_buffers
     ]
     for name in outputs:
         if name not in known:
