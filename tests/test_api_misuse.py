@@ -277,3 +277,18 @@ def test_what_the_checks_of_arguments_still_take(tmp_path: Path) -> None:
         earl.loads(FAMILY), environment=None, trace=tmp_path / "t.mcap", record_outputs=["w[1]/a.cs.out[1]"]
     ) as simulation:
         assert simulation.trace is not None and simulation.trace.links_also_recorded
+
+
+@pytest.mark.parametrize(
+    ("signal", "outputs"),
+    [
+        ("w[1]/a.cs.out[1]", ["w[1]/a.cs.out[1]"]),
+        ("w[2]/a.cs.out", ["w[2]/a.cs.out[1]", "w[2]/a.cs.out[2]"]),
+    ],
+)
+def test_a_plotted_member_of_an_output_family_is_recorded_by_its_member_name(signal: str, outputs: list[str]) -> None:
+    """`--plot --signal 'w[1]/a.cs.out[1]'` asked the run for `w[1]/a.cs.out`, which no link leaves."""
+    from earl.model.expand import expand
+    from earl.runtime.plot import what_to_record
+
+    assert what_to_record(expand(earl.loads(FAMILY), {}), [signal]) == ([], outputs)

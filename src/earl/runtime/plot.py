@@ -65,7 +65,13 @@ def what_to_record(expanded: System, signals: list[str]) -> tuple[list[str], lis
         if element in memories:
             record.append(owner)
         elif element in outputs:  # an output buffer's values are the messages on its links
-            sending.append(f"{owner}.{element}")
+            indices = sorted({o.index for o in subsystem.output_buffers if o.name == element and o.index is not None})
+            if not indices:
+                sending.append(f"{owner}.{element}")
+            else:  # a family of output buffers: the member the signal names (`out[1]`), or every member
+                chosen = re.match(r"\[(\d+)\]", signal[len(owner) + 1 + len(element) :])
+                picked = [int(chosen.group(1))] if chosen is not None else indices
+                sending += [f"{owner}.{element}[{index}]" for index in picked if index in indices]
         else:
             hint = did_you_mean(element, [*memories, *outputs])
             known = ", ".join(f"`{name}`" for name in dict.fromkeys([*memories, *outputs])) or "none"
