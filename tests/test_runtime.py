@@ -237,7 +237,10 @@ def test_each_link_gets_a_message_writer_only_from_the_recorders_that_record_it(
     none for a link it does not record, and a link nobody records is then never reported."""
     from earl.runtime.trace import TraceWriter
 
-    sim, events = simulate(SPECS / "counter", trace=tmp_path / "links.mcap", record_links=["nothing-matches"])
+    from earl.runtime import RecordingWarning
+
+    with pytest.warns(RecordingWarning, match="`nothing-matches` matches no link"):
+        sim, events = simulate(SPECS / "counter", trace=tmp_path / "links.mcap", record_links=["nothing-matches"])
     links = sorted(sim.network.link_types)
     assert links
     assert all(Recorder().message_writer(link) is None for link in links)
