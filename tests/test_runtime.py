@@ -235,9 +235,8 @@ def test_the_same_spec_and_seed_give_a_byte_identical_trace(tmp_path: Path) -> N
 def test_each_link_gets_a_message_writer_only_from_the_recorders_that_record_it(tmp_path: Path) -> None:
     """The engine asks for a writer per link once: a recorder without `message_sent` gives none, the trace
     none for a link it does not record, and a link nobody records is then never reported."""
-    from earl.runtime.trace import TraceWriter
-
     from earl.runtime import RecordingWarning
+    from earl.runtime.trace import TraceWriter
 
     with pytest.warns(RecordingWarning, match="`nothing-matches` matches no link"):
         sim, events = simulate(SPECS / "counter", trace=tmp_path / "links.mcap", record_links=["nothing-matches"])
