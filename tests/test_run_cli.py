@@ -593,6 +593,53 @@ def test_a_run_killed_with_sigkill_still_leaves_a_readable_trace(tmp_path: Path)
     assert ended is not None and float(ended.group(1)) >= 1.2, summary.stdout
 
 
+HOLDS = """\
+system holds
+r/r { x/a }
+x/a {
+    cs {
+        period 100 ms
+        go/pp = true
+        never/pp = false
+        start/bb {
+            tf = {}
+            tc = go/pp
+        }
+        hold/bb {
+            tf = {}
+            tc = never/pp
+        }
+        fsm {
+            initial start
+            state start: start/bb
+            state hold: hold/bb
+            start -> hold when go/pp
+        }
+    }
+}
+"""
+
+
+def test_a_run_killed_while_it_records_nothing_more_has_its_earlier_records_in_the_trace(tmp_path: Path) -> None:
+    """A batch went to the trace's process only with the next record after it was due: a run that went on
+    holding a state recorded nothing more, and a kill lost what it had recorded (seconds of a real run;
+    here the transition into `hold` at 0.1 s). It now goes while the run waits for its next instant."""
+    spec = tmp_path / "holds" / "system.earl"
+    spec.parent.mkdir()
+    spec.write_text(HOLDS)
+    trace = tmp_path / "run.mcap"
+    process = realtime_run_under_way(trace, spec.parent)
+    process.kill()
+    process.communicate(timeout=30)
+    summary = earl_cli("trace", "summary", str(trace))
+    deadline = time.monotonic() + 20
+    while summary.returncode != 0 and time.monotonic() < deadline:  # the writer may still be finishing
+        time.sleep(0.2)
+        summary = earl_cli("trace", "summary", str(trace))
+    assert summary.returncode == 0, summary.stderr
+    assert "start,hold" in summary.stdout, summary.stdout
+
+
 @pytest.mark.skipif(not Path("/dev/full").exists(), reason="no /dev/full here")
 def test_a_trace_on_a_full_disk_stops_the_run_with_one_line_and_exit_1() -> None:
     result = earl_cli(

@@ -84,6 +84,10 @@ class Recorder:
     def iteration_done(self, time: int, subsystem: str) -> None:
         pass
 
+    def idle(self, seconds: float) -> None:
+        """The run is about to wait `seconds` of wall-clock time for its next event (real time only):
+        a moment to hand over what is held back, so that a process killed while it waits loses little."""
+
 
 class Recorders(Recorder):
     """Several recorders as one."""
@@ -133,6 +137,10 @@ class Recorders(Recorder):
     def fault(self, fault: Fault) -> None:
         for recorder in self.recorders:
             recorder.fault(fault)
+
+    def idle(self, seconds: float) -> None:
+        for recorder in self.recorders:
+            recorder.idle(seconds)
 
 
 class StatisticsRecorder(Recorder):

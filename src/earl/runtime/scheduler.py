@@ -313,6 +313,8 @@ class Scheduler:
 
         The owner lock is free meanwhile, so that a message can be served on its receiving thread."""
         due = self._wall_start + time
+        # while the owner lock is still held: the recorders belong to its holder
+        self.recorder.idle((due - self.clock()) * 1e-9)
         self._sleeping_until = time
         self._owning = False
         inbox.owner.release()
@@ -424,6 +426,8 @@ class Scheduler:
         so that a stop request is seen (a signal handler only sets a flag), then spin the last 0.2 ms, as
         a sleep alone wakes up to a scheduler tick late. False when `should_stop()` came true first."""
         due = self._wall_start + time
+        if due - self.clock() > 300_000:
+            self.recorder.idle((due - self.clock()) * 1e-9)
         while True:
             remaining = due - self.clock()
             if remaining <= 300_000:

@@ -319,6 +319,10 @@ class TraceWriter(Recorder):
 
         return self._sink.writer_of(register)
 
+    def idle(self, seconds: float) -> None:
+        if isinstance(self._sink, BackgroundSink) and not self.closed:
+            self._sink.idle(seconds)
+
     def _recorded(self, link: str) -> bool:
         return (
             self.link_patterns is None
@@ -485,6 +489,13 @@ class BackgroundSink:
         self._times.append(time)
         self._values.append(value)
         if len(self._values) >= self.BATCH or _clock() >= self._due:
+            self._batch_done()
+
+    def idle(self, seconds: float) -> None:
+        """The run waits `seconds`: send what the batch holds if it is due, or would be before the run
+        wakes. A batch went only with the next message after it was due, so a run that recorded nothing
+        more (a subsystem holding a state) kept seconds of its trace here, lost when it was killed."""
+        if (self._values or self._channels) and _clock() + seconds >= self._due:
             self._batch_done()
 
     def _batch_done(self) -> None:
