@@ -446,6 +446,8 @@ def test_a_stop_signal_to_the_whole_process_group_leaves_a_readable_trace(tmp_pa
     _, stderr = process.communicate(timeout=30)
     assert process.returncode == 130, stderr
     assert "interrupted at" in stderr and "Traceback" not in stderr
+    # "Ctrl-C again" is advice for a terminal, not for the signals `timeout` and `earl launch` send
+    assert ("Ctrl-C again to stop at once" in stderr) == (stop == signal.SIGINT), stderr
     summary = earl_cli("trace", "summary", str(trace))
     assert summary.returncode == 0, summary.stderr
     assert "counting,finished" in summary.stdout

@@ -199,7 +199,17 @@ def test_an_environment_that_would_run_twice_or_apart_from_its_effectors_is_refu
     ("text", "fragment"),
     [
         ("", "no `[[process]]` table"),
-        ("[[process]]\nagents = []\nlisten = 'tcp/127.0.0.1:1'\n", "`agents` must be a list"),
+        ("[[process]]\nagents = []\nlisten = 'tcp/127.0.0.1:1'\n", "`agents` is empty; list the agents it runs"),
+        ("[[process]]\nagents = 'a'\nlisten = 'tcp/127.0.0.1:1'\n", "`agents` must be a list"),
+        ("[process]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:1'\n", "write `[[process]]`, with two brackets"),
+        (
+            "[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:1'\nargs = ['--transport', 'inproc']\n",
+            "`args` sets `--transport`, which `earl launch` sets for each process itself (always zenoh)",
+        ),
+        (
+            "[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:1'\nargs = ['--agents=b/a']\n",
+            "`args` sets `--agents`, which `earl launch` sets for each process itself",
+        ),
         ("[[process]]\nagents = ['a']\n", "`listen` must be a Zenoh endpoint"),
         ("[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:1'\nspeed = 3\n", "unknown key `speed`"),
         (
@@ -440,6 +450,7 @@ def test_the_inbox_wakes_its_sleeper_and_hands_over_in_arrival_order() -> None:
         (["--transport", "zenoh", "--agents", "nobody"], "`nobody/a` is not an agent of this system"),
         (["--transport", "zenoh", "--agents", "sender/a"], "deploy.toml"),
         (["--agents", "sender/a", "--zenoh-config", "z.json5"], "go with --transport zenoh"),
+        (["--agents", "sender/a", "--wait-for-peers", "5s"], "--wait-for-peers go with --transport zenoh"),
         (["--agents", "sender/a,nobody"], "`nobody/a` is not an agent of this system"),
         (["--transport", "zenoh", "--agents", "sender/a", "--wait-for-peers", "soon"], "is not a duration"),
         (["--transport", "zenoh", "--agents", "sender/a", "--zenoh-config", "/no/such.json5"], "no such file"),

@@ -42,7 +42,8 @@ whether the run.toml environment lives there, and extra `earl run` options
 (docs/distributed.md). Only processes whose `host` is this machine are started.
 
 exit codes: 0 every process completed, 1 a process failed or the deployment is invalid,
-            2 usage error, 130 interrupted (every process was stopped)
+            2 usage error (a missing spec or deployment file, a bad option), 130 interrupted
+            (every process was stopped)
 """
 
 

@@ -131,7 +131,7 @@ def register(commands: Any) -> None:
     parser.add_argument(
         "--wait-for-peers",
         metavar="TIME",
-        default="30s",
+        default=None,
         help="with --transport zenoh: wait at most this long for the agents of other processes before starting "
         "(default 30s; 0: start at once); missing ones start out stale",
     )
@@ -202,8 +202,8 @@ def _run(arguments: argparse.Namespace) -> int:
             kind = "is a directory; name its file" if Path(arguments.deployment).is_dir() else "does not exist"
             return usage_error(f"--deployment {arguments.deployment} {kind}")
         arguments.realtime = True  # distribution runs in real time only (docs/distributed.md)
-    elif arguments.zenoh_config or arguments.deployment:
-        return usage_error("--zenoh-config and --deployment go with --transport zenoh")
+    elif arguments.zenoh_config or arguments.deployment or arguments.wait_for_peers is not None:
+        return usage_error("--zenoh-config, --deployment and --wait-for-peers go with --transport zenoh")
     record_memory = arguments.record_memory if arguments.record_memory is not None else settings.record_memory
     if agents and arguments.record_memory is None and record_memory:
         # run.toml names the subsystems of the whole system; this process records those it runs
@@ -378,7 +378,9 @@ def _stopped_between_instants() -> Iterator[_StopRequest]:
         if not request.requested:
             request.requested = True
             with contextlib.suppress(OSError):  # said from a signal handler: one write, no Rich
-                os.write(2, b"earl run: stopping after this instant (Ctrl-C again to stop at once)\n")
+                # `earl launch` stops its processes with SIGTERM: "Ctrl-C again" is advice for a terminal
+                said = b" (Ctrl-C again to stop at once)" if number == signal.SIGINT else b""
+                os.write(2, b"earl run: stopping after this instant" + said + b"\n")
 
     with handling_stop_signals(stop):
         yield request

@@ -213,6 +213,14 @@ def endpoint_problem(endpoint: str) -> str | None:
     return None
 
 
+#: `earl run` options `earl launch` gives each process, which its `args` may not give again
+LAUNCH_SETS = {
+    "--transport": "always zenoh",
+    "--agents": "from the process's `agents`",
+    "--deployment": "this file",
+}
+
+
 def _endpoint_key(endpoint: str) -> tuple[str, str, str]:
     """An endpoint as a listener sees it: `localhost`, `127.0.0.1` and `[::1]` are the same host."""
     protocol, _, address = endpoint.partition("/")
@@ -240,6 +248,10 @@ def read_deployment(path: Path) -> Deployment:
     if unknown:
         raise DeploymentError(f"{path}: unknown setting `{unknown[0]}` (a deployment has `[[process]]` tables)")
     tables = data.get("process")
+    if isinstance(tables, dict):
+        raise DeploymentError(
+            f"{path}: `[process]` is one table; write `[[process]]`, with two brackets, before each process"
+        )
     if not isinstance(tables, list) or not tables:
         raise DeploymentError(f"{path}: no `[[process]]` table; each names its `agents` and `listen` endpoint")
     processes: list[ProcessGroup] = []
@@ -254,7 +266,9 @@ def read_deployment(path: Path) -> Deployment:
         if extra:
             raise DeploymentError(f"{where}: unknown key `{extra[0]}` (known: agents, listen, environment, host, args)")
         agents = table.get("agents")
-        if not isinstance(agents, list) or not agents or not all(isinstance(a, str) and a.strip() for a in agents):
+        if agents == []:
+            raise DeploymentError(f'{where}: `agents` is empty; list the agents it runs, e.g. ["manip/a", "grip/a"]')
+        if not isinstance(agents, list) or not all(isinstance(a, str) and a.strip() for a in agents):
             raise DeploymentError(f'{where}: `agents` must be a list of agent names, e.g. ["manip/a", "grip/a"]')
         names = tuple(normalise_agent(a) for a in agents)
         for agent in names:
@@ -285,5 +299,12 @@ def read_deployment(path: Path) -> Deployment:
             raise DeploymentError(f"{where}: `host` must be a host name")
         if not isinstance(args, list) or not all(isinstance(a, str) for a in args):
             raise DeploymentError(f'{where}: `args` must be a list of `earl run` options, e.g. ["--trace", "x.mcap"]')
+        for arg in args:
+            option = arg.split("=", 1)[0]
+            if option in LAUNCH_SETS:
+                raise DeploymentError(
+                    f"{where}: `args` sets `{option}`, which `earl launch` sets for each process itself "
+                    f"({LAUNCH_SETS[option]})"
+                )
         processes.append(ProcessGroup(names, listen, environment, host, tuple(args)))
     return Deployment(path, tuple(processes))

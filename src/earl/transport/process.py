@@ -122,10 +122,16 @@ def agents_of(system: System, parameters: Mapping[str, Any], agents: list[str]) 
     return names
 
 
-def peers_wait(text: str) -> float:
-    """`--wait-for-peers`: a duration, or 0 for none (start at once, whoever is there)."""
+#: `--wait-for-peers` when it is not given
+DEFAULT_PEERS_WAIT = "30s"
+
+
+def peers_wait(text: str | None) -> float:
+    """`--wait-for-peers`: a duration, or 0 for none (start at once, whoever is there); None: the default."""
     from earl.runtime.durations import parse_duration
 
+    if text is None:
+        text = DEFAULT_PEERS_WAIT
     if text.strip() in ("0", "0s", "0 s", "0ms", "0 ms"):
         return 0.0
     return parse_duration(text)
