@@ -242,6 +242,11 @@ def test_a_peer_with_another_data_type_is_refused_with_both_types_named(
     refused = int(line.split(", ")[-1].split(" ")[0])
     assert refused > 50, line
     assert received(output, "sender,receiver") == 0
+    # the sender, whose messages are lost, says it too (it counted them as sent)
+    assert (
+        f"earl run: link sender,receiver: receiver/a.cs refuses this process's messages of `{theirs}`: its ping/ib "
+        f"expects `{PING}`" in sender.output
+    ), sender.output
 
 
 def test_malformed_bytes_injected_on_a_link_key_are_counted_and_dropped(

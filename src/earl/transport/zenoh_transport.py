@@ -29,6 +29,7 @@ from typing import Any
 
 import zenoh
 
+from earl.diagnostics import escape_controls
 from earl.model.types import DataType
 from earl.runtime.engine import SubsystemEngine
 from earl.runtime.values import TypeSystem
@@ -229,6 +230,7 @@ class ZenohTransport:
         self._lost: set[str] = set()  # peers seen, then gone (scheduler's thread)
         self._alive_changed = threading.Condition()
         self._descriptions: dict[str, str] = {}  # fingerprint hex -> description, for the types queryable
+        self._refusals_said: set[str] = set()  # links whose receivers said they refuse our messages
         self._declared: list[Any] = []
         self._tokens: list[zenoh.LivelinessToken] = []
         self._types: TypeSystem | None = None
@@ -385,6 +387,25 @@ class ZenohTransport:
         description = self._descriptions.get(fingerprint)
         if description is not None:
             query.reply(query.key_expr, description.encode("utf-8"))
+            self._told_of_refusal(query, description)
+
+    def _told_of_refusal(self, query: zenoh.Query, ours: str) -> None:
+        """The peer asking refuses our messages and says where (`explain_mismatch`): this side says it too,
+        once per link, so that the process whose messages are lost is not the one that stays silent."""
+        try:
+            payload = query.payload
+            asked: dict[str, Any] = json.loads(payload.to_bytes()) if payload is not None else {}
+            link, receiver, buffer, expects = (str(asked[k]) for k in ("link", "receiver", "buffer", "expects"))
+        except Exception:  # an older peer, or one that says nothing: its own report is the one
+            return
+        if link in self._refusals_said:
+            return
+        self._refusals_said.add(link)
+        message = escape_controls(  # a peer's words: none may forge a line of this process's output
+            f"earl run: link {link}: {receiver} refuses this process's messages of `{ours}`: its {buffer}/ib "
+            f"expects `{expects}` — the two processes run different specifications"
+        )
+        self.inbox.put(lambda _time, said: self.log(said), message)
 
     def explain_mismatch(self, remote: _Input, received: bytes) -> None:
         """Ask the peers what `received` stands for (off Zenoh's callback thread), then report once."""
@@ -392,7 +413,15 @@ class ZenohTransport:
         def ask() -> None:
             theirs = f"an unknown type (fingerprint {received.hex()}; its sender did not describe it)"
             try:
-                for reply in self.session.get(type_key(self.system, received), timeout=2.0):
+                # what this side expects goes with the question: the sender says the refusal too
+                said = {
+                    "link": remote.link,
+                    "receiver": remote.engine.name,
+                    "buffer": remote.buffer,
+                    "expects": remote.codec.description,
+                }
+                replies = self.session.get(type_key(self.system, received), timeout=2.0, payload=json.dumps(said))
+                for reply in replies:
                     ok = reply.ok
                     if ok is not None:
                         theirs = f"`{ok.payload.to_bytes().decode('utf-8', errors='replace')}`"
