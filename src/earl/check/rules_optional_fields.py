@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass
+from typing import Literal
 
 from earl.check.context import CheckContext
 from earl.check.registry import Finding, rule
@@ -46,7 +47,7 @@ Path = tuple[str, ...]
 #: how a read's value is used: compared for order, computed with or read into (`value`), taken as a
 #: Boolean (`boolean`: an absent field reads as false, so `not` of it as true), or compared for equality
 #: (`equality`: an absent field equals no value, which is what it should be)
-Use = str
+Use = Literal["value", "boolean", "equality"]
 
 
 @dataclass(frozen=True)
@@ -129,7 +130,7 @@ class _Reader:
             yield from self.unguarded(expression.operand, present, predicate, "boolean")
             return
         if isinstance(expression, Comparison):
-            side_use = "equality" if expression.operator in ("==", "!=") else "value"
+            side_use: Use = "equality" if expression.operator in ("==", "!=") else "value"
             for side in (expression.left, expression.right):
                 yield from self.unguarded(side, present, predicate, side_use)
             return
