@@ -141,6 +141,31 @@ class Case:
     passing: str
 
 
+def optional_speed(terminal_condition: str) -> str:
+    """BASE with the link's messages a struct of one optional field, and a2's `tc` reading it."""
+    return add(
+        "struct Cmd {\n    speed: double?\n}\n",
+        edit(
+            ("out/ob: double", "out/ob: Cmd"),
+            ("inp/ib: double", "inp/ib: Cmd"),
+            (
+                "        got/pp = newData(inp/ib)\n",
+                "        got/pp = newData(inp/ib)\n        fast/pp = inp/ib.speed > 1.0\n",
+            ),
+            ("tc = got/pp", f"tc = {terminal_condition}"),
+        ),
+    )
+
+
+def predicate_chain(length: int) -> str:
+    """BASE with a1's `tc` a chain of `length` predicates, each naming the next (two levels deeper each)."""
+    chain = "".join(f"        q{i}/pp = x/mi > 0.0 and q{i + 1}/pp\n" for i in range(length))
+    return edit(
+        ("        go/pp = x/mi > 1.0\n", f"        go/pp = x/mi > 1.0\n{chain}        q{length}/pp = x/mi > 0.0\n"),
+        ("tc = go/pp", "tc = q0/pp"),
+    )
+
+
 CASES: list[Case] = [
     Case(
         "EARL-E001",
@@ -625,59 +650,21 @@ CASES: list[Case] = [
     ),
     Case(
         "EARL-W046",
-        add(
-            "struct Cmd {\n    speed: double?\n}\n",
-            edit(
-                ("out/ob: double", "out/ob: Cmd"),
-                ("inp/ib: double", "inp/ib: Cmd"),
-                (
-                    "        got/pp = newData(inp/ib)\n",
-                    "        got/pp = newData(inp/ib)\n        fast/pp = inp/ib.speed > 1.0\n",
-                ),
-                ("tc = got/pp", "tc = got/pp and fast/pp"),
-            ),
-        ),
+        optional_speed("got/pp and fast/pp"),
         27,
         19,
         "the terminal condition of `run/bb` (through `fast/pp`) reads `inp/ib.speed` even when no message that "
         "carries the optional field `speed` has arrived",
-        add(
-            "struct Cmd {\n    speed: double?\n}\n",
-            edit(
-                ("out/ob: double", "out/ob: Cmd"),
-                ("inp/ib: double", "inp/ib: Cmd"),
-                (
-                    "        got/pp = newData(inp/ib)\n",
-                    "        got/pp = newData(inp/ib)\n        fast/pp = inp/ib.speed > 1.0\n",
-                ),
-                ("tc = got/pp", "tc = newData(inp/ib.speed) and fast/pp"),
-            ),
-        ),
+        optional_speed("newData(inp/ib.speed) and fast/pp"),
     ),
     Case(
         "EARL-E047",
-        edit(
-            (
-                "        go/pp = x/mi > 1.0\n",
-                "        go/pp = x/mi > 1.0\n"
-                + "".join(f"        q{i}/pp = x/mi > 0.0 and q{i + 1}/pp\n" for i in range(80))
-                + "        q80/pp = x/mi > 0.0\n",
-            ),
-            ("tc = go/pp", "tc = q0/pp"),
-        ),
+        predicate_chain(80),
         13,
         9,
         "primitive predicate `q5/pp` of a1/a.cs is 152 levels deep written out through the predicates it names: "
         "at most 150",
-        edit(
-            (
-                "        go/pp = x/mi > 1.0\n",
-                "        go/pp = x/mi > 1.0\n"
-                + "".join(f"        q{i}/pp = x/mi > 0.0 and q{i + 1}/pp\n" for i in range(60))
-                + "        q60/pp = x/mi > 0.0\n",
-            ),
-            ("tc = go/pp", "tc = q0/pp"),
-        ),
+        predicate_chain(60),
     ),
     Case(
         "EARL-E017",

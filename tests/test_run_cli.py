@@ -573,12 +573,8 @@ def test_a_trace_never_replaces_a_file_that_is_not_a_trace(tmp_path: Path) -> No
         assert earl_cli("run", str(spec.parent), "--duration", "10ms", "--trace", str(trace)).returncode == 0
 
 
-def test_a_run_killed_with_sigkill_still_leaves_a_readable_trace(tmp_path: Path) -> None:
-    """The trace's own process finishes the file when the run's process disappears."""
-    trace = tmp_path / "run.mcap"
-    process = realtime_run_under_way(trace)
-    time.sleep(1.5)
-    process.kill()
+def summary_once_finished(process: subprocess.Popen[str], trace: Path) -> subprocess.CompletedProcess[str]:
+    """`earl trace summary` of the trace of a run that was killed, once its writer has finished the file."""
     process.communicate(timeout=30)
     summary = earl_cli("trace", "summary", str(trace))
     deadline = time.monotonic() + 20
@@ -586,6 +582,16 @@ def test_a_run_killed_with_sigkill_still_leaves_a_readable_trace(tmp_path: Path)
         time.sleep(0.2)
         summary = earl_cli("trace", "summary", str(trace))
     assert summary.returncode == 0, summary.stderr
+    return summary
+
+
+def test_a_run_killed_with_sigkill_still_leaves_a_readable_trace(tmp_path: Path) -> None:
+    """The trace's own process finishes the file when the run's process disappears."""
+    trace = tmp_path / "run.mcap"
+    process = realtime_run_under_way(trace)
+    time.sleep(1.5)
+    process.kill()
+    summary = summary_once_finished(process, trace)
     assert "counter/a.cs" in summary.stdout
     # the counts are written at the end, which never came: unknown, not 0
     assert "without the run's end (the run was killed)" in summary.stdout
@@ -632,13 +638,7 @@ def test_a_run_killed_while_it_records_nothing_more_has_its_earlier_records_in_t
     trace = tmp_path / "run.mcap"
     process = realtime_run_under_way(trace, spec.parent)
     process.kill()
-    process.communicate(timeout=30)
-    summary = earl_cli("trace", "summary", str(trace))
-    deadline = time.monotonic() + 20
-    while summary.returncode != 0 and time.monotonic() < deadline:  # the writer may still be finishing
-        time.sleep(0.2)
-        summary = earl_cli("trace", "summary", str(trace))
-    assert summary.returncode == 0, summary.stderr
+    summary = summary_once_finished(process, trace)
     assert "start,hold" in summary.stdout, summary.stdout
 
 
