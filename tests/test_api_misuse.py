@@ -170,6 +170,7 @@ def test_every_kind_of_declared_name_is_checked() -> None:
     ("options", "error", "message"),
     [
         ({"check": "no"}, TypeError, "check takes True or False, not str 'no'"),
+        ({"check": None}, TypeError, "check takes True or False, not NoneType None"),
         ({"realtime": "yes"}, TypeError, "realtime takes True or False, not str 'yes'"),
         ({"trace": "missing/run.mcap"}, FileNotFoundError, "the directory `missing` does not exist"),
         ({"record_outputs": ["zz/a.cs.out"]}, ValueError, "record_outputs: `zz/a.cs.out` is no output buffer"),
@@ -283,7 +284,7 @@ def test_what_the_checks_of_arguments_still_take(tmp_path: Path) -> None:
     ("signal", "outputs"),
     [
         ("w[1]/a.cs.out[1]", ["w[1]/a.cs.out[1]"]),
-        ("w[2]/a.cs.out", ["w[2]/a.cs.out[1]", "w[2]/a.cs.out[2]"]),
+        ("w[2]/a.cs.out[*]", ["w[2]/a.cs.out[1]", "w[2]/a.cs.out[2]"]),
     ],
 )
 def test_a_plotted_member_of_an_output_family_is_recorded_by_its_member_name(signal: str, outputs: list[str]) -> None:
@@ -292,3 +293,39 @@ def test_a_plotted_member_of_an_output_family_is_recorded_by_its_member_name(sig
     from earl.runtime.plot import what_to_record
 
     assert what_to_record(expand(earl.loads(FAMILY), {}), [signal]) == ([], outputs)
+
+
+def test_a_family_of_outputs_named_whole_is_every_member_to_record_and_a_member_to_plot(tmp_path: Path) -> None:
+    from earl.model.expand import expand
+    from earl.runtime.plot import what_to_record
+
+    with pytest.raises(ValueError, match=r"`out` is a family of output buffers; name a member, `w\[1\]/a.cs.out\[1\]`"):
+        what_to_record(expand(earl.loads(FAMILY), {}), ["w[1]/a.cs.out"])
+    with earl.simulate(
+        earl.loads(FAMILY), environment=None, trace=tmp_path / "t.mcap", record_outputs=["w[1]/a.cs.out"]
+    ) as simulation:
+        assert simulation.trace is not None and simulation.trace.links_also_recorded == {"w[1],boss"}
+
+
+def test_a_recorder_without_idle_still_records_a_real_time_run() -> None:
+    """`idle` came later than the other methods: a recorder that does not derive from `Recorder` may lack it."""
+
+    class Counting:
+        def __init__(self) -> None:
+            self.changes = 0
+
+        def state_changed(self, *arguments: object) -> None:
+            self.changes += 1
+
+        def behaviour_started(self, *arguments: object) -> None: ...
+        def behaviour_stopped(self, *arguments: object) -> None: ...
+        def message_sent(self, *arguments: object) -> None: ...
+        def message_writer(self, link: str) -> None: ...
+        def memory_snapshot(self, *arguments: object) -> None: ...
+        def fault(self, *arguments: object) -> None: ...
+        def iteration_done(self, *arguments: object) -> None: ...
+
+    counting = Counting()
+    with earl.simulate(earl.loads(TEXT), environment=None, realtime=True, recorders=[counting]) as simulation:  # type: ignore[list-item]
+        simulation.advance_to(0.05)
+    assert counting.changes >= 1

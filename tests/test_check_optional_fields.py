@@ -179,3 +179,16 @@ def test_an_optional_boolean_taken_as_a_condition_reads_as_false_and_the_warning
         )
         if d.code == "EARL-W046"
     ] == []
+
+
+def test_a_predicate_compared_for_equality_is_judged_as_the_field_itself_would_be() -> None:
+    """`p/pp == false` of an absent Boolean does not hold, as `c[1]/ib.flag == false` does not: no warning
+    that it reads as false, where `not p/pp` does read as true."""
+    text = SPEC.replace("    speed: double\n", "    speed: double\n    flag: boolean?\n")
+    predicates = "        p/pp = c[1]/ib.flag\n"
+    found = {}
+    for condition in ("p/pp == false", "p/pp != true", "not p/pp"):
+        system = earl.loads(text.replace("CONDITION", condition).replace("        PREDICATES\n", predicates), "o.earl")
+        found[condition] = [d.message for d in check(system) if d.code == "EARL-W046"]
+    assert found["p/pp == false"] == found["p/pp != true"] == []
+    assert len(found["not p/pp"]) == 1

@@ -158,7 +158,7 @@ def optional_speed(terminal_condition: str) -> str:
 
 
 def predicate_chain(length: int) -> str:
-    """BASE with a1's `tc` a chain of `length` predicates, each naming the next (two levels deeper each)."""
+    """BASE with a1's `tc` a chain of `length` predicates, each naming the next (one level deeper each)."""
     chain = "".join(f"        q{i}/pp = x/mi > 0.0 and q{i + 1}/pp\n" for i in range(length))
     return edit(
         ("        go/pp = x/mi > 1.0\n", f"        go/pp = x/mi > 1.0\n{chain}        q{length}/pp = x/mi > 0.0\n"),
@@ -659,12 +659,12 @@ CASES: list[Case] = [
     ),
     Case(
         "EARL-E047",
-        predicate_chain(80),
-        13,
+        predicate_chain(160),
+        19,
         9,
-        "primitive predicate `q5/pp` of a1/a.cs is 152 levels deep written out through the predicates it names: "
+        "primitive predicate `q11/pp` of a1/a.cs is 151 levels deep written out through the predicates it names: "
         "at most 150",
-        predicate_chain(60),
+        predicate_chain(148),
     ),
     Case(
         "EARL-E017",
@@ -1379,3 +1379,20 @@ def test_a_link_family_named_otherwise_is_said_as_a_family() -> None:
     text = add(FAMILY_AGENT.replace("link m[K in 1..2],d[K]:", "link m[K in 1..2],drive:"))
     found = [d.message for d in findings(text, "EARL-W010") if "drive" in d.message]
     assert found == ["link `m[K],drive` is not named after its ends; §2.5 suggests `m[K],d`"]
+
+
+def test_a_predicate_s_depth_is_that_of_its_expression_with_each_named_predicate_written_out() -> None:
+    """`p = q and x > 0` with `q = x > 1` is `(x > 1) and (x > 0)` written out: 3 levels (the regression
+    hunt found the named predicate's level counted twice, refusing chains of 76 that ran before)."""
+    from earl.check.rules_behaviour import predicate_depths
+
+    text = edit(
+        (
+            "        go/pp = x/mi > 1.0\n",
+            "        go/pp = x/mi > 1.0\n        p/pp = q/pp and x/mi > 0.0\n        q/pp = x/mi > 1.0\n        r/pp = not p/pp\n",
+        ),
+    )
+    context = context_for(earl.loads(text, "depth.earl"))
+    subsystem = next(s for a, s in context.subsystems() if a.name == "a1")
+    depths = predicate_depths(subsystem)
+    assert (depths["q"], depths["p"], depths["r"], depths["go"]) == (2, 3, 4, 2)

@@ -210,6 +210,18 @@ def test_an_environment_that_would_run_twice_or_apart_from_its_effectors_is_refu
             "[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:1'\nargs = ['--agents=b/a']\n",
             "`args` sets `--agents`, which `earl launch` sets for each process itself",
         ),
+        (
+            "[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:1'\nargs = ['--agent', 'b/a']\n",
+            "`args` sets `--agents` (as `--agent`)",
+        ),
+        (
+            "[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:1'\nargs = ['--trans=inproc']\n",
+            "`args` sets `--transport` (as `--trans`)",
+        ),
+        (
+            "[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:1'\nargs = ['--dep', 'x.toml']\n",
+            "`args` sets `--deployment` (as `--dep`)",
+        ),
         ("[[process]]\nagents = ['a']\n", "`listen` must be a Zenoh endpoint"),
         ("[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:1'\nspeed = 3\n", "unknown key `speed`"),
         (

@@ -496,7 +496,8 @@ def predicate_depths(subsystem: Subsystem) -> dict[str, int]:
             if inner is None:
                 stack2.pop()
                 open_.discard(name)
-                depths[name] = max(level + (depths.get(n, 0) if n is not None else 0) for level, n in own[name])
+                # a predicate named at level L is replaced there by its definition: its root takes level L
+                depths[name] = max(level + (depths.get(n, 1) - 1 if n is not None else 0) for level, n in own[name])
             elif inner not in depths and inner not in open_:
                 open_.add(inner)
                 stack2.append((inner, iter([n for _, n in own[inner] if n is not None])))

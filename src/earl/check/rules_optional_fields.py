@@ -76,7 +76,7 @@ class _Reader:
         }
         self._present: dict[tuple[str, bool], frozenset[Path]] = {}
         self._opened: set[str] = set()  # predicates whose definitions are being followed
-        self._followed: set[tuple[str, frozenset[Path]]] = set()
+        self._followed: set[tuple[str, frozenset[Path], Use]] = set()
 
     # ---------------------------------------------------------------- what a formula proves present
     def present_if(self, expression: Expression, holds: bool) -> frozenset[Path]:
@@ -157,13 +157,14 @@ class _Reader:
         if read.target.kind is Kind.PRIMITIVE_PREDICATE:
             name = read.target.name
             definition = self.definitions.get(name)
-            if definition is None or read.path or name in self._opened or (name, present) in self._followed:
+            if definition is None or read.path or name in self._opened or (name, present, use) in self._followed:
                 return
-            # evaluated where it is named: the caller's guards hold inside it
-            self._followed.add((name, present))
+            # evaluated where it is named: the caller's guards hold inside it, and its value is used as the
+            # caller uses it (`p/pp == false` of an absent Boolean holds no more than the field's own would)
+            self._followed.add((name, present, use))
             self._opened.add(name)
             try:
-                yield from self.unguarded(definition, present, name, "boolean")
+                yield from self.unguarded(definition, present, name, use)
             finally:
                 self._opened.discard(name)
             return

@@ -140,7 +140,9 @@ class Recorders(Recorder):
 
     def idle(self, seconds: float) -> None:
         for recorder in self.recorders:
-            recorder.idle(seconds)
+            idle = getattr(recorder, "idle", None)  # a recorder written before `idle` existed has none
+            if idle is not None:
+                idle(seconds)
 
 
 class StatisticsRecorder(Recorder):

@@ -68,8 +68,14 @@ def what_to_record(expanded: System, signals: list[str]) -> tuple[list[str], lis
             indices = sorted({o.index for o in subsystem.output_buffers if o.name == element and o.index is not None})
             if not indices:
                 sending.append(f"{owner}.{element}")
-            else:  # a family of output buffers: the member the signal names (`out[1]`), or every member
-                chosen = re.match(r"\[(\d+)\]", signal[len(owner) + 1 + len(element) :])
+            else:  # a family of output buffers: the member the signal names (`out[1]`), or every one (`out[*]`)
+                rest = signal[len(owner) + 1 + len(element) :]
+                chosen = re.match(r"\[(\d+)\]", rest)
+                if chosen is None and not rest.startswith("[*]"):
+                    raise ValueError(
+                        f"`{signal}`: `{element}` is a family of output buffers; name a member, "
+                        f"`{owner}.{element}[{indices[0]}]`, or every one, `{owner}.{element}[*]`"
+                    )
                 picked = [int(chosen.group(1))] if chosen is not None else indices
                 sending += [f"{owner}.{element}[{index}]" for index in picked if index in indices]
         else:

@@ -100,9 +100,11 @@ class Simulation:
             # function that draws a random number, and look like that function's fault
             raise ValueError(f"the seed is a whole number >= 0, not {seed!r}")
         for flag, value in (("realtime", realtime), ("check", check)):
-            if isinstance(value, (str, bytes)):
-                # `check="no"` is truthy: it would check, and `realtime="yes"` would run paced by the clock
+            if value is None or isinstance(value, (str, bytes)):
+                # `check="no"` is truthy: it would check, and `realtime="yes"` would run paced by the clock;
+                # None would skip the checker without a word
                 raise TypeError(f"{flag} takes True or False, not {type(value).__name__} {value!r:.60}")
+        realtime, check = bool(realtime), bool(check)  # NumPy's Booleans, 0 and 1: the trace says true/false
         if isinstance(trace, (str, Path)) and not Path(trace).parent.is_dir():
             # said before the network is built and user code imported, not when the trace file is opened
             raise FileNotFoundError(f"the trace cannot be written: the directory `{Path(trace).parent}` does not exist")
@@ -161,7 +163,9 @@ class Simulation:
             # says: what `earl run --plot` draws of an output buffer is the messages on its links
             wanted = set(record_outputs or [])
             self.trace.links_also_recorded = {
-                link for link, source in self.network.link_sources.items() if source in wanted
+                link
+                for link, source in self.network.link_sources.items()
+                if source in wanted or source.rsplit("[", 1)[0] in wanted  # a family named whole: each member
             }
             self.recorder.add(self.trace)
             self.trace.run_started(
@@ -335,7 +339,10 @@ def _refuse_unknown_outputs(outputs: list[str] | None, expanded: System) -> None
         for s in a.subsystems
         for o in s.output_buffers
     ]
+    families = {name.rsplit("[", 1)[0] for name in known if name.endswith("]")}
     for name in outputs:
+        if name in families:
+            continue  # a family of output buffers: every member (`Simulation` records each)
         if name not in known:
             hint = (
                 did_you_mean(name, known)

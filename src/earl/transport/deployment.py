@@ -221,6 +221,15 @@ LAUNCH_SETS = {
 }
 
 
+def _launch_option(arg: str) -> str | None:
+    """The option of LAUNCH_SETS that `arg` gives as `earl run` reads it: whole, with `=VALUE`, or
+    abbreviated (`--agent`, `--trans=inproc`: argparse takes any prefix no other option shares)."""
+    written = arg.split("=", 1)[0]
+    if not written.startswith("--") or len(written) < 3:
+        return None
+    return next((option for option in LAUNCH_SETS if option.startswith(written)), None)
+
+
 def _endpoint_key(endpoint: str) -> tuple[str, str, str]:
     """An endpoint as a listener sees it: `localhost`, `127.0.0.1` and `[::1]` are the same host."""
     protocol, _, address = endpoint.partition("/")
@@ -300,10 +309,12 @@ def read_deployment(path: Path) -> Deployment:
         if not isinstance(args, list) or not all(isinstance(a, str) for a in args):
             raise DeploymentError(f'{where}: `args` must be a list of `earl run` options, e.g. ["--trace", "x.mcap"]')
         for arg in args:
-            option = arg.split("=", 1)[0]
-            if option in LAUNCH_SETS:
+            option = _launch_option(arg)
+            if option is not None:
+                written = arg.split("=", 1)[0]
+                shortened = f" (as `{written}`)" if written != option else ""
                 raise DeploymentError(
-                    f"{where}: `args` sets `{option}`, which `earl launch` sets for each process itself "
+                    f"{where}: `args` sets `{option}`{shortened}, which `earl launch` sets for each process itself "
                     f"({LAUNCH_SETS[option]})"
                 )
         processes.append(ProcessGroup(names, listen, environment, host, tuple(args)))
