@@ -756,3 +756,19 @@ def test_this_host_is_known_by_its_name_in_any_case_and_by_its_addresses() -> No
     name = socket.gethostname()
     assert is_this_host(name.upper()) and is_this_host(name + ".") and is_this_host("127.0.1.1")
     assert not is_this_host("no-such-host.invalid")
+
+
+def test_the_run_options_sharing_a_prefix_with_the_launch_options_are_known_to_the_deployment_reader() -> None:
+    """A deployment's `args` may not set what `earl launch` sets, abbreviated or not; an abbreviation that
+    another `earl run` option shares (`--tra`) is left to `earl run`, which refuses it as ambiguous."""
+    from earl.cli.main import build_parser
+    from earl.transport.deployment import LAUNCH_SETS, SHARING_A_PREFIX
+
+    parser = build_parser("run")
+    run = next(a for a in parser._subparsers._group_actions[0].choices.values())  # type: ignore[union-attr]
+    options = {o for action in run._actions for o in action.option_strings if o.startswith("--")}
+    assert set(LAUNCH_SETS) <= options
+    sharing = {
+        other for other in options - set(LAUNCH_SETS) - {"--help"} for launch in LAUNCH_SETS if other[:3] == launch[:3]
+    }
+    assert sharing == set(SHARING_A_PREFIX)

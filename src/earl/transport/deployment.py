@@ -221,12 +221,19 @@ LAUNCH_SETS = {
 }
 
 
+#: the other `earl run` options that begin as one of LAUNCH_SETS does (tests/test_transport.py keeps this
+#: list equal to the run's parser): a prefix of both is ambiguous, and `earl run` says so itself
+SHARING_A_PREFIX = ("--trace", "--duration")
+
+
 def _launch_option(arg: str) -> str | None:
     """The option of LAUNCH_SETS that `arg` gives as `earl run` reads it: whole, with `=VALUE`, or
     abbreviated (`--agent`, `--trans=inproc`: argparse takes any prefix no other option shares)."""
     written = arg.split("=", 1)[0]
     if not written.startswith("--") or len(written) < 3:
         return None
+    if written not in LAUNCH_SETS and any(other.startswith(written) for other in SHARING_A_PREFIX):
+        return None  # `--tra`: `--trace` or `--transport`, an ambiguity `earl run` refuses in its own words
     return next((option for option in LAUNCH_SETS if option.startswith(written)), None)
 
 
