@@ -49,7 +49,7 @@ from typing import TYPE_CHECKING, Any
 from earl.check.context import CheckContext, subsystem_name
 from earl.check.expression_types import BOOLEAN, ExpressionTyper
 from earl.check.registry import Finding, rule
-from earl.check.rules_behaviour import MAX_PREDICATE_NESTING, predicate_depths
+from earl.check.rules_behaviour import followable_definitions
 from earl.diagnostics import Severity
 from earl.model.elements import FSM, Agent, State, Subsystem, Transition
 from earl.model.expressions import (
@@ -181,12 +181,7 @@ class _Encoder:
         #: `python(reads)` says only what it reads, which two different predicates may share)
         #: a predicate too deep written out (EARL-E047) stays a Boolean of its own: following it to its
         #: definition would recurse past Python's limit
-        depths = predicate_depths(subsystem)
-        self.definitions: dict[str, Expression] = {
-            p.name: p.expression
-            for p in subsystem.primitive_predicates
-            if p.implementation is None and depths.get(p.name, 0) <= MAX_PREDICATE_NESTING
-        }
+        self.definitions: dict[str, Expression] = followable_definitions(subsystem)
         self._defining: set[str] = set()
         #: predicates reached again while their own definition was being encoded: defined through
         #: themselves (EARL-E045), they stay free Booleans; `p ≡ not p` would make every formula false

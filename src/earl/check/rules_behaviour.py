@@ -505,6 +505,18 @@ def predicate_depths(subsystem: Subsystem) -> dict[str, int]:
     return depths
 
 
+def followable_definitions(subsystem: Subsystem) -> dict[str, Expression]:
+    """The definitions of the subsystem's primitive predicates that a walk over a condition may follow: those
+    written as expressions (not computed by Python) and not too deep written out (EARL-E047); the others
+    stay Booleans of their own to the FSM analysis and to EARL-W046."""
+    depths = predicate_depths(subsystem)
+    return {
+        p.name: p.expression
+        for p in subsystem.primitive_predicates
+        if p.implementation is None and depths.get(p.name, 0) <= MAX_PREDICATE_NESTING
+    }
+
+
 @rule(
     "EARL-E047",
     Severity.ERROR,

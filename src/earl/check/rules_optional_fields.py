@@ -20,7 +20,7 @@ from typing import Literal
 
 from earl.check.context import CheckContext
 from earl.check.registry import Finding, rule
-from earl.check.rules_behaviour import MAX_PREDICATE_NESTING, _conditions, predicate_depths
+from earl.check.rules_behaviour import _conditions, followable_definitions
 from earl.diagnostics import Severity
 from earl.model.elements import Subsystem
 from earl.model.expressions import (
@@ -68,12 +68,7 @@ class _Reader:
     def __init__(self, context: CheckContext, subsystem: Subsystem) -> None:
         self.context = context
         self.subsystem = subsystem
-        depths = predicate_depths(subsystem)
-        self.definitions = {
-            p.name: p.expression
-            for p in subsystem.primitive_predicates
-            if p.implementation is None and depths.get(p.name, 0) <= MAX_PREDICATE_NESTING
-        }
+        self.definitions = followable_definitions(subsystem)
         self._present: dict[tuple[str, bool], frozenset[Path]] = {}
         self._opened: set[str] = set()  # predicates whose definitions are being followed
         self._followed: set[tuple[str, frozenset[Path], Use]] = set()
@@ -228,7 +223,7 @@ def optional_fields_read_only_when_present(context: CheckContext) -> Iterator[Fi
     need no guard (an absent field equals no value). Assumptions are not evaluated at run time and are
     not checked."""
 
-    reported: set[SourceLocation | None] = set()  # each read once, named with the first condition that reaches it
+    reported: set[object] = set()  # each read once, named with the first condition that reaches it
     for _agent, subsystem in context.distinct_subsystems():
         reader = _Reader(context, subsystem)
         for role, expression, location in _conditions(subsystem):
@@ -236,8 +231,10 @@ def optional_fields_read_only_when_present(context: CheckContext) -> Iterator[Fi
                 continue  # a predicate is read where a condition names it, with that condition's guards
             for found in reader.unguarded(expression, frozenset()):
                 where = found.read.location or location
-                if where not in reported:
-                    reported.add(where)
+                # a model built in Python has no locations: its reads are told apart by what they read
+                key = where if where is not None else (subsystem.name, found.predicate, expression_text(found.read))
+                if key not in reported:
+                    reported.add(key)
                     yield _finding(found, role, where)
 
 
