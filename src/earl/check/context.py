@@ -23,21 +23,8 @@ from earl.model.expressions import ElementReference, Literal, Name
 from earl.model.kinds import Kind
 from earl.model.location import SourceLocation
 from earl.model.tables import AgentType, agent_type
+from earl.model.text import instance_name
 from earl.model.types import ArrayType, DataType, PrimitiveType, StructType, TypeDefinition, TypeReference
-
-
-def instance_name(name: str, index: int | None) -> str:
-    return name if index is None else f"{name}[{index}]"
-
-
-def subsystem_name(agent: Agent, subsystem: Subsystem) -> str:
-    """`manip/a.cs`, `manip/a.motorController[3]/ve`: the dot notation of manual §2.2."""
-    own = (
-        "cs"
-        if subsystem.kind is Kind.CONTROL_SUBSYSTEM
-        else f"{instance_name(subsystem.name, subsystem.index)}/{subsystem.kind.value}"
-    )
-    return f"{instance_name(agent.name, agent.index)}/a.{own}"
 
 
 def reference_key(reference: ElementReference) -> str:

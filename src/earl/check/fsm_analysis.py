@@ -46,7 +46,7 @@ from fractions import Fraction
 from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
-from earl.check.context import CheckContext, subsystem_name
+from earl.check.context import CheckContext
 from earl.check.expression_types import BOOLEAN, ExpressionTyper
 from earl.check.registry import Finding, rule
 from earl.check.rules_behaviour import followable_definitions
@@ -68,7 +68,7 @@ from earl.model.expressions import (
     evaluate_constant,
 )
 from earl.model.kinds import Kind
-from earl.model.text import expression_text, reference_text
+from earl.model.text import expression_text, reference_text, subsystem_name
 from earl.model.types import StructType
 
 

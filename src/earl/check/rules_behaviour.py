@@ -5,7 +5,7 @@ from __future__ import annotations
 import re
 from collections.abc import Iterable, Iterator
 
-from earl.check.context import CheckContext, instance_name, reference_key, subsystem_name
+from earl.check.context import CheckContext, reference_key
 from earl.check.expression_types import BOOLEAN, ExpressionTyper
 from earl.check.registry import Finding, rule
 from earl.diagnostics import Severity
@@ -14,7 +14,7 @@ from earl.model.expressions import Call, ElementReference, Expression, Read, chi
 from earl.model.graphs import cycles
 from earl.model.kinds import Kind
 from earl.model.location import SourceLocation
-from earl.model.text import expression_text, reference_text
+from earl.model.text import expression_text, instance_name, reference_text, subsystem_name
 
 
 def _conditions(subsystem: Subsystem) -> Iterator[tuple[str, Expression, SourceLocation | None]]:

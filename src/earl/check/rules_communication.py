@@ -5,12 +5,13 @@ from __future__ import annotations
 from collections.abc import Iterable, Iterator
 from operator import attrgetter
 
-from earl.check.context import CheckContext, ResolvedLink, instance_name, subsystem_name
+from earl.check.context import CheckContext, ResolvedLink
 from earl.check.registry import Finding, rule
 from earl.diagnostics import Severity
 from earl.model.elements import LinkNamePart
 from earl.model.kinds import KIND_TITLES, Kind
 from earl.model.tables import PERMITTED_LINKS, permitted_link
+from earl.model.text import instance_name, subsystem_name
 from earl.model.types import type_text
 
 

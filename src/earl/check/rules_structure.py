@@ -4,11 +4,11 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 
-from earl.check.context import CheckContext, instance_name, subsystem_name
+from earl.check.context import CheckContext
 from earl.check.registry import Finding, rule
 from earl.diagnostics import Severity
 from earl.model.kinds import KIND_TITLES, Kind
-from earl.model.text import reference_text
+from earl.model.text import instance_name, reference_text, subsystem_name
 
 
 @rule("EARL-E001", Severity.ERROR, "a System contains at least one Robot", "§2.1, Figure 2")

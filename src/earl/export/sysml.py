@@ -23,7 +23,7 @@ from pathlib import Path
 
 from earl import __version__
 from earl.check import context_for as check_context_for
-from earl.check.context import CheckContext, instance_name
+from earl.check.context import CheckContext
 from earl.diagnostics import EarlError, Severity
 from earl.export.sysml_expressions import ExpressionWriter, literal
 from earl.export.sysml_names import Namespace, name_text, quoted, readable
@@ -49,7 +49,7 @@ from earl.model.elements import (
 from earl.model.expressions import ElementReference, Literal
 from earl.model.kinds import Kind
 from earl.model.location import Comments, SourceLocation
-from earl.model.text import expression_text
+from earl.model.text import expression_text, instance_name
 from earl.model.types import ArrayType, DataType, PrimitiveType, StructType, TypeAlias, TypeReference, type_text
 
 Value = bool | int | float | str

@@ -46,7 +46,7 @@ from earl.model.expressions import (
 from earl.model.graphs import cycles
 from earl.model.kinds import KIND_TITLES, Kind
 from earl.model.location import SourceLocation
-from earl.model.text import reference_text
+from earl.model.text import reference_text, subsystem_name
 from earl.model.types import (
     MAX_ARRAY_DIMENSIONS,
     PARAMETER_TYPES,
@@ -746,7 +746,7 @@ class Resolver:
                 table.declared_twice.add(key)
                 continue
             sub_scope = dict(inner)
-            self._place = f"`{_owner(agent, subsystem)}`"
+            self._place = f"`{subsystem_name(agent, subsystem)}`"
             sub_family = self.family_range(subsystem.family, inner)
             if subsystem.family is not None and sub_family is not None:
                 sub_scope[subsystem.family.index] = sub_family
@@ -801,7 +801,7 @@ class Resolver:
 
     def _agent_body(self, table: _AgentTable) -> None:
         for sub_table, _family in table.subsystems.values():
-            self._place = f"`{_owner(table.agent, sub_table.subsystem)}`"
+            self._place = f"`{subsystem_name(table.agent, sub_table.subsystem)}`"
             self._subsystem_body(table, sub_table, sub_table.scope)  # type: ignore[attr-defined]
         self._place = f"the links of `{table.agent.name}/a`"
         self._links(table.agent.links, table.scope, agent=table)
@@ -809,7 +809,7 @@ class Resolver:
 
     def _subsystem_body(self, agent: _AgentTable, table: _SubsystemTable, scope: Scope) -> None:
         subsystem = table.subsystem
-        owner = _owner(agent.agent, subsystem)
+        owner = subsystem_name(agent.agent, subsystem)
         for buffer in subsystem.input_buffers:
             if buffer.queue is not None:
                 capacity = self.constant_integer(buffer.queue.capacity, scope, "a FIFO capacity")
@@ -1334,12 +1334,6 @@ _ELEMENT_LISTS = {
 }
 #: a name as the grammar reads it (earl.lark's NAME)
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
-
-
-def _owner(agent: Agent, subsystem: Subsystem) -> str:
-    """`manip/a.cs`, `manip/a.motorController/ve`: a subsystem as messages name it."""
-    kind = "cs" if subsystem.kind is Kind.CONTROL_SUBSYSTEM else f"{subsystem.name}/{subsystem.kind.value}"
-    return f"{agent.name}/a.{kind}"
 
 
 def _declared_names(system: System) -> Iterator[tuple[object, str, SourceLocation | None]]:

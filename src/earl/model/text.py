@@ -28,9 +28,10 @@ from earl.model.expressions import (
     Read,
     Star,
 )
+from earl.model.kinds import Kind
 
 if TYPE_CHECKING:
-    from earl.model.elements import Family, Link
+    from earl.model.elements import Agent, Family, Link, Subsystem
 
 # Binding strength, loosest first; a child binding more loosely than its parent needs parentheses.
 _OR, _AND, _NOT, _COMPARE, _SUM, _PRODUCT, _UNARY, _ATOM = range(8)
@@ -152,3 +153,19 @@ def _operand(expression: Expression, parent: int, *, strict: bool) -> str:
     if own < parent or (strict and own == parent):
         return f"({text})"
     return text
+
+
+def instance_name(name: str, index: int | None) -> str:
+    """`motorController[3]`: a member of a family by its index; an element declared alone by its name."""
+    return name if index is None else f"{name}[{index}]"
+
+
+def subsystem_name(agent: Agent, subsystem: Subsystem) -> str:
+    """`manip/a.cs`, `manip/a.motorController[3]/ve`: the dot notation of manual §2.2, for the checker's and
+    the run's messages and the names a run gives its subsystems alike."""
+    own = (
+        "cs"
+        if subsystem.kind is Kind.CONTROL_SUBSYSTEM
+        else f"{instance_name(subsystem.name, subsystem.index)}/{subsystem.kind.value}"
+    )
+    return f"{instance_name(agent.name, agent.index)}/a.{own}"

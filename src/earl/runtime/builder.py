@@ -16,6 +16,7 @@ from earl.diagnostics import Diagnostic, EarlError, Severity
 from earl.model.elements import Agent, Link, LinkEnd, PrimitivePredicate, Subsystem, System, duration_problems
 from earl.model.expressions import ElementReference, Literal, Read
 from earl.model.kinds import Kind
+from earl.model.text import subsystem_name
 from earl.model.types import DataType
 from earl.runtime.binding import (
     PREDICATE_SIGNATURE,
@@ -36,7 +37,7 @@ from earl.runtime.engine import (
     TransitionRuntime,
 )
 from earl.runtime.events import Recorder
-from earl.runtime.names import agent_name, indexed, reference_key, subsystem_name
+from earl.runtime.names import agent_name, indexed, reference_key
 from earl.runtime.predicates import CompiledPredicate, PredicateCompileError, compile_predicate
 from earl.runtime.values import TypeSystem, ValueTypeError
 from earl.runtime.views import Context, build_inputs, build_outputs

@@ -6,9 +6,8 @@ Python API (`sim.state_of("manip/a.cs")`) and in trace topics.
 
 from __future__ import annotations
 
-from earl.model.elements import Agent, Subsystem
+from earl.model.elements import Agent
 from earl.model.expressions import ElementReference, Literal
-from earl.model.kinds import Kind
 
 
 def indexed(name: str, index: int | None) -> str:
@@ -17,12 +16,6 @@ def indexed(name: str, index: int | None) -> str:
 
 def agent_name(agent: Agent) -> str:
     return f"{indexed(agent.name, agent.index)}/a"
-
-
-def subsystem_name(agent: Agent, subsystem: Subsystem) -> str:
-    if subsystem.kind is Kind.CONTROL_SUBSYSTEM:
-        return f"{agent_name(agent)}.cs"
-    return f"{agent_name(agent)}.{indexed(subsystem.name, subsystem.index)}/{subsystem.kind.value}"
 
 
 def reference_key(reference: ElementReference) -> str:

@@ -8,8 +8,8 @@ from pathlib import Path
 from earl.diagnostics import did_you_mean
 from earl.model.elements import Memory, OutputBuffer, Subsystem, System
 from earl.model.expressions import Literal
+from earl.model.text import subsystem_name
 from earl.model.types import ArrayType, StructType
-from earl.runtime.names import subsystem_name
 from earl.runtime.trace_reader import CUT, read_signals, signal_element
 
 #: the kinds of file a plot is written as, by the suffix (what Matplotlib's Agg backend writes)

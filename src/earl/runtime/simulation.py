@@ -331,7 +331,8 @@ def _refuse_unknown_outputs(outputs: list[str] | None, expanded: System) -> None
     if not outputs:
         return
     from earl.diagnostics import did_you_mean
-    from earl.runtime.names import indexed, subsystem_name
+    from earl.model.text import subsystem_name
+    from earl.runtime.names import indexed
 
     known = [
         f"{subsystem_name(a, s)}.{indexed(o.name, o.index)}"
