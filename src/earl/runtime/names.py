@@ -8,10 +8,9 @@ from __future__ import annotations
 
 from earl.model.elements import Agent
 from earl.model.expressions import ElementReference, Literal
+from earl.model.text import instance_name as indexed  # `windingCurrent[3]`: spelled as the checker spells it
 
-
-def indexed(name: str, index: int | None) -> str:
-    return name if index is None else f"{name}[{index}]"
+__all__ = ["agent_name", "indexed", "reference_index", "reference_key"]
 
 
 def agent_name(agent: Agent) -> str:
