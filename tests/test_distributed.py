@@ -249,6 +249,44 @@ def test_a_peer_with_another_data_type_is_refused_with_both_types_named(
     ), sender.output
 
 
+def test_peers_that_run_different_specifications_say_so_and_their_links_still_carry_messages(
+    tmp_path: Path, processes: list[Process]
+) -> None:
+    # a timeout of the receiver changed in one copy: no link's data type shows it, so every message is accepted
+    other = tmp_path / "other"
+    shutil.copytree(PINGPONG, other)
+    spec = other / "system.earl"
+    spec.write_text(
+        spec.read_text().replace(
+            "state gone: gone/bb { obligatory ping/ib  timeout 200 ms }",
+            "state gone: gone/bb { obligatory ping/ib  timeout 300 ms }",
+        )
+    )
+    assert spec.read_text() != (PINGPONG / "system.earl").read_text()
+    deploy = deployment(tmp_path, [(["sender/a"], False), (["receiver/a"], False)])
+    common = ["--transport", "zenoh", "--deployment", str(deploy), "--duration", "2s"]
+    receiver = run(processes, tmp_path / "receiver.log", [str(PINGPONG), *common, "--agents", "receiver/a"])
+    sender = run(processes, tmp_path / "sender.log", [str(other), *common, "--agents", "sender/a"])
+    assert sender.finish(60) == 0, sender.output
+    assert receiver.finish(60) == 0, receiver.output
+    said = "runs another specification than this process (digest "
+    assert receiver.output.count(f"earl run: sender/a {said}") == 1, receiver.output
+    assert sender.output.count(f"earl run: receiver/a {said}") == 1, sender.output
+    assert "the spec, its imports or the --param values differ" in receiver.output
+    assert received(receiver.output, "sender,receiver") > 50, receiver.output
+    # the same spec read from another directory, with its comments changed, is the same system
+    again = tmp_path / "again"
+    shutil.copytree(PINGPONG, again)
+    (again / "system.earl").write_text("// another copy\n" + (PINGPONG / "system.earl").read_text())
+    deploy = deployment(tmp_path, [(["sender/a"], False), (["receiver/a"], False)])
+    common = ["--transport", "zenoh", "--deployment", str(deploy), "--duration", "1s"]
+    receiver = run(processes, tmp_path / "receiver2.log", [str(PINGPONG), *common, "--agents", "receiver/a"])
+    sender = run(processes, tmp_path / "sender2.log", [str(again), *common, "--agents", "sender/a"])
+    assert sender.finish(60) == 0, sender.output
+    assert receiver.finish(60) == 0, receiver.output
+    assert said not in receiver.output + sender.output, (receiver.output, sender.output)
+
+
 def test_malformed_bytes_injected_on_a_link_key_are_counted_and_dropped(
     tmp_path: Path, processes: list[Process]
 ) -> None:

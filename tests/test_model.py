@@ -359,3 +359,46 @@ def test_cycles_are_found_in_one_walk_each_once_from_where_the_walk_returns() ->
     chain = {f"n{i}": [f"n{i + 1}"] for i in range(20_000)} | {"n20000": ["n0"]}
     [cycle] = cycles(chain, chain.__getitem__)  # no recursion, and no walk from each node in turn
     assert len(cycle) == 20_001 and cycle[0] == "n0"
+
+
+def test_the_digest_of_a_system_follows_equality_and_is_the_same_in_every_process() -> None:
+    from earl.model.digest import model_digest
+
+    spec = Path(__file__).parent.parent / "examples" / "pick_and_place" / "system.earl"
+    system = earl.load(spec)
+    digest = model_digest(expand(system, {}))
+    assert len(digest) == 16 and int(digest, 16) >= 0
+    # comments, locations and where the text was read from are no part of the system
+    again = earl.loads("// a copy\n" + system.to_earl().replace("//", "// said otherwise:"), "elsewhere/system.earl")
+    assert again == system and model_digest(expand(again, {})) == digest
+    # another parameter value, a changed period, a changed condition: another system
+    assert model_digest(expand(system, {"N": 7})) != digest
+    text = system.to_earl()
+    for old, new in [("period 2 ms", "period 3 ms"), ("emergencyStopCommand or any", "emergencyStopCommand and any")]:
+        assert old in text
+        assert model_digest(expand(earl.loads(text.replace(old, new, 1)), {})) != digest, old
+    # sets and dicts have no order (and str hashes differ between processes): the same digest in another one
+    program = (
+        "import sys, earl\nfrom earl.model.expand import expand\nfrom earl.model.digest import model_digest\n"
+        "print(model_digest(expand(earl.load(sys.argv[1]), {})), model_digest({'b': {1, 'x'}, 'a': frozenset('yz')}))"
+    )
+    outputs = {
+        subprocess.run(
+            [sys.executable, "-c", program, str(spec)],
+            capture_output=True,
+            text=True,
+            check=True,
+            env={**__import__("os").environ, "PYTHONHASHSEED": seed},
+        ).stdout
+        for seed in ("1", "2")
+    }
+    assert outputs == {f"{digest} {model_digest({'a': frozenset('zy'), 'b': {'x', 1}})}\n"}
+
+
+def test_the_digest_walks_a_model_nested_deeper_than_pythons_recursion_limit() -> None:
+    from earl.model.digest import model_digest
+
+    deep: object = Literal(True)
+    for _ in range(sys.getrecursionlimit() * 2):
+        deep = Not(deep)  # type: ignore[arg-type]
+    assert model_digest(deep) != model_digest(Not(Literal(True)))

@@ -126,7 +126,10 @@ def test_link_names_become_single_key_chunks_that_read_back() -> None:
         assert "/" not in chunk and not set(chunk) & set("*$?#@ ")
         if text:
             assert unescape(chunk) == text
-    assert alive_key("pickAndPlace", "task/a", "1f2e") == "earl/pickAndPlace/alive/task%2Fa/1f2e"
+    assert alive_key("pickAndPlace", "task/a", "1f2e", "468ec4426e04f9f7") == (
+        "earl/pickAndPlace/alive/task%2Fa/1f2e/468ec4426e04f9f7"
+    )
+    assert alive_key("pickAndPlace", "task/a", "1f2e") == "earl/pickAndPlace/alive/task%2Fa/1f2e/-"  # says none
 
 
 def test_the_examples_deployment_puts_every_agent_in_one_process() -> None:
@@ -640,7 +643,7 @@ class _InboxOnly:
     def __init__(self) -> None:
         self.inbox = Inbox()
 
-    def start(self) -> None:
+    def start(self, specification: str | None = None) -> None:
         pass
 
     def close(self) -> None:

@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any, Protocol
 
 from earl.diagnostics import Diagnostic, EarlError, Severity
+from earl.model.digest import model_digest
 from earl.model.elements import Duration, System
 from earl.model.expand import expand
 from earl.model.types import refuse_wrong_parameters
@@ -58,8 +59,9 @@ class Transport(RemoteLinks, Protocol):
     @property
     def inbox(self) -> Inbox: ...
 
-    def start(self) -> None:
-        """Every link is declared: announce this process's agents."""
+    def start(self, specification: str | None = None) -> None:
+        """Every link is declared: announce this process's agents, and the digest of the expanded system it
+        runs (`earl.model.digest.model_digest`), which peers compare with theirs."""
 
     def close(self) -> None: ...
 
@@ -137,7 +139,7 @@ class Simulation:
         )
         self.transport = transport
         if transport is not None:
-            transport.start()
+            transport.start(model_digest(self.expanded))
         memory = set(record_memory or [])
         if "all" in memory:
             memory = set(self.network.by_name)

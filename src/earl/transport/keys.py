@@ -1,7 +1,8 @@
 """Zenoh key expressions of a running system (docs/distributed.md, "Keys").
 
     earl/<system>/<link>            the messages of one link
-    earl/<system>/alive/<agent>     one liveliness token per running agent
+    earl/<system>/alive/<agent>/<process>/<spec>
+                                    one liveliness token per running agent and process
     earl/<system>/types/<hex>       the description of a data type, by its fingerprint
 
 A link's name (`task,manip`, `manip/a:cs,motorController[3]`) keeps the characters a key
@@ -31,10 +32,15 @@ def link_key(system: str, link: str) -> str:
     return f"earl/{escape(system)}/{escape(link)}"
 
 
-def alive_key(system: str, agent: str, process: str) -> str:
+#: the last chunk of a liveliness token whose process did not say which specification it runs
+UNKNOWN_SPECIFICATION = "-"
+
+
+def alive_key(system: str, agent: str, process: str, specification: str = UNKNOWN_SPECIFICATION) -> str:
     """The liveliness token of `agent` as run by one process (`process`: an id of its own), so that the
-    same agent started twice is seen as two tokens, not one."""
-    return f"earl/{escape(system)}/alive/{escape(agent)}/{escape(process)}"
+    same agent started twice is seen as two tokens, not one; `specification` is the digest of the system
+    the process runs (earl.model.digest), so that its peers can tell when they run another one."""
+    return f"earl/{escape(system)}/alive/{escape(agent)}/{escape(process)}/{escape(specification)}"
 
 
 def alive_prefix(system: str) -> str:

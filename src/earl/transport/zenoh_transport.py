@@ -36,6 +36,7 @@ from earl.runtime.values import TypeSystem
 from earl.transport.codec import FingerprintMismatch, LinkCodec, MalformedMessage
 from earl.transport.inbox import Inbox
 from earl.transport.keys import (
+    UNKNOWN_SPECIFICATION,
     alive_key,
     alive_prefix,
     escape,
@@ -240,6 +241,12 @@ class ZenohTransport:
         self.process_id = uuid.uuid4().hex[:12]
         #: the processes each agent is seen alive in (more than one: the agent was started twice)
         self._instances: dict[str, set[str]] = {}
+        #: the digest of the expanded system this process runs (`start`), None until it says
+        self.specification: str | None = None
+        #: what each peer process's tokens say it runs: (an agent of it, the digest of its system)
+        self._peer_specifications: dict[str, tuple[str, str]] = {}
+        #: peer processes found running another specification (said once each)
+        self._other_specifications: set[str] = set()
         try:
             self.session = zenoh.open(config)
         except Exception as error:
@@ -247,7 +254,7 @@ class ZenohTransport:
         self._declared.append(self.session.declare_queryable(f"earl/{escape(system)}/types/*", self._answer_type_query))
         self._declared.append(
             self.session.liveliness().declare_subscriber(
-                alive_prefix(system) + "*/*", self._on_liveliness, history=True
+                alive_prefix(system) + "*/*/*", self._on_liveliness, history=True
             )
         )
         self._declared.append(self.session.declare_subscriber(finished_prefix(system) + "*", self._on_finished))
@@ -285,11 +292,20 @@ class ZenohTransport:
         self._descriptions[codec.fingerprint.hex()] = codec.description
         return codec
 
-    def start(self) -> None:
+    def start(self, specification: str | None = None) -> None:
         """Declare this process's agents alive: called once every link is declared, so a peer that
-        sees the token also finds the subscribers."""
+        sees the token also finds the subscribers.  `specification` is the digest of the expanded
+        system this process runs (`earl.model.digest.model_digest`); a peer that runs another is
+        reported once (None: this process does not say, and compares with none)."""
+        with self._alive_changed:
+            self.specification = specification
+            seen = list(self._peer_specifications.items())
+        for process, (agent, theirs) in seen:  # peers whose tokens came before this process knew its own
+            self._compare_specifications(agent, process, theirs)
+        said = UNKNOWN_SPECIFICATION if specification is None else specification
         for agent in self.local_agents:
-            self._tokens.append(self.session.liveliness().declare_token(alive_key(self.system, agent, self.process_id)))
+            key = alive_key(self.system, agent, self.process_id, said)
+            self._tokens.append(self.session.liveliness().declare_token(key))
 
     # ---------------------------------------------------------------- peers
     @property
@@ -318,10 +334,14 @@ class ZenohTransport:
 
     def _on_liveliness(self, sample: zenoh.Sample) -> None:
         """On Zenoh's thread: a process declared one of its agents alive, or that token went."""
-        chunks = str(sample.key_expr).rsplit("/", 2)
-        agent, process = unescape(chunks[-2]), unescape(chunks[-1])
+        chunks = str(sample.key_expr).rsplit("/", 3)
+        agent, process, specification = unescape(chunks[-3]), unescape(chunks[-2]), unescape(chunks[-1])
         if process == self.process_id:
             return  # our own token
+        if sample.kind == zenoh.SampleKind.PUT:
+            with self._alive_changed:
+                self._peer_specifications[process] = (agent, specification)
+            self._compare_specifications(agent, process, specification)
         with self._alive_changed:
             instances = self._instances.setdefault(agent, set())
             was_alive = bool(instances)
@@ -346,6 +366,23 @@ class ZenohTransport:
         if alive != was_alive:
             # always handed over: the buffers it feeds may not be declared yet (the token can come first)
             self.inbox.put(self._peer_changed, (agent, alive))
+
+    def _compare_specifications(self, agent: str, process: str, theirs: str) -> None:
+        """Say once per peer process that it runs another specification than this one: links whose data types
+        agree still carry its messages, but the two processes each run their own version of the system (a
+        period, a condition or a `--param` value that no link's type shows)."""
+        with self._alive_changed:  # from Zenoh's thread, and from `start`
+            ours = self.specification
+            if ours is None or theirs in (ours, UNKNOWN_SPECIFICATION) or process in self._other_specifications:
+                return
+            self._other_specifications.add(process)
+        self.log(
+            escape_controls(  # a peer's words: none may forge a line of this process's output
+                f"earl run: {agent} runs another specification than this process (digest {theirs} there, {ours} "
+                "here): the spec, its imports or the --param values differ; start every process from the same "
+                "spec with the same parameters"
+            )
+        )
 
     def _peer_changed(self, time: int, item: tuple[str, bool]) -> None:
         """On the scheduler's thread: the buffers fed by `agent` go stale, or flow again."""
