@@ -753,3 +753,93 @@ def test_the_entry_into_the_initial_state_names_no_transition(tmp_path: Path) ->
     assert changes[0] == {"from": None, "to": "counting", "transition": None}
     assert changes[1:] == [{"from": "counting", "to": "finished", "transition": "counting,finished"}]
     assert summarise(tmp_path / "run.mcap").subsystems["counter/a.cs"].transitions == {"counting,finished": 1}
+
+
+DAG_LEVELS = 24
+
+
+def predicate_dag(tmp_path: Path) -> Path:
+    """A predicate each level of which names the next twice: written out, the condition is 2**24 leaves long."""
+    levels = "\n".join(f"        p{k}/pp = p{k + 1}/pp and p{k + 1}/pp" for k in range(1, DAG_LEVELS))
+    (tmp_path / "system.earl").write_text(
+        f"""system dag
+x/a {{
+    cs {{
+        period 1 ms
+        n/m: int = 0
+        p{DAG_LEVELS}/pp = n/mi >= 0
+{levels}
+        count/pf(n/mi -> n/mo) = python "dagcode:count"
+        run/bb {{
+            tf = {{count/pf}}
+            tc = p1/pp
+        }}
+        again/bb {{
+            tf = {{count/pf}}
+            tc = p1/pp
+        }}
+        fsm {{
+            initial run
+            state run: run/bb
+            state again: again/bb
+            run -> again when p1/pp
+            again -> run when p1/pp or p2/pp
+        }}
+    }}
+}}
+r/r {{
+    x/a
+}}
+"""
+    )
+    (tmp_path / "dagcode.py").write_text("def count(i, o, c):\n    o.n = i.n + 1\n")
+    return tmp_path
+
+
+def test_a_predicate_that_names_another_twice_at_each_level_is_computed_once_per_decision(tmp_path: Path) -> None:
+    from earl.runtime.predicates import REPEATED_EVALUATIONS
+
+    sim = earl.simulate(earl.load(predicate_dag(tmp_path)))
+    try:
+        engine = sim.network.by_name["x/a.cs"]
+        calls = dict.fromkeys(engine.predicates, 0)
+
+        def counted(name: str, predicate: Any) -> Any:
+            def call(*arguments: Any) -> Any:
+                calls[name] += 1
+                return predicate(*arguments)
+
+            return call
+
+        for name, predicate in list(engine.predicates.items()):
+            engine.predicates[name] = counted(name, predicate)
+        sim.advance_to(0.0095)  # ten decisions, each of which holds: every state's tc and its transition
+        states = [sim.state_of("x/a.cs").state]
+        assert states == ["run"] and sim.state_of("x/a.cs").memory["n"] == 10
+        # each decision evaluates at most three conditions (tc, and a transition naming p1/pp and p2/pp): without
+        # keeping values the deepest predicate would be computed 2**23 times per condition, 2.5 * 10**8 in all
+        assert max(calls.values()) <= 10 * 3 * REPEATED_EVALUATIONS, calls
+        assert calls[f"p{DAG_LEVELS}"] <= 10 * REPEATED_EVALUATIONS, calls
+    finally:
+        sim.close()
+
+
+def test_only_predicates_a_condition_would_compute_many_times_over_are_kept() -> None:
+    from earl.model.expressions import BooleanOperation, ElementReference, Read
+    from earl.model.kinds import Kind
+    from earl.runtime.predicates import REPEATED_EVALUATIONS, repeatedly_evaluated
+
+    def named(name: str) -> Read:
+        return Read(ElementReference(name, Kind.PRIMITIVE_PREDICATE), ())
+
+    # p1 names p2 twice, p2 names p3 twice, …: p_k is reached 2**(k-1) times from p1
+    definitions: dict[str, Any] = {
+        f"p{k}": BooleanOperation("and", (named(f"p{k + 1}"), named(f"p{k + 1}"))) for k in range(1, 8)
+    }
+    definitions["p8"] = named("leaf")
+    assert repeatedly_evaluated(definitions, [named("p1")]) == {"p5"}  # 16 times; p6 then only twice
+    assert repeatedly_evaluated(definitions, [named("p4")]) == {"p8"}  # 16 times
+    assert repeatedly_evaluated(definitions, [named("p5")]) == set()  # p8 8 times: no more than the limit
+    # a predicate named by many conditions is computed once per condition: not kept
+    assert repeatedly_evaluated(definitions, [named("p8")] * 20) == set()
+    assert REPEATED_EVALUATIONS == 8

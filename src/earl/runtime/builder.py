@@ -38,7 +38,13 @@ from earl.runtime.engine import (
 )
 from earl.runtime.events import Recorder
 from earl.runtime.names import agent_name, indexed, reference_key
-from earl.runtime.predicates import CompiledPredicate, PredicateCompileError, compile_predicate
+from earl.runtime.predicates import (
+    CompiledPredicate,
+    PredicateCompileError,
+    compile_predicate,
+    kept_for_the_decision,
+    repeatedly_evaluated,
+)
 from earl.runtime.values import TypeSystem, ValueTypeError
 from earl.runtime.views import Context, build_inputs, build_outputs
 
@@ -266,9 +272,10 @@ def _behaviour(
         if predicate.implementation is not None:
             try:
                 engine.predicates[predicate.name] = _python_predicate(engine, predicate)
-                engine.has_python_predicates = True
+                engine.keeps_predicate_values = True
             except BindingProblem as problem:
                 problems.append(problem.diagnostic)
+    _keep_repeated_predicates(engine, subsystem)
     functions: dict[str, FunctionRuntime] = {}
     for declared in subsystem.partial_transition_functions:
         try:
@@ -372,6 +379,25 @@ def _behaviour(
         )
 
 
+def _keep_repeated_predicates(engine: SubsystemEngine, subsystem: Subsystem) -> None:
+    """Predicates that a condition would compute many times over are computed once per decision instead."""
+    definitions = {
+        predicate.name: predicate.expression
+        for predicate in subsystem.primitive_predicates
+        if predicate.implementation is None and predicate.expression is not None
+    }
+    conditions = [transition.condition.expression for transition in subsystem.fsm.transitions] if subsystem.fsm else []
+    for behaviour in subsystem.basic_behaviours:
+        conditions.append(behaviour.terminal_condition.expression)
+        if behaviour.error_condition is not None:
+            conditions.append(behaviour.error_condition.expression)
+    for name in repeatedly_evaluated(definitions, conditions):
+        if name not in engine.predicates:  # not compiled: the run refuses the spec for it already
+            continue
+        engine.predicates[name] = kept_for_the_decision(engine.predicates[name], name, engine.predicate_values)
+        engine.keeps_predicate_values = True
+
+
 def _python_predicate(engine: SubsystemEngine, predicate: PrimitivePredicate) -> CompiledPredicate:
     """`ready/pp(x/ib, y/mi) = python "m:f"`: `f(inputs, context)`, its result taken as a Boolean."""
     assert predicate.implementation is not None
@@ -385,7 +411,7 @@ def _python_predicate(engine: SubsystemEngine, predicate: PrimitivePredicate) ->
     inputs = build_inputs(f"{predicate.name}/pp", predicate.reads, engine.inputs, engine.memory)
     refresh = inputs._earl_refresh
     context = engine.context
-    values = engine.python_predicate_values
+    values = engine.predicate_values
     name = predicate.name
 
     def evaluate(*_: object) -> bool:

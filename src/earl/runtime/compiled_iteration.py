@@ -58,8 +58,8 @@ def compile_iteration(engine: SubsystemEngine, state: StateRuntime) -> Iterate:
     lines += _sends(engine, namespace)
     lines += ["    engine.iteration += 1", "    engine.total_iterations += 1"]
     lines += _obligatory(engine, state, namespace)
-    if _has_python_predicates(engine):
-        lines.append("    engine.python_predicate_values.clear()")  # the memory changed
+    if _keeps_predicate_values(engine):
+        lines.append("    engine.predicate_values.clear()")  # the memory changed
     lines += _receives(engine, namespace)
     lines += _decision(behaviour.never_ends, behaviour.error_condition is not None)
     lines.append("    return True")
@@ -76,16 +76,17 @@ def compile_completion(engine: SubsystemEngine, state: StateRuntime) -> Completi
     behaviour = state.behaviour
     namespace = _steps_4_and_5(engine, state)
     lines = ["def complete(time):"]
-    if _has_python_predicates(engine):
-        lines.append("    engine.python_predicate_values.clear()")
+    if _keeps_predicate_values(engine):
+        lines.append("    engine.predicate_values.clear()")
     lines += _receives(engine, namespace)
     lines += _decision(behaviour.never_ends, behaviour.error_condition is not None)
     return generated_function("complete", lines, namespace)  # type: ignore[return-value]
 
 
-def _has_python_predicates(engine: SubsystemEngine) -> bool:
-    """Whether a predicate of `engine` is computed by Python, whose values are kept for one decision."""
-    return engine.has_python_predicates
+def _keeps_predicate_values(engine: SubsystemEngine) -> bool:
+    """Whether some predicate values of `engine` are kept for one decision: those computed by Python, and those
+    a condition would otherwise compute many times over (earl.runtime.predicates.repeatedly_evaluated)."""
+    return engine.keeps_predicate_values
 
 
 def _steps_4_and_5(engine: SubsystemEngine, state: StateRuntime) -> dict[str, Any]:

@@ -129,9 +129,11 @@ class SubsystemEngine:
         self.destinations: dict[str, list[Destination]] = {}
         self.predicates: dict[str, CompiledPredicate] = {}
         #: what each predicate computed by Python returned (or raised) since the input buffers last took
-        #: what arrived: one call per predicate per decision, however many conditions name it
-        self.python_predicate_values: dict[str, bool | BaseException] = {}
-        self.has_python_predicates = False
+        #: what arrived: one call per predicate per decision, however many conditions name it; and the
+        #: values of predicates that conditions would otherwise compute many times over
+        self.predicate_values: dict[str, bool | BaseException] = {}
+        #: whether `predicate_values` is used at all (emptied before each decision then)
+        self.keeps_predicate_values = False
         self.states: dict[str, StateRuntime] = {}
         self.state: StateRuntime | None = None
         self.iteration = 0
@@ -248,7 +250,7 @@ class SubsystemEngine:
         """`tf.pf.ib.receive()`: every input buffer takes what arrived; obligatory ones not filled time out."""
         state = self.state
         assert state is not None
-        self.python_predicate_values.clear()
+        self.predicate_values.clear()
         inputs = self.inputs
         new_data = self.new_data
         for key, channel in self.channels.items():
@@ -302,7 +304,7 @@ class SubsystemEngine:
     def _failure_recorded(self, raised: BaseException) -> None:
         """A Python predicate that raised is asked again in the same decision (a `tc` and a transition naming
         it) as false, without a second fault for the one failure."""
-        values = self.python_predicate_values
+        values = self.predicate_values
         for name, value in values.items():
             if value is raised:
                 values[name] = PredicateFailedBefore(name)

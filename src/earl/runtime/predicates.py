@@ -15,7 +15,7 @@ subsystem's set of stale input buffers, given when the predicate is compiled.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from collections.abc import Set as AbstractSet
 from typing import Any
 
@@ -36,6 +36,7 @@ from earl.model.expressions import (
     Not,
     Quantifier,
     Read,
+    walk,
 )
 from earl.model.kinds import Kind
 from earl.runtime.names import reference_key
@@ -65,6 +66,77 @@ def compile_predicate(
         code, {"__builtins__": {}, "stale": stale, "_element": _element, "_carries": _carries}
     )
     return function
+
+
+#: a named predicate that one condition, evaluated in full, would evaluate more often than this is
+#: computed once per decision instead (`repeatedly_evaluated`)
+REPEATED_EVALUATIONS = 8
+
+
+def repeatedly_evaluated(definitions: Mapping[str, Expression], conditions: Iterable[Expression]) -> set[str]:
+    """The predicates (keys of `definitions`) that some condition would evaluate more than REPEATED_EVALUATIONS
+    times: a predicate each level of which names the next twice (`p1 = p2 and p2`, `p2 = p3 and p3`, …) doubles
+    its work at each level, and compiled predicates call each other.  The engine keeps these for the decision."""
+    named: dict[str, list[str]] = {name: _named(expression) for name, expression in definitions.items()}
+    order = _definitions_first(named)
+    found: set[str] = set()
+    for condition in conditions:
+        # how many times a full evaluation of `condition` reaches each predicate: from the condition down
+        reached: dict[str, int] = {}
+        for name in _named(condition):
+            reached[name] = reached.get(name, 0) + 1
+        for name in reversed(order):  # every predicate after all that name it
+            times = reached.get(name, 0)
+            if not times:
+                continue
+            if times > REPEATED_EVALUATIONS:
+                found.add(name)
+                times = 1  # kept: its own parts are evaluated once
+            for part in named[name]:
+                reached[part] = reached.get(part, 0) + times
+    return found
+
+
+def _named(expression: Expression) -> list[str]:
+    """The primitive predicates `expression` names, once per mention."""
+    return [
+        reference_key(node.target)
+        for node in walk(expression)
+        if isinstance(node, Read) and node.target.kind is Kind.PRIMITIVE_PREDICATE
+    ]
+
+
+def _definitions_first(named: Mapping[str, list[str]]) -> list[str]:
+    """The predicates ordered so that each comes after every predicate it names (a cycle, which the checker
+    refuses, is cut where it closes)."""
+    order: list[str] = []
+    placed: set[str] = set()
+    for root in named:
+        stack: list[tuple[str, bool]] = [(root, False)]
+        while stack:
+            name, parts_done = stack.pop()
+            if parts_done:
+                order.append(name)
+                continue
+            if name in placed or name not in named:
+                continue
+            placed.add(name)
+            stack.append((name, True))
+            stack.extend((part, False) for part in named[name] if part not in placed)
+    return order
+
+
+def kept_for_the_decision(predicate: CompiledPredicate, name: str, values: dict[str, Any]) -> CompiledPredicate:
+    """`predicate`, computed at most once per decision: its value is kept in `values` (the engine's dictionary of
+    predicate values, emptied when the input buffers take what arrived and when the memory changes)."""
+
+    def kept(ib: Any, nd: Any, to: Any, mem: Any, pp: Any) -> Any:
+        known = values.get(name)
+        if known is None:  # an exception is not kept: it ends the whole condition's evaluation at once
+            known = values[name] = bool(predicate(ib, nd, to, mem, pp))
+        return known
+
+    return kept
 
 
 def _element(index: int) -> int:
