@@ -357,6 +357,32 @@ def test_modules_next_to_the_spec_named_like_earl_or_its_libraries_break_nothing
     assert "EARL-X002" in result.stderr and "`earl` is also the name of a module that earl or Python" in result.stderr
 
 
+def test_a_package_without_init_py_binds_again_in_the_same_process(tmp_path: Path) -> None:
+    # a namespace package (no __init__.py) has no `__file__`: it was taken for one of Python's own modules
+    # the second time the spec's code was bound, and refused as shadowed (EARL-X002)
+    spec = counter_copy(tmp_path)
+    (spec.parent / "counting" / "__init__.py").unlink()
+    system = earl.load(spec)
+    for _ in range(2):
+        simulation = earl.simulate(system)
+        simulation.advance_to(0.05)
+        assert simulation.state_of("counter/a.cs").state == "finished"
+        simulation.close()
+    # and an environment from the same package, imported before the functions are bound
+    (spec.parent / "counting" / "world.py").write_text("def make(system, seed):\n    return None\n")
+    result = earl_cli("run", str(spec.parent), "--duration", "50ms", "--environment", "counting.world:make")
+    assert result.returncode == 0, result.stderr
+    assert "EARL-X002" not in result.stderr
+    # another spec's package of the same name, also without __init__.py, is its own
+    other = counter_copy(tmp_path / "other")
+    (other.parent / "counting" / "__init__.py").unlink()
+    functions = other.parent / "counting" / "cs.py"
+    functions.write_text(functions.read_text() + "\nRAN_FROM_OTHER = True\n")
+    simulation = earl.simulate(earl.load(other))
+    simulation.close()
+    assert getattr(sys.modules["counting.cs"], "RAN_FROM_OTHER", False)
+
+
 def test_a_thread_the_specs_code_leaves_running_does_not_keep_earl_run_alive(tmp_path: Path) -> None:
     spec = counter_copy(tmp_path)
     functions = spec.parent / "counting" / "cs.py"

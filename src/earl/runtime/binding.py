@@ -69,10 +69,10 @@ def _forget_shadowed(directory: Path) -> None:
         top = name.partition(".")[0]
         if top not in importable:
             continue
-        location = getattr(module, "__file__", None)
-        if location is not None and Path(location).resolve().is_relative_to(directory):
+        locations = _locations(module)
+        if any(Path(location).resolve().is_relative_to(directory) for location in locations):
             continue
-        if top in sys.stdlib_module_names or top in sys.builtin_module_names or _installed(location):
+        if top in sys.stdlib_module_names or top in sys.builtin_module_names or _installed(locations):
             # earl itself, a library it uses (msgpack, numpy) or Python's own: forgetting it would break the
             # runtime; the spec's module of that name cannot be imported, which binding it then says
             _SHADOWING[top] = directory
@@ -84,13 +84,27 @@ def _forget_shadowed(directory: Path) -> None:
 _SHADOWING: dict[str, Path] = {}
 
 
-def _installed(location: str | None) -> bool:
-    """Whether a module's file belongs to Python's installation or environment, or to earl itself."""
-    if location is None:
-        return True  # a namespace or built-in module: nothing of a spec's
-    path = Path(location).resolve()
-    roots = {sys.prefix, sys.base_prefix, sys.exec_prefix, str(Path(__file__).resolve().parents[1])}
-    return any(path.is_relative_to(Path(root).resolve()) for root in roots)
+def _locations(module: object) -> list[str]:
+    """Where a module was read from: its file, or the directories of a package without `__init__.py` (a
+    namespace package, whose `__file__` is None: a spec's own package often is one)."""
+    location = getattr(module, "__file__", None)
+    if isinstance(location, str):
+        return [location]
+    try:
+        return [entry for entry in getattr(module, "__path__", []) if isinstance(entry, str)]
+    except Exception:  # a module object of some library's making, with a `__path__` of its own kind
+        return []
+
+
+def _installed(locations: list[str]) -> bool:
+    """Whether a module's files belong to Python's installation or environment, or to earl itself."""
+    if not locations:
+        return True  # a built-in module: nothing of a spec's
+    roots = [
+        Path(root).resolve()
+        for root in {sys.prefix, sys.base_prefix, sys.exec_prefix, str(Path(__file__).resolve().parents[1])}
+    ]
+    return any(Path(location).resolve().is_relative_to(root) for location in locations for root in roots)
 
 
 def resolve_callable(
