@@ -510,6 +510,27 @@ def test_a_buffer_fed_by_another_agent_may_time_out_anywhere_and_the_message_say
     )
 
 
+def test_only_the_member_of_a_family_another_agent_feeds_may_see_its_buffer_go_stale() -> None:
+    """`x[1]/a` is fed from `y/a` and `x[2]/a` by nothing: one analysis would say the overlap of both
+    or of neither; each member is analysed as it is linked."""
+    text = (
+        PROBE.replace("TC", "true")
+        .replace("FIRST", "newData(v/ib) or timeout(v/ib)")
+        .replace("SECOND", "not newData(v/ib)")
+        .replace("x/a {", "x[K in 1..2]/a {")
+    )
+    text = text.replace(
+        "r/r { x/a }",
+        "r/r { x[1]/a x[2]/a }\n\ny/a {\n    cs {\n        period 10 ms\n        out/ob: double\n    }\n}\n\n"
+        "link y,x: y/a.cs.out -> x[1]/a.cs.v\n",
+    )
+    [message] = [d.message for d in check(earl.loads(text, "probe.earl")) if d.code == "EARL-E060"]
+    assert "of x[1]/a.cs can both hold" in message
+    assert message.endswith(
+        "(only while a sending agent in another process is stale: its buffer then reads as timed out in every state)"
+    )
+
+
 @pytest.mark.parametrize(
     ("first", "second"),
     [("v/ib > 3.0", "v/ib <= 3.0"), ("v/ib > 3.0 and v/ib < 1e999", "v/ib <= 3.0 or v/ib == 1e999")],

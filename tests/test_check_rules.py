@@ -1204,6 +1204,95 @@ def test_members_that_name_no_index_are_one_subsystem_to_the_rules() -> None:
     ]
 
 
+WORKERS = """\
+system workers
+
+param N: int = 3
+
+r/r { sup/a }
+
+worker[K in 1..N]/a {
+    cs { period 1 ms
+        i/ib: double
+        x/m: double = 0.0
+        take/pf(i/ib -> x/mo)
+        b/bb {
+            tf = {take/pf}
+            tc = false
+        }
+        fsm {
+            initial one
+            state one: b/bb { obligatory i/ib }
+        }
+    }
+}
+
+sup/a {
+    cs { period 1 ms
+        o/ob: double
+        x/m: double = 0.0
+        send/pf(x/mi -> o/ob)
+        b/bb {
+            tf = {send/pf}
+            tc = false
+        }
+        fsm {
+            initial one
+            state one: b/bb
+        }
+    }
+}
+
+link sup,worker: sup/a.cs.o -> worker[FED]/a.cs.i
+"""
+
+
+@pytest.mark.parametrize(("fed", "unfed"), [(1, "worker[2..3]"), (2, "worker[1, 3]"), (3, "worker[1..2]")])
+def test_members_of_an_agent_family_linked_differently_are_checked_each(fed: int, unfed: str) -> None:
+    """Only one worker is fed: the others wait for ever on `i/ib`, wherever the fed one is in the family
+    (the members were one subsystem to the rules, checked as the first: linking `worker[1]` hid the rest)."""
+    text = WORKERS.replace("FED", str(fed))
+    assert [d.message for d in findings(text, "EARL-E016")] == [
+        f"state `one` of {unfed}/a.cs waits for ever: `i/ib` is obligatory, no link feeds it, and the state has "
+        "no `timeout`"
+    ]
+    assert [d.message for d in findings(text, "EARL-W011")] == [
+        f"`{unfed}/a.cs.i/ib` is fed by no link: it never receives a message"
+    ]
+
+
+def test_members_of_a_subsystem_family_linked_differently_are_checked_each() -> None:
+    text = add(
+        "a4/a {\n    cs {\n        o/ob: double\n    }\n"
+        "    d[K in 1..3]/ve {\n        in/ib: double\n        out/ob: double\n        x/m: double = 0.0\n"
+        "        take/pf(in/ib -> x/mo)\n        b/bb {\n            tf = {take/pf}\n            tc = false\n        }\n"
+        "        fsm {\n            initial one\n            state one: b/bb { obligatory in/ib }\n        }\n    }\n"
+        "    link cs,d: cs.o -> d[1]/ve.in\n}\n"
+    )
+    assert [d.message for d in findings(text, "EARL-E016")] == [
+        "state `one` of a4/a.d[2..3]/ve waits for ever: `in/ib` is obligatory, no link feeds it, and the state "
+        "has no `timeout`"
+    ]
+    assert [d.message for d in findings(text, "EARL-W011")] == [
+        "`a4/a.d[2..3]/ve.in/ib` is fed by no link: it never receives a message"
+    ]
+
+
+def test_members_linked_alike_are_still_one_subsystem_to_the_rules() -> None:
+    """Every worker fed, each by a link of its own: one subsystem to the rules, not one per member."""
+    text = WORKERS.replace("o/ob: double", "o[K in 1..N]/ob: double").replace("-> o/ob)", "-> o[*]/ob)")
+    text = text.replace(
+        "link sup,worker: sup/a.cs.o -> worker[FED]/a.cs.i",
+        "link sup,worker[K in 1..N]: sup/a.cs.o[K] -> worker[K]/a.cs.i",
+    )
+    context = context_for(earl.loads(text, "spec.earl"))
+    distinct = [(agent.name, agent.index) for agent, _ in context.distinct_subsystems()]
+    assert distinct == [("worker", 1), ("sup", None)]
+    groups = [[(agent.name, agent.index) for agent, _ in members] for members in context.distinct_subsystem_groups()]
+    assert groups == [[("worker", 1), ("worker", 2), ("worker", 3)], [("sup", None)]]
+    assert findings(text, "EARL-E016") == []
+
+
 # ---------------------------------------------------------------- EARL-W041 beyond the initial state
 
 

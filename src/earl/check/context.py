@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections import defaultdict
-from collections.abc import Hashable, Iterator
+from collections.abc import Hashable, Iterator, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import TypeVar
@@ -112,6 +112,11 @@ class ResolvedLink:
     between_agents: bool
 
 
+def _link_shape(links: Sequence[ResolvedLink]) -> tuple[int, int]:
+    """How many links reach a buffer, and how many of them come from or go to another agent."""
+    return len(links), sum(link.between_agents for link in links)
+
+
 @dataclass
 class CheckContext:
     declared: System
@@ -186,22 +191,41 @@ class CheckContext:
             values.append(_value_of(name, agent, subsystem))
         return tuple(values)
 
+    def link_key(self, subsystem: Subsystem) -> Hashable:
+        """Equal for two expanded subsystems whose buffers, taken in order, are linked alike: as many links
+        into and out of each, and as many of them between agents. Rules that read links (an obligatory
+        buffer no link feeds waits for ever, EARL-E016; a buffer fed from another agent may go stale) find
+        the same problems in two members exactly when this and `content_key` agree; `worker[1]/a`, fed by
+        another agent, and its unlinked siblings are not one subsystem to them."""
+        return (
+            tuple(_link_shape(self.links_into.get(id(buffer), ())) for buffer in subsystem.input_buffers),
+            tuple(_link_shape(self.links_out_of.get(id(buffer), ())) for buffer in subsystem.output_buffers),
+        )
+
     @cached_property
-    def _distinct(self) -> list[tuple[Agent, Subsystem]]:
-        seen: set[Hashable] = set()
-        result = []
+    def _distinct(self) -> list[list[tuple[Agent, Subsystem]]]:
+        groups: dict[Hashable, list[tuple[Agent, Subsystem]]] = {}
         for agent, subsystem in self.subsystems():
-            key = self.content_key(agent, subsystem)
-            if key not in seen:
-                seen.add(key)
-                result.append((agent, subsystem))
-        return result
+            key = (self.content_key(agent, subsystem), self.link_key(subsystem))
+            groups.setdefault(key, []).append((agent, subsystem))
+        return list(groups.values())
 
     def distinct_subsystems(self) -> Iterator[tuple[Agent, Subsystem]]:
-        """One expanded subsystem per distinct content (see `content_key`), in declaration order.
+        """One expanded subsystem per distinct content and links (`content_key`, `link_key`), in
+        declaration order.
 
-        Ten thousand members of `worker[I]/a` whose control subsystems never name `I` are one
-        subsystem to the rules about predicates, functions, behaviours and the FSM."""
+        Ten thousand members of `worker[I]/a` whose control subsystems never name `I`, and are linked
+        alike, are one subsystem to the rules about predicates, functions, behaviours and the FSM: a
+        problem inside them is fixed once, in the declaration, and said of the first member."""
+        for members in self._distinct:
+            yield members[0]
+
+    def distinct_subsystem_groups(self) -> Iterator[list[tuple[Agent, Subsystem]]]:
+        """The members `distinct_subsystems` stands for, grouped, the one it yields first in each group.
+
+        A rule about links checks the first member and names every member of its group: each member
+        is linked on its own, so each needs the fix, and the check merges their names into one
+        finding with the indices as a range (`worker[2..3]/a.cs`, check/merging.py)."""
         yield from self._distinct
 
     # ------------------------------------------------------------------ links

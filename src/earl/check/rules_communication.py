@@ -174,7 +174,8 @@ def waits_for_nothing_for_ever(context: CheckContext) -> Iterator[Finding]:
     """A state's obligatory Input Buffers are received by waiting until each has a new message, at most
     for the state's `timeout`. An obligatory buffer that no link feeds never gets one: in a state without
     a timeout the subsystem would wait there for ever, silently."""
-    for agent, subsystem in context.distinct_subsystems():
+    for members in context.distinct_subsystem_groups():
+        _, subsystem = members[0]
         if subsystem.fsm is None:
             continue
         fed = {
@@ -189,13 +190,14 @@ def waits_for_nothing_for_ever(context: CheckContext) -> Iterator[Finding]:
                 buffer = context.input_buffer(subsystem, reference)
                 if buffer is None or instance_name(buffer.name, buffer.index) in fed:
                     continue
-                yield Finding(
-                    f"state `{state.name}` of {subsystem_name(agent, subsystem)} waits for ever: "
-                    f"`{instance_name(buffer.name, buffer.index)}/ib` is obligatory, no link feeds it, "
-                    "and the state has no `timeout`",
-                    reference.location or state.location,
-                    "link an Output Buffer to it, give the state's buffer group a `timeout`, or make it optional",
-                )
+                for agent, member in members:  # each member is linked on its own: each is said
+                    yield Finding(
+                        f"state `{state.name}` of {subsystem_name(agent, member)} waits for ever: "
+                        f"`{instance_name(buffer.name, buffer.index)}/ib` is obligatory, no link feeds it, "
+                        "and the state has no `timeout`",
+                        reference.location or state.location,
+                        "link an Output Buffer to it, give the state's buffer group a `timeout`, or make it optional",
+                    )
 
 
 @rule("EARL-E017", Severity.ERROR, "something paces every state of a subsystem", "§2.2, Figure 5")
@@ -224,11 +226,14 @@ def every_state_is_paced(context: CheckContext) -> Iterator[Finding]:
 def unfed_input_buffers(context: CheckContext) -> Iterator[Finding]:
     """An Input Buffer receives messages only over a link (§2.3); one that no link feeds keeps its type's
     zero value for ever, and `newData()` of it is never true."""
-    for agent, subsystem in context.distinct_subsystems():
+    for members in context.distinct_subsystem_groups():
+        _, subsystem = members[0]
         for buffer in subsystem.input_buffers:
-            if not context.links_into.get(id(buffer)):
+            if context.links_into.get(id(buffer)):
+                continue
+            for agent, member in members:  # each member is linked on its own: each is said
                 yield Finding(
-                    f"`{subsystem_name(agent, subsystem)}.{instance_name(buffer.name, buffer.index)}/ib` is fed by "
+                    f"`{subsystem_name(agent, member)}.{instance_name(buffer.name, buffer.index)}/ib` is fed by "
                     "no link: it never receives a message",
                     buffer.location,
                     "link an Output Buffer to it, or remove it",
