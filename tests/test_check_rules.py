@@ -1278,6 +1278,18 @@ def test_members_of_a_subsystem_family_linked_differently_are_checked_each() -> 
     ]
 
 
+def test_every_zombie_member_of_an_agent_family_is_named() -> None:
+    """Only `worker[3]/a` is linked: the other four are zombies, named together (not `worker[1]/a` alone)."""
+    text = WORKERS.replace("param N: int = 3", "param N: int = 5").replace("FED", "3")
+    assert [d.message for d in findings(text, "EARL-W001")] == [
+        "agent `worker[1, 2, 4, 5]/a` is of type C (zombie): no effectors, receptors or inter-agent links"
+    ]
+    linked_first = WORKERS.replace("FED", "1")
+    assert [d.message for d in findings(linked_first, "EARL-W001")] == [
+        "agent `worker[2..3]/a` is of type C (zombie): no effectors, receptors or inter-agent links"
+    ]
+
+
 def test_members_linked_alike_are_still_one_subsystem_to_the_rules() -> None:
     """Every worker fed, each by a link of its own: one subsystem to the rules, not one per member."""
     text = WORKERS.replace("o/ob: double", "o[K in 1..N]/ob: double").replace("-> o/ob)", "-> o[*]/ob)")

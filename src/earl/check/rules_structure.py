@@ -139,11 +139,10 @@ def required_buffers(context: CheckContext) -> Iterator[Finding]:
 def zombie_agent(context: CheckContext) -> Iterator[Finding]:
     """An agent with neither effectors, receptors nor inter-agent links has type C: it can neither act,
     perceive nor communicate (Table 1 calls it a zombie)."""
-    seen: set[int] = set()
+    # every member is said: the zombies of one family are merged into one finding (`worker[1, 2, 4, 5]/a`,
+    # check/merging.py), where keeping only the first would leave the others unnamed
     for agent in context.system.agents:
-        declared = agent.location
-        if context.agent_type(agent).name == "C" and id(declared) not in seen:
-            seen.add(id(declared))
+        if context.agent_type(agent).name == "C":
             yield Finding(
                 f"agent `{instance_name(agent.name, agent.index)}/a` is of type C (zombie): no effectors, receptors or inter-agent links",
                 agent.location,
