@@ -1482,6 +1482,57 @@ def test_a_link_family_named_otherwise_is_said_as_a_family() -> None:
     assert found == ["link `m[K],drive` is not named after its ends; §2.5 suggests `m[K],d`"]
 
 
+TWO_LINKS = edit(
+    ("        out/ob: double\n", "        out/ob: double\n        pose/ob: double\n"),
+    ("emit/pf(x/mi -> out/ob)", "emit/pf(x/mi -> out/ob, pose/ob)"),
+    ("        inp/ib: double\n", "        inp/ib: double\n        pose/ib: double\n"),
+    ("take/pf(inp/ib -> y/mo)", "take/pf(inp/ib, pose/ib -> y/mo)"),
+    (
+        "link a1,a2: a1/a.cs.out -> a2/a.cs.inp\n",
+        "link a1,a2: a1/a.cs.out -> a2/a.cs.inp\nSECOND: a1/a.cs.pose -> a2/a.cs.pose\n",
+    ),
+)
+
+
+@pytest.mark.parametrize("second", ["link a1,a22", "link a1,a2Pose"])
+def test_two_links_between_the_same_agents_can_both_be_named_after_their_ends(second: str) -> None:
+    """`a1,a2` is the first link's (names are unique, EARL-R002): the pair's names with what tells the second
+    apart after the destination's name keeps the good practice of §2.5, and the system checks clean."""
+    text = TWO_LINKS.replace("SECOND", second).replace("    link a1,a2\n", f"    link a1,a2\n    {second}\n")
+    assert findings(text) == []
+
+
+def test_the_second_link_between_two_agents_is_told_a_name_that_is_free() -> None:
+    [finding] = findings(TWO_LINKS.replace("SECOND", "link poses"), "EARL-W010")
+    assert finding.message == (
+        "link `poses` is not named after its ends; §2.5 suggests `a1,a2`, but another link between them has that "
+        "name: name it `a1,a2Pose`"
+    )
+    assert finding.hint is not None and "EARL-R002" in finding.hint
+
+
+def test_a_suffix_after_the_destination_is_no_name_for_a_link_alone_between_its_ends() -> None:
+    alone = edit(("link a1,a2: a1/a.cs.out", "link a1,a22: a1/a.cs.out"), ("    link a1,a2\n", "    link a1,a22\n"))
+    assert [d.message for d in findings(alone, "EARL-W010")] == [
+        "link `a1,a22` is not named after its ends; §2.5 suggests `a1,a2`"
+    ]
+
+
+def test_two_links_inside_an_agent_are_named_alike() -> None:
+    """Inside an agent the ends are subsystems: `v,cs` and `v,cs2` from one virtual receptor into `cs`."""
+    agent = (
+        "a4/a {\n    cs {\n        c/ib: double\n        d/ib: double\n    }\n"
+        "    v/vr {\n        i/ib: double\n        o/ob: double\n        p/ob: double\n    }\n"
+        "    r/rr {\n        o/ob: double\n    }\n"
+        "    link r,v: r/rr.o -> v/vr.i\n    link v,cs: v/vr.o -> cs.c\n    link SECOND: v/vr.p -> cs.d\n}\n"
+    )
+    assert findings(add(agent.replace("SECOND", "v,cs2")), "EARL-W010") == []
+    [finding] = findings(add(agent.replace("SECOND", "data")), "EARL-W010")
+    assert finding.message.endswith(
+        "§2.5 suggests `v,cs`, but another link between them has that name: name it `v,csD`"
+    )
+
+
 def test_a_predicate_s_depth_is_that_of_its_expression_with_each_named_predicate_written_out() -> None:
     """`p = q and x > 0` with `q = x > 1` is `(x > 1) and (x > 0)` written out: 3 levels (the regression
     hunt found the named predicate's level counted twice, refusing chains of 76 that ran before)."""

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections import defaultdict
 from collections.abc import Iterable, Iterator
 from operator import attrgetter
 
@@ -141,27 +142,69 @@ def receptor_chain(context: CheckContext) -> Iterator[Finding]:
 @rule("EARL-W010", Severity.WARNING, "link names join source and destination", "§2.1, §2.5")
 def link_names(context: CheckContext) -> Iterator[Finding]:
     """Good practice (§2.5): a link is named by its source, a comma, and its destination — agent names for
-    inter-agent links (`task,manip`), subsystem names inside an agent."""
+    inter-agent links (`task,manip`), subsystem names inside an agent. Link names are unique (EARL-R002), so
+    of two links between the same ends only one can have that name: the other is named by the pair with what
+    tells it apart after the destination's name (`v,csPose`, `v,cs2`)."""
+    between = _links_between(context.links)
     reported: set[int] = set()
     for link in context.links:
         parts = [part.name for part in link.link.name]
-        if link.between_agents:
-            expected = [link.source_agent.name, link.destination_agent.name]
-        else:
-            expected = [link.source_subsystem.name, link.destination_subsystem.name]
-        if parts != expected and id(link.link.location) not in reported:
-            reported.add(id(link.link.location))
-            name, suggested = link.link.name_text, f"{expected[0]},{expected[1]}"
-            family = link.link.family
-            if family is not None and len(expected) == len(link.link.name):
-                # a member of a link family: said as the family is written, its index kept on the indexed side
-                name = _family_link_name(parts, link.link.name, family.index)
-                suggested = _family_link_name(expected, link.link.name, family.index)
-            yield Finding(
-                f"link `{name}` is not named after its ends; §2.5 suggests `{suggested}`",
-                link.link.location,
-                None,
-            )
+        expected = _ends_names(link)
+        if id(link.link.location) in reported:
+            continue
+        alongside = [other for other in between[_ends(link)] if other.link is not link.link]
+        if parts == expected or (alongside and _tells_apart(parts, expected)):
+            continue
+        reported.add(id(link.link.location))
+        taken = any([part.name for part in other.link.name] == expected for other in alongside)
+        # the pair's name is another link's: the destination buffer, the message's content, tells them apart
+        suggested_names = [expected[0], expected[1] + _capitalised(link.destination_buffer.name)] if taken else expected
+        name, suggested = link.link.name_text, ",".join(suggested_names)
+        family = link.link.family
+        if family is not None and len(expected) == len(link.link.name):
+            # a member of a link family: said as the family is written, its index kept on the indexed side
+            name = _family_link_name(parts, link.link.name, family.index)
+            suggested = _family_link_name(suggested_names, link.link.name, family.index)
+        if not taken:
+            yield Finding(f"link `{name}` is not named after its ends; §2.5 suggests `{suggested}`", link.link.location)
+            continue
+        yield Finding(
+            f"link `{name}` is not named after its ends; §2.5 suggests `{expected[0]},{expected[1]}`, but another "
+            f"link between them has that name: name it `{suggested}`",
+            link.link.location,
+            "of two links between the same ends, name one `source,destination` and the other the same with what "
+            "tells it apart after the destination's name (link names are unique, EARL-R002)",
+        )
+
+
+def _ends_names(link: ResolvedLink) -> list[str]:
+    """The names §2.5 builds a link's name from: its agents' between agents, its subsystems' inside one."""
+    if link.between_agents:
+        return [link.source_agent.name, link.destination_agent.name]
+    return [link.source_subsystem.name, link.destination_subsystem.name]
+
+
+def _ends(link: ResolvedLink) -> tuple[int, int]:
+    """What a link joins, by identity: two agents, or two subsystems of one agent."""
+    if link.between_agents:
+        return id(link.source_agent), id(link.destination_agent)
+    return id(link.source_subsystem), id(link.destination_subsystem)
+
+
+def _links_between(links: list[ResolvedLink]) -> dict[tuple[int, int], list[ResolvedLink]]:
+    between: dict[tuple[int, int], list[ResolvedLink]] = defaultdict(list)
+    for link in links:
+        between[_ends(link)].append(link)
+    return between
+
+
+def _tells_apart(parts: list[str], expected: list[str]) -> bool:
+    """`v,cs2` or `v,csPose` for a link from `v` to `cs`: the pair's names with something after the destination's."""
+    return len(parts) == 2 and parts[0] == expected[0] and parts[1].startswith(expected[1]) and parts[1] != expected[1]
+
+
+def _capitalised(name: str) -> str:
+    return name[:1].upper() + name[1:]
 
 
 def _family_link_name(names: list[str], parts: Iterable[LinkNamePart], index: str) -> str:
