@@ -1444,6 +1444,30 @@ def test_a_constant_index_outside_a_fixed_array_is_refused() -> None:
     assert negative.message == "`v/mi[1 - 2]` reads element -1 of a `double[3]`, whose elements are 0 to 2"
 
 
+def test_a_constant_index_a_quantifier_puts_in_is_checked_for_every_value() -> None:
+    """`all(J in 1..N: v/mi[J] > 0.0)` of a `double[N]`: J = N is one past the last element (they count
+    from 0). The check looked only at the first body of the unrolled quantifier (J = 1)."""
+    text = BASE.replace("system base\n", "system base\n\nparam N: int = 3\n").replace(
+        "        x/m: double = 0.0\n",
+        "        x/m: double = 0.0\n        v/m: double[N] = [1.0, 1.0, 1.0]\n",
+    )
+    text = text.replace(
+        "        go/pp = x/mi > 1.0\n", "        go/pp = x/mi > 1.0 and all(J in 1..N: v/mi[J] > 0.0)\n"
+    )
+    [finding] = findings(text, "EARL-E030")
+    assert finding.message == (
+        "`v/mi[3]` reads element 3 of a `double[3]`, whose elements are 0 to 2 (in the body of `all(J in …: …)`)"
+    )
+    assert finding.location is not None
+    assert (finding.location.line, finding.location.column) == position_of(text, "all(J in", "[J]")
+    # every value of the range out of bounds, inside a quantifier inside another: said once, at its place
+    nested = text.replace("all(J in 1..N: v/mi[J] > 0.0)", "any(I in 1..2: all(J in 1..5: v/mi[J] > 0.0))")
+    assert [d.message for d in findings(nested, "EARL-E030")] == [
+        "`v/mi[3]` reads element 3 of a `double[3]`, whose elements are 0 to 2 (in the body of `all(J in …: …)`)"
+    ]
+    assert findings(text.replace("v/mi[J]", "v/mi[J - 1]"), "EARL-E030") == []
+
+
 def test_a_transition_condition_reading_unwritten_memory_is_reported() -> None:
     text = edit(
         ("        x/m: double = 0.0\n", "        x/m: double = 0.0\n        z/m: double\n"),

@@ -21,6 +21,7 @@ from earl.model.expressions import (
     Not,
     Quantifier,
     Read,
+    children,
     evaluate_constant,
 )
 from earl.model.kinds import Kind
@@ -63,6 +64,8 @@ class ExpressionTyper:
         self.context = context
         self.subsystem = subsystem
         self.problems: list[TypeProblem] = []
+        # an index said out of range once: the unrolled bodies of a quantifier repeat each index's place
+        self._indices_said: set[SourceLocation | None] = set()
 
     def type_of(self, expression: Expression) -> str:
         if isinstance(expression, Literal):
@@ -87,6 +90,8 @@ class ExpressionTyper:
         if isinstance(expression, BooleanOperation):
             quantifier = expression.unrolled
             if quantifier is not None:
+                # each body reads with its own K: an index out of range may be in any of them
+                self._check_indices_in(expression)
                 # `any(K in 1..N: …)` unrolled: every operand is the body for one K; said once, as written
                 self._expect(
                     expression.operands[0],
@@ -165,9 +170,26 @@ class ExpressionTyper:
             return True
         return self.context.same_type(first, second)  # type: ignore[arg-type]
 
-    def _structure(self, read: Read, check_indices: bool = False) -> PrimitiveType | ArrayType | StructType | None:
+    def _check_indices_in(self, expression: Expression) -> None:
+        """A constant index outside a fixed-size array anywhere in `expression`, said with the innermost
+        unrolled quantifier around it: its place alone is that of every body."""
+        stack: list[tuple[Expression, str]] = [(expression, "")]
+        while stack:
+            node, within = stack.pop()
+            quantifier = node.unrolled if isinstance(node, BooleanOperation) else None
+            if quantifier is not None:
+                within = f" (in the body of `{quantifier.quantifier}({quantifier.index} in …: …)`)"
+            if isinstance(node, Read):
+                self._structure(node, check_indices=True, within=within)
+            # the first body first: the first value out of range is the one said
+            stack.extend((child, within) for child in reversed(list(children(node))))
+
+    def _structure(
+        self, read: Read, check_indices: bool = False, within: str = ""
+    ) -> PrimitiveType | ArrayType | StructType | None:
         """The type a read of a buffer or memory yields, aliases followed; None when not known. With
-        `check_indices`, a constant index outside a fixed-size array on the way is a problem."""
+        `check_indices`, a constant index outside a fixed-size array on the way is a problem (`within`
+        says where, when the place alone does not)."""
         target = read.target
         element: InputBuffer | Memory | None
         if target.kind is Kind.INPUT_BUFFER:
@@ -187,7 +209,7 @@ class ExpressionTyper:
                 current = self.context.structural(field.data_type)
             elif not isinstance(accessor, FieldAccess) and isinstance(current, ArrayType):
                 if check_indices:
-                    self._check_index(read, accessor, current)
+                    self._check_index(read, accessor, current, within)
                 current = self.context.structural(current.element)
             else:
                 return None
@@ -208,7 +230,7 @@ class ExpressionTyper:
                 return STRING
         return OTHER
 
-    def _check_index(self, read: Read, accessor: object, array: ArrayType) -> None:
+    def _check_index(self, read: Read, accessor: object, array: ArrayType, within: str = "") -> None:
         """A constant index outside a fixed-size array: `ranges/ib[8]` of a `double[8]` (elements 0 to 7)
         would fail every time the condition is evaluated, and count as false."""
         index = getattr(accessor, "index", None)
@@ -222,12 +244,14 @@ class ExpressionTyper:
         length = size.value
         if isinstance(position, bool) or not isinstance(position, int) or not isinstance(length, int):
             return
-        if not 0 <= position < length:
+        location = getattr(accessor, "location", None) or read.location
+        if not 0 <= position < length and location not in self._indices_said:
+            self._indices_said.add(location)
             self.problems.append(
                 TypeProblem(
                     f"`{expression_text(read)}` reads element {position} of a `{type_text(array)}`, whose elements "
-                    f"are 0 to {length - 1}",
-                    getattr(accessor, "location", None) or read.location,
+                    f"are 0 to {length - 1}{within}",
+                    location,
                 )
             )
 
