@@ -18,6 +18,8 @@ READING_CODES: dict[str, str] = {
     "EARL-S006": "something other than what the grammar expects here",
     "EARL-S007": "a misspelt keyword, or a keyword where it cannot stand",
     "EARL-S008": "a duration without one of the units `s`, `ms`, `us`",
+    "EARL-S009": "a clause said once written twice: `period`, `initial`, `tf`, `tc`, `ec`, a state's `timeout`, "
+    "`fifo`, `overflow`, `when`, `priority`",
     "EARL-S010": "a link family that declares two indices",
     "EARL-S011": "a subsystem with a second `fsm`",
     "EARL-S012": "a duration shorter than 1 ns (or not positive), or longer than 10⁹ s",

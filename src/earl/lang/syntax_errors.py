@@ -162,6 +162,45 @@ def _unexpected_character(error: UnexpectedCharacters, path: str, text: str) -> 
     )
 
 
+#: The clauses a declaration holds once, by keyword: what holds one, and how to mend a second.
+SAID_ONCE: dict[str, tuple[str, str]] = {
+    "period": ("a subsystem runs at one period", "keep one `period`"),
+    "timeout": ("a state waits for its obligatory buffers for one timeout", "keep one `timeout`"),
+    "initial": (
+        "an FSM has one initial state",
+        "keep one `initial`; the other states are declared `state NAME: behaviour/bb`",
+    ),
+    "tf": (
+        "a Basic Behaviour has one transition function",
+        "keep one `tf`, its stages in order: `tf = {first/pf} then {second/pf}`",
+    ),
+    "tc": (
+        "a Basic Behaviour has one terminal condition",
+        "keep one `tc`; when either condition ends the behaviour, join them with `or`",
+    ),
+    "ec": (
+        "a Basic Behaviour has one error condition",
+        "keep one `ec`; when either condition is an error, join them with `or`",
+    ),
+    "fifo": ("an Input Buffer has one capacity", "keep one `fifo CAPACITY`"),
+    "overflow": ("a FIFO has one overflow policy", "keep one `overflow POLICY`"),
+    "priority": ("a transition has one priority", "keep one `priority N`"),
+    "when": ("a transition has one condition", "keep one `when`; join the conditions with `and` or `or`"),
+}
+
+
+def said_twice(keyword: str, where: str, first_line: int, location: SourceLocation) -> Diagnostic:
+    """EARL-S009 at the second of a clause said once; `where` names its holder (" in `cs`"), or is ""."""
+    reason, hint = SAID_ONCE[keyword]
+    return Diagnostic(
+        Severity.ERROR,
+        f"a second `{keyword}`{where} (the first is on line {first_line}): {reason}",
+        location,
+        code="EARL-S009",
+        hint=hint,
+    )
+
+
 class _Context:
     """What the parser had read when it stopped, and what it would have accepted."""
 
@@ -275,6 +314,7 @@ def _unexpected_token(
 
     for special in (
         _stray_closing,
+        _repeated_clause,
         _misplaced_keyword,
         _missing_arrow,
         _end_of_file,
@@ -380,6 +420,92 @@ def _start_line(value: Any) -> int | None:
         return value.line
     if isinstance(value, Tree) and not value.meta.empty:
         return int(value.meta.line)
+    return None
+
+
+#: The rules of the block clauses said once, by the keyword that starts them (their keyword is not kept in the tree).
+_CLAUSE_RULES = {
+    "initial_state": "initial",
+    "transition_function": "tf",
+    "terminal_condition": "tc",
+    "error_condition": "ec",
+}
+
+
+def _repeated_clause(token: Token, context: _Context, location: SourceLocation, path: str) -> Diagnostic | None:
+    """A second `tc`, `initial`, `priority`, …: the grammar takes each once, so the parser stops at it.
+
+    The repeated keyword is the token the parser stopped at (`tc = a  tc = b`), or the name just
+    before it (`initial two`: `initial` read as a state's name). The first one is still on the
+    stack: as its keyword, as the clause it began, or inside the statement just before.
+    """
+    previous = context.previous
+    if str(token) in SAID_ONCE and token.type != "$END":
+        repeated = token
+    elif previous is not None and previous.type == "NAME" and str(previous) in SAID_ONCE:
+        repeated = previous
+    else:
+        return None
+    keyword = str(repeated)
+    block = _innermost_block(context.values)
+    statements = [value for value in block if value is not repeated]
+    first_line: int | None = None
+    for value in statements:
+        if isinstance(value, Token) and value.type != "NAME" and str(value) == keyword:
+            first_line = value.line
+        elif isinstance(value, Tree) and _CLAUSE_RULES.get(str(value.data)) == keyword and not value.meta.empty:
+            first_line = value.meta.line
+        if first_line is not None:
+            break
+    if first_line is None and statements:
+        first_line = _clause_line_in_statement(statements[-1], keyword)
+    if first_line is None:
+        return None
+    return said_twice(keyword, "", first_line, _token_location(path, repeated))
+
+
+def _innermost_block(values: list[Any]) -> list[Any]:
+    """What was read after the innermost `{` still open, the statements of a repetition one by one."""
+    start = 0
+    depth = 0
+    for index in range(len(values) - 1, -1, -1):
+        value = values[index]
+        if isinstance(value, Token) and value.type == "RBRACE":
+            depth += 1
+        elif isinstance(value, Token) and value.type == "LBRACE":
+            if depth == 0:
+                start = index + 1
+                break
+            depth -= 1
+    flat: list[Any] = []
+    for value in values[start:]:
+        # `(a | b)*` is collected in a tree of its own (`__fsm_star_8`) until its block closes
+        if isinstance(value, Tree) and str(value.data).startswith("__"):
+            flat.extend(value.children)
+        else:
+            flat.append(value)
+    return flat
+
+
+def _clause_line_in_statement(statement: Any, keyword: str) -> int | None:
+    """The line of `keyword`'s clause in the statement just read, when it has one."""
+    if not isinstance(statement, Tree):
+        return None
+    children = statement.children
+    if statement.data == "input_buffer":
+        queue = next((c for c in children if isinstance(c, Tree) and c.data == "queue"), None)
+        if queue is None or queue.meta.empty:
+            return None
+        if keyword == "fifo":
+            return int(queue.meta.line)
+        policy = queue.children[1] if len(queue.children) > 1 else None
+        return policy.line if keyword == "overflow" and isinstance(policy, Token) else None
+    if statement.data == "transition" and len(children) >= 3:
+        condition = children[2]
+        if keyword == "when":
+            return _start_line(condition)
+        priority = children[3] if len(children) > 3 else None
+        return priority.line if keyword == "priority" and isinstance(priority, Token) else None
     return None
 
 

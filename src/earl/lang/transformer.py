@@ -17,6 +17,7 @@ from lark import Token
 
 from earl.diagnostics import Diagnostic, Severity
 from earl.lang.reductions import Span
+from earl.lang.syntax_errors import said_twice
 from earl.model.elements import (
     FSM,
     SUBSYSTEM_CLASSES,
@@ -124,6 +125,7 @@ class _BodyItem:
 
     what: str
     value: Any
+    location: SourceLocation | None = None
 
 
 #: What a method gets as `meta`: the span its rule covered, or one token.
@@ -320,8 +322,13 @@ class ElementBuilder:
         return self._fill(subsystem, children[2:])
 
     def _fill(self, subsystem: Subsystem, items: list[Any]) -> Subsystem:
+        period: _BodyItem | None = None
         for item in items:
             if isinstance(item, _BodyItem):
+                # the grammar takes the body's lines in any order and number; a second period would
+                # silently win, and `earl fmt` would drop the first
+                _refuse_second(period, item, f" in `{subsystem.name}`")
+                period = item
                 subsystem.period = item.value
             elif isinstance(item, Parameter):
                 subsystem.parameters.append(item)
@@ -354,7 +361,7 @@ class ElementBuilder:
         return subsystem
 
     def period(self, meta: Meta, children: list[Any]) -> _BodyItem:
-        return _BodyItem("period", children[0])
+        return _BodyItem("period", children[0], self._loc(meta))
 
     def duration(self, meta: Meta, children: list[Token]) -> Duration:
         number = _number(children[0], self.path)
@@ -523,12 +530,15 @@ class ElementBuilder:
                     hint=f"write `state {name}: {behaviour.name}/bb`",
                 )
             )
+        timeout: _BodyItem | None = None
         for item in group[0] if group else []:
             if item.what == "obligatory":
                 state.obligatory.extend(item.value)
             elif item.what == "optional":
                 state.optional.extend(item.value)
             else:
+                _refuse_second(timeout, item, f" in state `{name}`")
+                timeout = item
                 state.timeout = item.value
         return state
 
@@ -542,7 +552,7 @@ class ElementBuilder:
         return _BodyItem("optional", children[0])
 
     def state_timeout(self, meta: Meta, children: list[Any]) -> _BodyItem:
-        return _BodyItem("timeout", children[0])
+        return _BodyItem("timeout", children[0], self._loc(meta))
 
     def transition(self, meta: Meta, children: list[Any]) -> Transition:
         source, destination, condition, *priority = children
@@ -651,6 +661,13 @@ class ElementBuilder:
 
     def list_literal(self, meta: Meta, children: list[Any]) -> Expression:
         return self._expression(ListLiteral(tuple(children), self._loc(meta)), children)
+
+
+def _refuse_second(first: _BodyItem | None, second: _BodyItem, where: str) -> None:
+    """EARL-S009 when `second` repeats a clause said once (`period`, a state's `timeout`)."""
+    if first is None or first.location is None or second.location is None:
+        return
+    raise SpecificationSyntaxError(said_twice(second.what, where, first.location.line, second.location))
 
 
 def _span(first: SourceLocation | None, last: SourceLocation | None) -> SourceLocation | None:
