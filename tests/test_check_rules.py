@@ -704,6 +704,24 @@ CASES: list[Case] = [
         edit(
             (
                 "            state run: run/bb\n            run -> run when got/pp",
+                "            state run: run/bb { obligatory inp/ib, inp/ib }\n            run -> run when got/pp",
+            ),
+        ),
+        34,
+        52,
+        "state `run` of a2/a.cs lists `inp/ib` twice as obligatory",
+        edit(
+            (
+                "            state run: run/bb\n            run -> run when got/pp",
+                "            state run: run/bb { obligatory inp/ib }\n            run -> run when got/pp",
+            ),
+        ),
+    ),
+    Case(
+        "EARL-W022",
+        edit(
+            (
+                "            state run: run/bb\n            run -> run when got/pp",
                 "            state run: run/bb { optional inp/ib  timeout 5 ms }\n            run -> run when got/pp",
             ),
         ),
@@ -921,6 +939,23 @@ def test_every_rule_the_language_enforces_has_a_reading_case() -> None:
     documented = {code for _, how in ENFORCED_BY_THE_LANGUAGE for code in re.findall(r"EARL-[SR]\d{3}", how)}
     tested = {case[1] for case in READING_CASES}
     assert documented - {"EARL-S011"} <= tested  # a second `fsm`: see test_a_second_fsm_is_refused
+
+
+def test_an_unfed_buffer_listed_twice_waits_for_ever_once() -> None:
+    # the repeat is EARL-W022's to say; EARL-E016 tells of the buffer, not of each mention
+    text = edit(
+        ("link a1,a2: a1/a.cs.out -> a2/a.cs.inp\n", ""),
+        ("    link a1,a2\n", ""),
+        (
+            "            state run: run/bb\n            run -> run when got/pp",
+            "            state run: run/bb { obligatory inp/ib, inp/ib }\n            run -> run when got/pp",
+        ),
+    )
+    waits = findings(text, "EARL-E016")
+    assert [(d.location.line, d.location.column) for d in waits if d.location is not None] == [(34, 44)]
+    assert [d.message for d in findings(text, "EARL-W022")] == [
+        "state `run` of a2/a.cs lists `inp/ib` twice as obligatory"
+    ]
 
 
 def test_a_second_fsm_is_refused() -> None:

@@ -229,14 +229,19 @@ def waits_for_nothing_for_ever(context: CheckContext) -> Iterator[Finding]:
         for state in subsystem.fsm.states:
             if state.timeout is not None:
                 continue
+            told: set[str] = set()  # a buffer listed twice waits for ever once (the repeat is EARL-W022)
             for reference in state.obligatory:
                 buffer = context.input_buffer(subsystem, reference)
-                if buffer is None or instance_name(buffer.name, buffer.index) in fed:
+                if buffer is None:
                     continue
+                name = instance_name(buffer.name, buffer.index)
+                if name in fed or name in told:
+                    continue
+                told.add(name)
                 for agent, member in members:  # each member is linked on its own: each is said
                     yield Finding(
                         f"state `{state.name}` of {subsystem_name(agent, member)} waits for ever: "
-                        f"`{instance_name(buffer.name, buffer.index)}/ib` is obligatory, no link feeds it, "
+                        f"`{name}/ib` is obligatory, no link feeds it, "
                         "and the state has no `timeout`",
                         reference.location or state.location,
                         "link an Output Buffer to it, give the state's buffer group a `timeout`, or make it optional",

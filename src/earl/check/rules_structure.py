@@ -152,21 +152,34 @@ def zombie_agent(context: CheckContext) -> Iterator[Finding]:
 
 @rule("EARL-W022", Severity.WARNING, "a state's buffer group says each thing once", "§2.2, Figure 5b")
 def buffer_groups(context: CheckContext) -> Iterator[Finding]:
-    """A state lists an Input Buffer as obligatory (waited for) or as optional (taken when new), not
-    both; its `timeout` bounds the wait for the obligatory buffers, so it needs one to bound."""
+    """A state lists an Input Buffer once: as obligatory (waited for) or as optional (taken when new),
+    not both, and not twice in one list; its `timeout` bounds the wait for the obligatory buffers, so
+    it needs one to bound."""
     for agent, subsystem in context.distinct_subsystems():
         if subsystem.fsm is None:
             continue
         for state in subsystem.fsm.states:
-            obligatory = {reference_text(r) for r in state.obligatory}
-            for reference in state.optional:
-                if reference_text(reference) in obligatory:
-                    yield Finding(
-                        f"state `{state.name}` of {subsystem_name(agent, subsystem)} lists "
-                        f"`{reference_text(reference)}` as obligatory and as optional",
-                        reference.location or state.location,
-                        "name it once: obligatory to wait for it, optional to take it only when it is there",
-                    )
+            listed_as: dict[str, str] = {}  # a buffer's text -> the list that named it first
+            for role, references in (("obligatory", state.obligatory), ("optional", state.optional)):
+                for reference in references:
+                    text = reference_text(reference)
+                    first_role = listed_as.get(text)
+                    if first_role is None:
+                        listed_as[text] = role
+                    elif first_role == role:
+                        # harmless at run time, but a slip: the other buffer meant was likely forgotten
+                        yield Finding(
+                            f"state `{state.name}` of {subsystem_name(agent, subsystem)} lists `{text}` twice as {role}",
+                            reference.location or state.location,
+                            f"name it once; was another buffer meant to be {role}?",
+                        )
+                    else:
+                        yield Finding(
+                            f"state `{state.name}` of {subsystem_name(agent, subsystem)} lists "
+                            f"`{text}` as obligatory and as optional",
+                            reference.location or state.location,
+                            "name it once: obligatory to wait for it, optional to take it only when it is there",
+                        )
             if state.timeout is not None and not state.obligatory:
                 yield Finding(
                     f"state `{state.name}` of {subsystem_name(agent, subsystem)} has a `timeout` but no "
