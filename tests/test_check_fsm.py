@@ -318,6 +318,38 @@ def test_assumptions_that_contradict_each_other_are_an_error_not_a_silence() -> 
     assert codes == ["EARL-E064"]
 
 
+def test_contradicting_assumptions_are_pointed_at_and_innocent_ones_are_not() -> None:
+    # only the two comparisons of `v/ib` contradict each other: the caret and the message are theirs
+    assumptions = (
+        "            assume not s/ib.b or v/ib > 0.0\n"
+        '            assume s/ib.mode == "a"\n'
+        "            assume v/ib > 3.0\n"
+        "            assume v/ib < 2.0\n"
+    )
+    text = PROBE.replace("TC", "go/pp").replace("FIRST", "go/pp").replace("SECOND", "hot/pp")
+    text = text.replace("            run -> b when hot/pp\n", "            run -> b when hot/pp\n" + assumptions)
+    [contradiction] = [d for d in check(earl.loads(text, "probe.earl")) if d.code == "EARL-E064"]
+    assert contradiction.location is not None
+    assert (contradiction.location.line, contradiction.location.column) == (40, 13)
+    assert contradiction.message == (
+        "the `assume` formulas of x/a.cs can never hold: `v/ib > 3.0` (line 40) and `v/ib < 2.0` (line 41) "
+        "cannot hold at once, so they would hide every overlap of its transitions"
+    )
+    assert contradiction.hint == "an assumption states what always holds of the inputs; correct one of these"
+
+
+def test_an_assumption_that_contradicts_itself_is_named_alone() -> None:
+    text = PROBE.replace("TC", "go/pp").replace("FIRST", "go/pp").replace("SECOND", "hot/pp")
+    text = text.replace(
+        "            run -> b when hot/pp\n",
+        "            run -> b when hot/pp\n            assume go/pp\n            assume hot/pp and not hot/pp\n",
+    )
+    [contradiction] = [d for d in check(earl.loads(text, "probe.earl")) if d.code == "EARL-E064"]
+    assert contradiction.location is not None and contradiction.location.line == 39
+    assert "`hot/pp and not hot/pp` (line 39) holds in no situation" in contradiction.message
+    assert contradiction.hint is not None and contradiction.hint.endswith("correct it")
+
+
 FAMILY = """\
 system fam
 

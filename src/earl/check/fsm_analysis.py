@@ -51,7 +51,7 @@ from earl.check.expression_types import BOOLEAN, ExpressionTyper
 from earl.check.registry import Finding, rule
 from earl.check.rules_behaviour import followable_definitions
 from earl.diagnostics import Severity
-from earl.model.elements import FSM, Agent, State, Subsystem, Transition
+from earl.model.elements import FSM, Agent, Assumption, State, Subsystem, Transition
 from earl.model.expressions import (
     Arithmetic,
     BooleanOperation,
@@ -450,6 +450,50 @@ def _constant_order(atom: tuple[str, Constant, Function]) -> tuple[int, Any]:
     return (1, repr(constant))
 
 
+def _contradicting(bdd: Any, formulas: list[Function], meaning: Function) -> list[int]:
+    """Which of the formulas, unsatisfiable together (under `meaning`), contradict each other: each is
+    dropped in turn while the others still cannot hold, so what is left is a set none of which can go
+    (innocent assumptions are never blamed)."""
+    kept = list(range(len(formulas)))
+    for candidate in range(len(formulas)):
+        rest = meaning
+        for index in kept:
+            if index != candidate:
+                rest &= formulas[index]
+        if rest == bdd.false:
+            kept.remove(candidate)
+    return kept
+
+
+#: An assumption quoted in a message is cut to this many characters: its line says where the rest is.
+_QUOTED_ASSUMPTION = 60
+
+
+def _contradiction(owner: str, culprits: list[Assumption]) -> Finding:
+    """EARL-E064 at the first of the assumptions that cannot hold together, naming each of them."""
+
+    def quoted(assumption: Assumption) -> str:
+        text = expression_text(assumption.expression)
+        if len(text) > _QUOTED_ASSUMPTION:
+            text = text[: _QUOTED_ASSUMPTION - 1] + "…"
+        line = assumption.location.line if assumption.location is not None else None
+        return f"`{text}`" + (f" (line {line})" if line is not None else "")
+
+    said = [quoted(assumption) for assumption in culprits]
+    if len(said) == 1:
+        why = f"{said[0]} holds in no situation"
+        hint = "an assumption states what always holds of the inputs; correct it"
+    else:
+        listed = ", ".join(said[:-1]) + " and " + said[-1]
+        why = f"{listed} cannot hold at once"
+        hint = "an assumption states what always holds of the inputs; correct one of these"
+    return Finding(
+        f"the `assume` formulas of {owner} can never hold: {why}, so they would hide every overlap of its transitions",
+        culprits[0].location,
+        hint,
+    )
+
+
 def _when(example: str) -> str:
     return example if example == "whatever the inputs" else f"e.g. when {example}"
 
@@ -472,8 +516,9 @@ def analyse(context: CheckContext, subsystem: Subsystem, fsm: FSM, owner: str) -
         code: [] for code in ("EARL-E064", "EARL-E060", "EARL-W061", "EARL-W062", "EARL-I063", "EARL-W021", "EARL-W020")
     }
     assumed = bdd.true
-    for assumption in fsm.assumptions:
-        assumed &= encoder.encode(assumption.expression)
+    each_assumed = [encoder.encode(assumption.expression) for assumption in fsm.assumptions]
+    for formula in each_assumed:
+        assumed &= formula
     conditions = {id(t): encoder.encode(t.condition.expression) for t in fsm.transitions}
     stops: dict[str, Function] = {}
     for state in fsm.states:
@@ -486,13 +531,8 @@ def analyse(context: CheckContext, subsystem: Subsystem, fsm: FSM, owner: str) -
     encoder.order_variables()
     meaning = encoder.constraints()
     if fsm.assumptions and (assumed & meaning) == bdd.false:
-        findings["EARL-E064"].append(
-            Finding(
-                f"the `assume` formulas of {owner} can never hold, so they would hide every overlap of its transitions",
-                fsm.assumptions[0].location,
-                "an assumption states what always holds of the inputs; correct the one that contradicts the others",
-            )
-        )
+        culprits = [fsm.assumptions[i] for i in _contradicting(bdd, each_assumed, meaning)]
+        findings["EARL-E064"].append(_contradiction(owner, culprits))
         return Analysis(findings)
     assumed &= meaning
     fed_by_other_agents = _fed_by_other_agents(context, subsystem)
@@ -805,7 +845,9 @@ _register(
     "§2.2, Table 5",
     "An `assume` formula states what always holds of a subsystem's inputs, and the FSM analysis considers "
     "only situations in which every assumption holds. Assumptions that contradict each other leave no "
-    "situation at all: every overlap and every missing transition would pass unseen.",
+    "situation at all: every overlap and every missing transition would pass unseen. The error points at "
+    "the assumptions that cannot hold at once, none of which can be left out of the contradiction (the "
+    "others, innocent, are not named).",
 )
 _register(
     "EARL-W061",
