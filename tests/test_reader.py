@@ -23,6 +23,9 @@ from earl.diagnostics import SourceMap
 from earl.lang import parser as reader
 from earl.lang.driver import Driver, NotWellFormed
 from earl.lang.transformer import ParsedFile
+from earl.model.expand import expand
+from earl.model.expressions import Star
+from earl.model.text import reference_text
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "benchmarks"))
@@ -284,3 +287,39 @@ a/a {
         earl.loads(text, "r.earl")
     (problem,) = [d for d in refused.value.diagnostics if d.code == "EARL-R054"]
     assert problem.hint == "`eyes` is an Output Buffer there; a link runs from an Output Buffer to an Input Buffer"
+
+
+_ROBOT_OF_WORKERS = """\
+system crew
+
+param N: int = 3
+
+r1/r {
+    MEMBERS
+}
+
+worker[K in 1..N]/a {
+    cs {
+        period 1 ms
+    }
+}
+"""
+
+
+def test_a_robot_without_the_member_of_a_family_is_told_to_write_one_or_all() -> None:
+    with pytest.raises(earl.EarlError) as refused:
+        earl.loads(_ROBOT_OF_WORKERS.replace("MEMBERS", "worker/a"), "crew.earl")
+    (problem,) = refused.value.diagnostics
+    assert (problem.code, problem.location.line if problem.location else None) == ("EARL-R024", 6)
+    assert problem.hint == "write `worker[1]/a`, or `worker[*]/a` for every member"
+
+
+def test_a_robot_holds_every_member_of_an_agent_family_with_star() -> None:
+    # what the hint of EARL-R024 says is read: the model, the resolver and the expansion already took it
+    system = earl.loads(_ROBOT_OF_WORKERS.replace("MEMBERS", "worker[*]/a"), "crew.earl")
+    (robot,) = system.robots
+    (reference,) = robot.agents
+    assert isinstance(reference.indices[0], Star)
+    assert "    worker[*]/a\n" in system.to_earl()
+    members = [reference_text(member) for member in expand(system).robots[0].agents]
+    assert members == ["worker[1]/a", "worker[2]/a", "worker[3]/a"]

@@ -231,7 +231,12 @@ class ElementBuilder:
         return robot
 
     def robot_agent(self, meta: Meta, children: list[Any]) -> ElementReference:
-        return ElementReference(str(children[0]), Kind.AGENT, tuple(children[1:-1]), self._loc(meta))
+        indices = tuple(self._star_or(index) for index in children[1:-1])
+        return ElementReference(str(children[0]), Kind.AGENT, indices, self._loc(meta))
+
+    def _star_or(self, index: Any) -> Any:
+        """`[*]` as the model's Star, any other index as the expression it is."""
+        return Star(self._loc(index)) if isinstance(index, Token) and index.type == "STAR" else index
 
     def robot_link(self, meta: Meta, children: list[Any]) -> ElementReference:
         parts, _family = children[0]
@@ -576,7 +581,7 @@ class ElementBuilder:
     # ------------------------------------------------------------------ expressions
     def element_ref(self, meta: Meta, children: list[Any]) -> ElementReference:
         name, *indices, kind = children
-        converted = tuple(Star(self._loc(i)) if isinstance(i, Token) and i.type == "STAR" else i for i in indices)
+        converted = tuple(self._star_or(index) for index in indices)
         return ElementReference(str(name), _kind(str(kind)), converted, self._loc(meta))
 
     def _expression(self, node: Expression, children: list[Any]) -> Expression:
