@@ -328,6 +328,44 @@ def test_importing_a_missing_file_points_at_the_import(tmp_path: Path) -> None:
 
 
 @pytest.mark.parametrize(
+    ("holds", "hint"),
+    [
+        # a `system.earl` starts a specification: a directory stands for it only as a command's SPEC
+        (
+            {"system.earl": "system t\n"},
+            "an import names a file, not a directory; `sub/system.earl` starts a specification of its own "
+            "and cannot be imported: move what both need into a file without a `system` line",
+        ),
+        (
+            {"system.earl": "system t\n", "types.earl": "param P: int = 1\n"},
+            'an import names a file, not a directory: e.g. `import "sub/types.earl"`',
+        ),
+        ({}, "an import names an `.earl` file, not a directory"),
+    ],
+)
+def test_importing_a_directory_points_at_the_import_and_names_a_file_to_import(
+    holds: dict[str, str], hint: str, tmp_path: Path
+) -> None:
+    (tmp_path / "sub").mkdir()
+    for name, text in holds.items():
+        (tmp_path / "sub" / name).write_text(text)
+    (tmp_path / "system.earl").write_text('system s\n\nimport "sub/"\n')
+    [error] = _errors(tmp_path / "system.earl")
+    assert error.code == "EARL-S030"
+    assert error.message.endswith("sub is a directory, not an `.earl` file")
+    assert error.location is not None and (error.location.line, error.location.column) == (3, 1)
+    assert error.hint == hint
+
+
+def test_a_directory_given_as_the_specification_stands_for_its_system_earl_or_is_refused(tmp_path: Path) -> None:
+    [error] = _errors(tmp_path)
+    assert error.code == "EARL-S030"
+    assert error.hint == "name the specification file, or a directory holding `system.earl`"
+    (tmp_path / "system.earl").write_text("system s\n")
+    assert earl.load(tmp_path).name == "s"
+
+
+@pytest.mark.parametrize(
     ("family", "code", "fragment"),
     [
         ("K in 1..-5", "EARL-R016", "the family range 1..-5 is empty"),

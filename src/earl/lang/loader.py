@@ -53,12 +53,19 @@ def _opened(path: Path) -> BinaryIO:
     return os.fdopen(descriptor, "rb")
 
 
-def read_file(path: Path, sources: SourceMap, location: SourceLocation | None = None) -> ParsedFile:
-    return _read_file(path, sources, location)[0]
+def read_file(
+    path: Path, sources: SourceMap, location: SourceLocation | None = None, imported_as: str | None = None
+) -> ParsedFile:
+    return _read_file(path, sources, location, imported_as)[0]
 
 
-def _read_file(path: Path, sources: SourceMap, location: SourceLocation | None = None) -> tuple[ParsedFile, bytes]:
-    """The file parsed, and its bytes as read (once: a named pipe cannot be read twice)."""
+def _read_file(
+    path: Path, sources: SourceMap, location: SourceLocation | None = None, imported_as: str | None = None
+) -> tuple[ParsedFile, bytes]:
+    """The file parsed, and its bytes as read (once: a named pipe cannot be read twice).
+
+    `location` and `imported_as` are those of the `import` that names the file, for a file imported.
+    """
     shown = _display_path(path)
     try:
         with _opened(path) as file:
@@ -79,7 +86,9 @@ def _read_file(path: Path, sources: SourceMap, location: SourceLocation | None =
                     f"{shown} is a directory, not an `.earl` file",
                     location,
                     code="EARL-S030",
-                    hint="name the specification file, or a directory holding `system.earl`",
+                    hint="name the specification file, or a directory holding `system.earl`"
+                    if imported_as is None
+                    else _directory_import_hint(path, imported_as),
                 )
             ],
             sources,
@@ -95,6 +104,26 @@ def _read_file(path: Path, sources: SourceMap, location: SourceLocation | None =
         error.sources = sources
         raise
     return parse_text(text, shown, sources), data
+
+
+def _directory_import_hint(directory: Path, imported_as: str) -> str:
+    """What to import instead of a directory: one of its files. A directory stands for its `system.earl`
+    only as the specification a command is given; that file starts with `system`, so it is never imported
+    (EARL-S032)."""
+    try:
+        names = sorted(entry.name for entry in directory.glob("*.earl") if entry.is_file())
+    except OSError:
+        names = []
+    importable = [name for name in names if name != "system.earl"]
+    inside = imported_as.rstrip("/")
+    if importable:
+        return f'an import names a file, not a directory: e.g. `import "{inside}/{importable[0]}"`'
+    if names:
+        return (
+            f"an import names a file, not a directory; `{inside}/system.earl` starts a specification of its own "
+            "and cannot be imported: move what both need into a file without a `system` line"
+        )
+    return "an import names an `.earl` file, not a directory"
 
 
 def locate_spec(path: Path) -> Path:
@@ -131,7 +160,7 @@ def load_files(path: Path, sources: SourceMap) -> tuple[ParsedFile, list[ParsedF
                 )
             if target in seen:
                 continue
-            child = read_file(target, sources, declaration.location)
+            child = read_file(target, sources, declaration.location, declaration.path)
             if child.system_name is not None:
                 raise EarlError(
                     [
