@@ -1047,3 +1047,124 @@ def test_the_closing_table_written_to_a_pipe_is_not_cut_to_80_columns() -> None:
     rows = [line for line in result.stdout.splitlines() if "counter/a.relay/ve" in line]
     assert len(rows) == 1 and re.search(r"\d+ µs / \d+ µs", rows[0]), result.stdout
     assert any("start lateness p50 / p99" in line for line in result.stdout.splitlines())
+
+
+OPTIONAL_SENDER = """\
+system optionals
+
+struct Reading {
+    level: double
+    note: string?
+    spare: double?
+}
+
+a/a {
+    cs {
+        period 10 ms
+        r/ob: Reading
+        t/m: double = 0.0
+        false/pp = false
+        tick/pf(t/mi -> t/mo) = python "readings:tick"
+        emit/pf(t/mi -> r/ob) = python "readings:emit"
+        run/bb {
+            tf = {tick/pf} then {emit/pf}
+            tc = false/pp
+        }
+        fsm {
+            initial run
+            state run: run/bb
+        }
+    }
+}
+
+b/a {
+    cs {
+        period 10 ms
+        r/ib: Reading
+        x/m: double = 0.0
+        false/pp = false
+        take/pf(r/ib -> x/mo) = python "readings:take"
+        run/bb {
+            tf = {take/pf}
+            tc = false/pp
+        }
+        fsm {
+            initial run
+            state run: run/bb
+        }
+    }
+}
+
+link a,b: a/a.cs.r -> b/a.cs.r
+
+r/r {
+    a/a
+    b/a
+    link a,b
+}
+"""
+
+#: `level` is infinite every other message (a gap in its line), `note` is always text, `spare` never sent
+READINGS = """\
+def tick(inputs, outputs, context):
+    outputs.t = inputs.t + 1.0
+
+
+def emit(inputs, outputs, context):
+    level = float("inf") if inputs.t % 2 else inputs.t
+    outputs.r = {"level": level, "note": "reading", "spare": None}
+
+
+def take(inputs, outputs, context):
+    outputs.x = 1.0
+"""
+
+
+def optional_sender(tmp_path: Path) -> Path:
+    (tmp_path / "system.earl").write_text(OPTIONAL_SENDER)
+    (tmp_path / "readings.py").write_text(READINGS)
+    return tmp_path
+
+
+def test_an_optional_field_never_sent_has_no_value_and_an_infinite_real_is_a_gap(tmp_path: Path) -> None:
+    """JSON writes an absent optional field and an infinite real both as null: the first is a signal
+    without a value, left out of the plot; the second a gap in a signal that has values."""
+    spec = optional_sender(tmp_path)
+    alone = earl_cli(
+        "run", str(spec), "--duration", "50ms", "--plot", str(tmp_path / "a.png"), "--signal", "a/a.cs.r.spare"
+    )
+    said = " ".join((alone.stdout + alone.stderr).split())
+    assert alone.returncode == 1, said
+    assert "no plot: no signal has a value" in said and "`a/a.cs.r.spare` had no value in this run" in said
+    assert not (tmp_path / "a.png").exists()
+    trace = tmp_path / "a.mcap"
+    again = earl_cli("plot", str(trace), "--signal", "a/a.cs.r.spare", "-o", str(tmp_path / "b.png"))
+    assert again.returncode == 1 and "`a/a.cs.r.spare` had no value in this run" in again.stderr, again.stderr
+    both = earl_cli(
+        "plot", str(trace), "--signal", "a/a.cs.r.spare", "--signal", "a/a.cs.r.level", "-o", str(tmp_path / "c.png")
+    )
+    assert both.returncode == 0, both.stderr
+    assert "`a/a.cs.r.spare` had no value in this run (an optional field never sent); drawn without it" in both.stderr
+    assert "level" not in both.stderr
+    infinite = earl_cli("plot", str(trace), "--signal", "a/a.cs.r.level", "-o", str(tmp_path / "d.png"))
+    assert infinite.returncode == 0 and infinite.stderr == "", infinite.stderr
+
+
+def test_a_signal_that_is_no_number_is_refused_before_the_run_and_by_earl_plot(tmp_path: Path) -> None:
+    spec = optional_sender(tmp_path)
+    png = tmp_path / "p.png"
+    for signal_name, fragment in [
+        ("a/a.cs.r.note", "`r.note` is a string, not a number"),
+        ("a/a.cs.r", "`r` is a struct (Reading), not a number; name a field of it: `r.level`"),
+    ]:
+        started = time.monotonic()
+        refused = earl_cli("run", str(spec), "--duration", "1000s", "--plot", str(png), "--signal", signal_name)
+        assert refused.returncode == 2 and fragment in refused.stderr, refused.stderr
+        assert time.monotonic() - started < 30  # before the run
+    trace = tmp_path / "t.mcap"
+    assert earl_cli("run", str(spec), "--duration", "50ms", "--trace", str(trace)).returncode == 0
+    text = earl_cli("plot", str(trace), "--signal", "a/a.cs.r.note", "-o", str(png))
+    assert text.returncode == 1 and "`a/a.cs.r.note` is not a number" in text.stderr, text.stderr
+    whole = earl_cli("plot", str(trace), "--signal", "a/a.cs.r", "-o", str(png))
+    assert whole.returncode == 1 and "`a/a.cs.r` is not a number but has parts" in whole.stderr, whole.stderr
+    assert "`a/a.cs.r.level`" in whole.stderr

@@ -370,16 +370,28 @@ def test_an_array_of_reals_the_specs_code_makes_from_the_runtimes_own_class_is_c
             Reals(wrong)
 
 
-def test_a_null_leaf_of_a_trace_is_a_gap_in_a_plot_not_a_missing_signal() -> None:
-    """JSON writes an infinite real as null; the plot shows a gap there instead of saying the signal is not
-    in the trace."""
-    import math
-
+def test_a_null_leaf_of_a_trace_is_a_leaf_the_reader_tells_apart_by_the_schema() -> None:
+    """JSON writes an infinite real and an absent optional field as null: both are leaves (a gap in a
+    plot, not a signal that seems never recorded), and the channel's schema says which one it is. A
+    memory family's member is one property (`log[2]`)."""
+    from earl.runtime.trace_reader import _null_is_absent
     from earl.runtime.values import iter_leaves
 
-    leaves = list(iter_leaves({"position": [1.0, None], "stop": False}))
-    assert [name for name, _ in leaves] == ["position[0]", "position[1]", "stop"]
-    assert leaves[0][1] == 1.0 and math.isnan(leaves[1][1]) and leaves[2][1] is False
+    leaves = list(iter_leaves({"position": [1.0, None], "stop": False, "note": "text"}))
+    assert leaves == [("position[0]", 1.0), ("position[1]", None), ("stop", False), ("note", "text")]
+    reals = {"type": "array", "items": {"type": "number"}}
+    schema = {
+        "type": "object",
+        "properties": {
+            "position": reals,
+            "log[2]": {"type": "number"},
+            "spare": {"anyOf": [{"type": "number"}, {"type": "null"}]},
+            "pose": {"anyOf": [{"type": "object", "properties": {"x": {"type": "number"}}}, {"type": "null"}]},
+        },
+    }
+    assert not _null_is_absent(schema, "position[1]") and not _null_is_absent(schema, "log[2]")
+    assert not _null_is_absent(schema, "pose.x")
+    assert _null_is_absent(schema, "spare") and _null_is_absent(schema, "pose") and _null_is_absent(None, "x")
 
 
 def test_an_output_buffer_read_as_an_attribute_before_it_is_written_is_told_to_keep_a_variable(

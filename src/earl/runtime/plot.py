@@ -9,7 +9,7 @@ from earl.diagnostics import did_you_mean
 from earl.model.elements import Memory, OutputBuffer, Subsystem, System
 from earl.model.expressions import Literal
 from earl.model.text import subsystem_name
-from earl.model.types import ArrayType, StructType
+from earl.model.types import ArrayType, PrimitiveType, StructType
 from earl.runtime.trace_reader import CUT, read_signals, signal_element
 
 #: the kinds of file a plot is written as, by the suffix (what Matplotlib's Agg backend writes)
@@ -43,6 +43,15 @@ def what_to_record(expanded: System, signals: list[str]) -> tuple[list[str], lis
     sending: list[str] = []
     for signal in signals:
         owner = next((name for name in longest_first if signal.startswith(name + ".")), None)
+        if owner is None and signal in subsystems:
+            # the subsystem alone: what did-you-mean would suggest is the signal itself
+            # memory first: an output buffer is often a struct, itself no signal
+            named = [
+                *sorted({m.name for m in subsystems[signal].memories}),
+                *sorted({o.name for o in subsystems[signal].output_buffers}),
+            ]
+            example = f", e.g. `{signal}.{named[0]}`" if named else ""
+            raise ValueError(f"`{signal}` names a subsystem: a signal goes on to its memory or output buffer{example}")
         if owner is None:
             family = re.match(r"(.+?)\[(\*|[A-Za-z_]\w*)\](/[a-z]+)\.(.+)", signal)
             if family is not None:
@@ -104,28 +113,52 @@ def _path_problem(expanded: System, subsystem: Subsystem, element: str, path: st
     steps = [(match.group(1), match.group(2)) for match in _STEP.finditer(path)]
     if "".join(match.group(0) for match in _STEP.finditer(path)) != path:
         return f"`{path}` is not a path of `[index]` and `.field` steps"
+    # what the signal names so far (`ball.spin`), so that a problem names the part that has it
+    named = element
     members = [d.index for d in declared if d.index is not None]
     if members and steps:  # the first brackets choose a member of the family
         index, _ = steps.pop(0)
         if index is None or (index != "*" and int(index) not in members):
             return f"`{element}` has members {min(members)}..{max(members)}"
+        named += f"[{index}]"
+    elif members:
+        return (
+            f"`{element}` is a family of memories, not a number; name a member, `{element}[{min(members)}]`, "
+            f"or every one, `{element}[*]`"
+        )
     types = TypeSystem(expanded)
     try:
         current: object = types.resolve(declared[0].data_type)
         for index, field in steps:
             if field is not None:
                 if not isinstance(current, StructType) or current.field_named(field) is None:
-                    return f"`{element}` has no field `{field}` where the signal names it"
+                    return f"`{named}` has no field `{field}` where the signal names it"
                 current = types.resolve(current.field_named(field).data_type)  # type: ignore[union-attr]
+                named += f".{field}"
             else:
                 if not isinstance(current, ArrayType):
-                    return f"`{element}` is not an array where the signal indexes it"
+                    return f"`{named}` is not an array where the signal indexes it"
                 size = current.size.value if isinstance(current.size, Literal) else None
                 if index != "*" and isinstance(size, int) and int(index) >= size:
-                    return f"`{element}` has elements 0 to {size - 1} where the signal indexes it, not {index}"
+                    return f"`{named}` has elements 0 to {size - 1} where the signal indexes it, not {index}"
                 current = types.resolve(current.element)
+                named += f"[{index}]"
     except ValueTypeError:
         return None  # a type the checker reports; the plot says what it finds
+    return _not_a_number(named, current)
+
+
+def _not_a_number(named: str, resolved: object) -> str | None:
+    """Why what a signal names cannot be drawn, or None: a plot draws numbers and Booleans."""
+    if isinstance(resolved, StructType):
+        fields = ", ".join(f"`{named}.{f.name}`" for f in resolved.fields[:4]) + (
+            " …" if len(resolved.fields) > 4 else ""
+        )
+        return f"`{named}` is a struct ({resolved.name}), not a number; name a field of it: {fields}"
+    if isinstance(resolved, ArrayType):
+        return f"`{named}` is an array, not a number; name an element, `{named}[0]`, or every one, `{named}[*]`"
+    if isinstance(resolved, PrimitiveType) and resolved.name in ("string", "bytes"):
+        return f"`{named}` is a {resolved.name}, not a number; a plot draws numbers and Booleans"
     return None
 
 

@@ -9,6 +9,7 @@ A *signal* is named as a person names the thing it measures:
 from __future__ import annotations
 
 import json
+import math
 import re
 from collections.abc import Iterator
 from dataclasses import dataclass, field
@@ -17,7 +18,7 @@ from typing import Any
 
 from mcap.exceptions import EndOfFile, McapError
 from mcap.reader import make_reader
-from mcap.records import Channel, Message
+from mcap.records import Channel, Message, Schema
 from mcap.stream_reader import StreamReader
 
 from earl.runtime.values import iter_leaves
@@ -90,9 +91,12 @@ def _messages(
         raise _nothing_readable(path, failure) from None
 
 
-def _records_up_to_the_cut(path: Path) -> Iterator[tuple[Channel, Message | None]]:
+def _records_up_to_the_cut(
+    path: Path, schemas: dict[int, Schema] | None = None
+) -> Iterator[tuple[Channel, Message | None]]:
     """Each channel as it is declared (with None) and each message with its channel, in file order,
-    until the file ends or its first damaged record (a chunk cut in half)."""
+    until the file ends or its first damaged record (a chunk cut in half). `schemas` gets each schema
+    by its number as it is declared (before the channels that use it)."""
     channels: dict[int, Channel] = {}
     with open(path, "rb") as stream:
         records = StreamReader(stream).records
@@ -101,7 +105,9 @@ def _records_up_to_the_cut(path: Path) -> Iterator[tuple[Channel, Message | None
                 record = next(records)
             except Exception:  # the cut: an end of file inside a record, a chunk that does not decompress
                 return
-            if isinstance(record, Channel):
+            if isinstance(record, Schema) and schemas is not None:
+                schemas[record.id] = record
+            elif isinstance(record, Channel):
                 channels[record.id] = record
                 yield record, None
             elif isinstance(record, Message) and record.channel_id in channels:
@@ -212,6 +218,12 @@ class _Summariser:
 
 
 def topics(path: Path) -> dict[str, dict[str, str]]:
+    """Each topic of the trace with its channel's metadata."""
+    return {topic: metadata for topic, (metadata, _) in _channels(path).items()}
+
+
+def _channels(path: Path) -> dict[str, tuple[dict[str, str], Any]]:
+    """Each topic of the trace with its channel's metadata and its JSON schema (None if it has none)."""
     failure: Exception | None = None
     try:
         with open(path, "rb") as stream:
@@ -221,14 +233,74 @@ def topics(path: Path) -> dict[str, dict[str, str]]:
     except Exception as error:  # as in `_messages`
         summary, failure = None, error
     if summary is not None:
-        return {channel.topic: dict(channel.metadata) for channel in summary.channels.values()}
-    # a trace cut short has no summary: its channels are declared before their first message
+        return {
+            channel.topic: (dict(channel.metadata), _schema_of(summary.schemas.get(channel.schema_id)))
+            for channel in summary.channels.values()
+        }
+    # a trace cut short has no summary: its schemas and channels are declared before their first message
+    schemas: dict[int, Schema] = {}
     found = {
-        channel.topic: dict(channel.metadata) for channel, message in _records_up_to_the_cut(path) if message is None
+        channel.topic: (dict(channel.metadata), _schema_of(schemas.get(channel.schema_id)))
+        for channel, message in _records_up_to_the_cut(path, schemas)
+        if message is None
     }
     if not found and failure is not None:
         raise _nothing_readable(path, failure) from None
     return found
+
+
+def _schema_of(schema: Schema | None) -> Any:
+    """A channel's JSON schema as data; None when it has none, or not one in JSON."""
+    if schema is None or schema.encoding != "jsonschema":
+        return None
+    try:
+        return json.loads(schema.data)
+    except ValueError:  # a damaged schema: its messages are read all the same
+        return None
+
+
+def _null_is_absent(schema: Any, leaf: str) -> bool:
+    """Whether a null at `leaf` of a message (`ball.note`, `log[2]`, `value[0]`) is an optional field
+    that was absent, rather than an infinite real: JSON writes both as null, and only the channel's
+    schema tells them apart. A null that the schema does not show to be a real (no schema, or an
+    optional real, whose absence is the likelier) counts as absent."""
+    current = schema
+    rest = leaf
+    while rest:
+        current = _present_branch(current)
+        if not isinstance(current, dict):
+            return True
+        properties = current.get("properties")
+        if isinstance(properties, dict):
+            # a memory family's member is one property, `log[2]`: the longest name that starts `rest`
+            name = max(
+                (key for key in properties if rest == key or rest.startswith((f"{key}.", f"{key}["))),
+                key=len,
+                default=None,
+            )
+            if name is None:
+                return True
+            current, rest = properties[name], rest[len(name) :].removeprefix(".")
+        else:
+            index = re.match(r"\[\d+\]", rest)
+            if index is None:
+                return True
+            current, rest = current.get("items"), rest[index.end() :].removeprefix(".")
+    if not isinstance(current, dict):
+        return True
+    options = current.get("anyOf", [])
+    if any(isinstance(option, dict) and option.get("type") == "null" for option in options):
+        return True
+    return bool(current.get("type") != "number")
+
+
+def _present_branch(schema: Any) -> Any:
+    """The schema of an optional field's value when present (`anyOf: [T, null]` gives T)."""
+    if isinstance(schema, dict) and isinstance(schema.get("anyOf"), list):
+        present = [option for option in schema["anyOf"] if isinstance(option, dict) and option.get("type") != "null"]
+        if len(present) == 1:
+            return present[0]
+    return schema
 
 
 @dataclass
@@ -260,7 +332,8 @@ def read_signals(path: Path, names: list[str]) -> Signals:
 
     The file is read once, whatever the number of signals: a trace of a long run is large.
     """
-    available = topics(path)
+    channels = _channels(path)
+    available = {topic: metadata for topic, (metadata, _) in channels.items()}
     subsystems = sorted({t[: -len("/fsm")] for t in available if t.endswith("/fsm")}, key=len, reverse=True)
     wanted: dict[str, tuple[str, str]] = {}  # topic -> (subsystem, prefix of its leaves)
     owners: list[tuple[str, str, str]] = []  # (name, subsystem, name inside the subsystem)
@@ -285,6 +358,12 @@ def read_signals(path: Path, names: list[str]) -> Signals:
                     wanted.setdefault(topic, (subsystem, buffer))
         wanted[f"{subsystem}/fsm"] = (subsystem, "")
     leaves: dict[tuple[str, str], tuple[list[float], list[float]]] = {}
+    #: the leaves that had a value at least once: a number, a Boolean, or an infinite real (null)
+    valued: set[tuple[str, str]] = set()
+    #: the leaves that held text: no number, which the plot says instead of "no value"
+    texts: set[tuple[str, str]] = set()
+    #: (topic, leaf) -> whether a null there is an absent optional field (else an infinite real)
+    absent_when_null: dict[tuple[str, str], bool] = {}
     stays: dict[str, list[tuple[float, str]]] = {}
     end = 0.0
     cut: list[bool] = []
@@ -298,18 +377,34 @@ def read_signals(path: Path, names: list[str]) -> Signals:
             if topic.endswith("/fsm"):
                 stays.setdefault(subsystem, []).append((seconds, str(data["to"])))
                 continue
-            for leaf, value in iter_leaves(data):
+            for raw, value in iter_leaves(data):
+                leaf = raw
                 if buffer:
                     # a message that is not a struct is recorded as `{"value": …}`: `raw[0]`, not `raw.value[0]`
                     if leaf == "value" or leaf.startswith("value["):
                         leaf = buffer + leaf[len("value") :]
                     else:
                         leaf = f"{buffer}.{leaf}"
-                found = leaves.get((subsystem, leaf))
+                key = (subsystem, leaf)
+                if isinstance(value, str):
+                    texts.add(key)
+                    continue
+                if value is None:
+                    absent = absent_when_null.get((topic, raw))
+                    if absent is None:
+                        absent = absent_when_null[(topic, raw)] = _null_is_absent(channels[topic][1], raw)
+                    # either way a gap in the line: an absent field has no value to hold until the next
+                    number = math.nan
+                    if not absent:
+                        valued.add(key)
+                else:
+                    number = float(value)
+                    valued.add(key)
+                found = leaves.get(key)
                 if found is None:
-                    found = leaves[(subsystem, leaf)] = ([], [])
+                    found = leaves[key] = ([], [])
                 found[0].append(seconds)
-                found[1].append(float(value))
+                found[1].append(number)
         except (KeyError, TypeError, ValueError, AttributeError):
             raise _not_from_earl(path, topic) from None
     series: list[Series] = []
@@ -317,12 +412,27 @@ def read_signals(path: Path, names: list[str]) -> Signals:
     leaf_hints: list[str] = []
     for name, subsystem, inner in owners:
         pattern = re.compile(re.escape(inner).replace(r"\[\*\]", r"\[\d+\]") + "$")
+        named = [key for key in leaves if key[0] == subsystem and pattern.match(key[1])]
         matched = [
-            Series(subsystem, leaf, times, values)
-            for (owner, leaf), (times, values) in leaves.items()
-            if owner == subsystem and pattern.match(leaf)
+            Series(subsystem, leaf, *leaves[(subsystem, leaf)]) for _, leaf in named if (subsystem, leaf) in valued
         ]
         if not matched:
+            if any(owner == subsystem and pattern.match(leaf) for owner, leaf in texts):
+                raise TraceError(
+                    f"`{name}` is not a number: the trace holds text for it; a plot draws numbers and Booleans"
+                )
+            if named:  # in the trace as null only: an optional field absent from every message
+                empty.append(f"`{name}` had no value in this run (an optional field never sent)")
+                leaf_hints.append(empty[-1])
+                continue
+            # a struct or an array named whole: its numbers are its parts
+            parts = sorted(
+                {leaf for owner, leaf in valued if owner == subsystem and leaf.startswith((f"{inner}.", f"{inner}["))},
+                key=_natural,
+            )
+            if parts:
+                listed = ", ".join(f"`{subsystem}.{leaf}`" for leaf in parts[:4]) + (" …" if len(parts) > 4 else "")
+                raise TraceError(f"`{name}` is not a number but has parts that are: name one, {listed}")
             element = signal_element(inner)
             same = sorted({leaf for (owner, leaf) in leaves if owner == subsystem and signal_element(leaf) == element})
             if same:

@@ -533,17 +533,17 @@ def json_schema(types: TypeSystem, data_type: DataType) -> dict[str, Any]:
 
 
 def iter_leaves(value: Value, prefix: str = "") -> Iterator[tuple[str, Any]]:
-    """(path, number) for every numeric or Boolean leaf: `position[0]`, `pose.x` — for plots.
+    """(path, leaf) for every leaf of a trace's JSON value: `position[0]`, `pose.x` — for plots.
 
-    A null leaf of a trace (an infinite value, which JSON cannot write, or an absent optional
-    field) is NaN: a gap in the plot, not a signal that seems never to have been recorded."""
-    if value is None:
-        yield prefix, math.nan
-    elif isinstance(value, dict):
+    A leaf is a number, a Boolean, a string or None. None is JSON's null, which stands for two
+    things the reader of a trace tells apart by the channel's schema: an absent optional field and
+    an infinite real (which JSON cannot write). A string is yielded too, so that a plot of it can
+    say it is no number rather than that it was never recorded."""
+    if isinstance(value, dict):
         for key, inner in value.items():
             yield from iter_leaves(inner, f"{prefix}.{key}" if prefix else key)
     elif isinstance(value, (list, tuple)):
         for index, inner in enumerate(value):
             yield from iter_leaves(inner, f"{prefix}[{index}]")
-    elif isinstance(value, (bool, int, float)):
+    elif value is None or isinstance(value, (bool, int, float, str)):
         yield prefix, value
