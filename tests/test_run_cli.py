@@ -1054,6 +1054,7 @@ system optionals
 
 struct Reading {
     level: double
+    spin: double[2]
     note: string?
     spare: double?
 }
@@ -1112,7 +1113,7 @@ def tick(inputs, outputs, context):
 
 def emit(inputs, outputs, context):
     level = float("inf") if inputs.t % 2 else inputs.t
-    outputs.r = {"level": level, "note": "reading", "spare": None}
+    outputs.r = {"level": level, "spin": [0.0, 1.0], "note": "reading", "spare": None}
 
 
 def take(inputs, outputs, context):
@@ -1168,3 +1169,18 @@ def test_a_signal_that_is_no_number_is_refused_before_the_run_and_by_earl_plot(t
     whole = earl_cli("plot", str(trace), "--signal", "a/a.cs.r", "-o", str(png))
     assert whole.returncode == 1 and "`a/a.cs.r` is not a number but has parts" in whole.stderr, whole.stderr
     assert "`a/a.cs.r.level`" in whole.stderr
+
+
+@pytest.mark.parametrize(
+    ("signal_name", "fragment"),
+    [
+        ("a/a.cs.r.spin[2]", "`r.spin` has elements 0 to 1 where the signal indexes it, not 2"),
+        ("a/a.cs.r.level.x", "`r.level` has no field `x` where the signal names it"),
+        ("a/a.cs", "`a/a.cs` names a subsystem: a signal goes on to its memory or output buffer, e.g. `a/a.cs.t`"),
+    ],
+)
+def test_a_wrong_signal_is_said_naming_the_part_that_is_wrong(tmp_path: Path, signal_name: str, fragment: str) -> None:
+    spec = optional_sender(tmp_path)
+    result = earl_cli("run", str(spec), "--plot", str(tmp_path / "p.png"), "--signal", signal_name)
+    assert result.returncode == 2 and fragment in result.stderr, result.stderr
+    assert "did you mean" not in result.stderr
