@@ -855,6 +855,20 @@ def test_options_that_would_record_nothing_are_said(tmp_path: Path) -> None:
     assert "`counter/a:relay*`" not in traced.stderr
 
 
+def test_a_record_links_pattern_of_run_toml_that_matches_no_link_is_said(tmp_path: Path) -> None:
+    spec = counter_copy(tmp_path)
+    (spec.parent / "run.toml").write_text('record_links = ["filter,*", "counter/a:relay*"]\n')
+    trace = str(tmp_path / "t.mcap")
+    result = earl_cli("run", str(spec.parent), "--duration", "20ms", "--trace", trace)
+    assert result.returncode == 0, result.stderr
+    said = " ".join(result.stderr.split())
+    assert "record_links `filter,*` in run.toml matches no link (the links: counter/a:cs,relay" in said
+    assert "`counter/a:relay*`" not in said
+    # the command line wins: run.toml's patterns are not used, so not checked either
+    overridden = earl_cli("run", str(spec.parent), "--duration", "20ms", "--trace", trace, "--record-links", "*")
+    assert overridden.returncode == 0 and "matches no link" not in overridden.stderr, overridden.stderr
+
+
 def test_a_stop_while_waiting_for_the_next_instant_is_made_at_once(tmp_path: Path) -> None:
     """Real time, periods of 20 s: the run sleeps between instants, and a stop must not wait for the next."""
     spec = counter_copy(tmp_path)

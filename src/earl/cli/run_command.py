@@ -288,7 +288,7 @@ def _run(arguments: argparse.Namespace) -> int:
         _close(transport)
         print(f"earl run: {error}", file=sys.stderr)
         return EXIT_FAILED
-    _say_what_is_not_recorded(arguments, simulation)
+    _say_what_is_not_recorded(arguments, simulation, settings.record_links)
     try:
         if transport is not None:
             from earl.transport.process import wait_for_peers
@@ -308,9 +308,12 @@ def _run(arguments: argparse.Namespace) -> int:
             simulation.close()
 
 
-def _say_what_is_not_recorded(arguments: argparse.Namespace, simulation: Any) -> None:
-    """A line for options that would record nothing: no trace to record into, or a link pattern that
-    matches no link of the system (a misspelt glob would otherwise leave the trace quietly empty)."""
+def _say_what_is_not_recorded(
+    arguments: argparse.Namespace, simulation: Any, record_links_of_run_toml: list[str] | None
+) -> None:
+    """A line for options that would record nothing: no trace to record into, or a link pattern (of
+    --record-links, or else of run.toml's `record_links`) that matches no link of the system (a
+    misspelt glob would otherwise leave the trace quietly empty)."""
     from fnmatch import fnmatchcase
 
     chosen = [name for name in ("record_memory", "record_links") if getattr(arguments, name) is not None]
@@ -318,12 +321,14 @@ def _say_what_is_not_recorded(arguments: argparse.Namespace, simulation: Any) ->
         options = " and ".join(f"--{name.replace('_', '-')}" for name in chosen)
         print(f"earl run: {options} choose what a trace records; without --trace nothing is recorded", file=sys.stderr)
     links = sorted(simulation.network.link_types)
-    for pattern in arguments.record_links or []:
+    if arguments.record_links is not None:
+        patterns, said = arguments.record_links, "--record-links `{}`"
+    else:  # the command line wins over run.toml: only the patterns the run uses are checked
+        patterns, said = record_links_of_run_toml or [], "record_links `{}` in run.toml"
+    for pattern in patterns:
         if not any(fnmatchcase(link, pattern) for link in links):
             known = ", ".join(links[:8]) + (" …" if len(links) > 8 else "")
-            print(
-                f"earl run: --record-links `{pattern}` matches no link (the links: {known or 'none'})", file=sys.stderr
-            )
+            print(f"earl run: {said.format(pattern)} matches no link (the links: {known or 'none'})", file=sys.stderr)
 
 
 #: signals that end a run as Ctrl-C does: `kill`, `timeout`, a service manager, a closed terminal
