@@ -418,7 +418,11 @@ def test_the_checker_runs_first_and_its_errors_stop_the_run(tmp_path: Path) -> N
         (["--duration", "1e400s"], "is too long: a duration is at most"),  # infinite as a float
         (["--duration=-1s"], "must be positive"),
         (["--agents", ","], "--agents names no agent"),
-        (["--plot", "/nonexistent/dir/x.png", "--signal", "counter/a.cs.count"], "cannot write the trace"),
+        (
+            ["--plot", "/nonexistent/dir/x.png", "--signal", "counter/a.cs.count"],
+            "the directory `/nonexistent/dir` does",
+        ),
+        (["--trace", "/nonexistent/dir/x.mcap"], "cannot write the trace /nonexistent/dir/x.mcap: the directory"),
         (["--record-memory", "counter/a.nothing"], "names no subsystem"),
         (["--param", "LIMIT"], "NAME=VALUE"),
     ],
@@ -853,6 +857,29 @@ def test_options_that_would_record_nothing_are_said(tmp_path: Path) -> None:
     assert traced.returncode == 0
     assert "--record-links `nomatch*` matches no link (the links: counter/a:cs,relay" in traced.stderr
     assert "`counter/a:relay*`" not in traced.stderr
+
+
+def test_a_plot_or_trace_into_a_directory_that_does_not_exist_is_refused_before_the_run(tmp_path: Path) -> None:
+    """Whether the trace goes beside the plot or elsewhere: one line, exit 2, and no directory made."""
+    missing = tmp_path / "nodir"
+    plot = ["--plot", str(missing / "p.png"), "--signal", "counter/a.cs.count"]
+    for extra in ([], ["--trace", str(tmp_path / "ok.mcap")]):
+        result = earl_cli("run", str(SPECS / "counter"), "--duration", "1000s", *plot, *extra)
+        assert result.returncode == 2, result.stdout + result.stderr
+        assert result.stderr.strip().splitlines() == [
+            f"earl: error: --plot '{missing / 'p.png'}': the directory `{missing}` does not exist"
+        ]
+        assert not missing.exists() and not (tmp_path / "ok.mcap").exists()
+    trace = earl_cli("run", str(SPECS / "counter"), "--trace", str(missing / "x.mcap"))
+    assert trace.returncode == 2
+    said = trace.stderr.strip()
+    assert said == f"earl: error: cannot write the trace {missing / 'x.mcap'}: the directory `{missing}` does not exist"
+    assert (
+        earl_cli("run", str(SPECS / "counter"), "--duration", "20ms", "--trace", str(tmp_path / "t.mcap")).returncode
+        == 0
+    )
+    drawn = earl_cli("plot", str(tmp_path / "t.mcap"), "--signal", "counter/a.cs.count", "-o", str(missing / "p.png"))
+    assert drawn.returncode == 2 and "the directory" in drawn.stderr and not missing.exists()
 
 
 def test_a_record_links_pattern_of_run_toml_that_matches_no_link_is_said(tmp_path: Path) -> None:

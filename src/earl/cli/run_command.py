@@ -180,6 +180,11 @@ def _run(arguments: argparse.Namespace) -> int:
         arguments.trace = str(Path(arguments.plot).with_suffix(".mcap"))
     if arguments.plot and Path(arguments.plot).resolve() == Path(arguments.trace).resolve():
         return usage_error(f"--trace and --plot both name {arguments.plot}: the plot would replace the trace")
+    if arguments.trace is not None and not Path(arguments.trace).parent.is_dir():
+        # said here in the CLI's words; `Simulation` would say it after the spec is read, in the API's
+        directory = Path(arguments.trace).parent
+        kind = "is not a directory" if directory.exists() else "does not exist"
+        return usage_error(f"cannot write the trace {arguments.trace}: the directory `{directory}` {kind}")
     # only a trace file this command creates may be removed, should a stop signal come before the run
     trace_was_there = arguments.trace is not None and os.path.lexists(arguments.trace)
     environment = arguments.environment or settings.environment

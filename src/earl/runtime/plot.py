@@ -24,12 +24,13 @@ def plot_output_problem(output: Path) -> str | None:
         return f"a plot is written as {', '.join(PLOT_SUFFIXES)}, named by its suffix"
     if output.exists() and not output.is_file():
         return "it is not a regular file (a device, a pipe or a socket)"
+    if output.parent.is_dir():
+        return None
     for parent in output.parents:
-        if parent.exists():
-            if not parent.is_dir():
-                return f"{parent} is a file, not a directory"
-            break
-    return None
+        if parent.exists() and not parent.is_dir():
+            return f"{parent} is a file, not a directory"
+    # not made for the plot: a misspelt directory would otherwise get the plot (and the trace beside it)
+    return f"the directory `{output.parent}` does not exist"
 
 
 def what_to_record(expanded: System, signals: list[str]) -> tuple[list[str], list[str]]:
@@ -206,7 +207,6 @@ def plot_signals(trace: Path, signals: list[str], output: Path, title: str | Non
     if title:
         figure.suptitle(title)
     figure.tight_layout()
-    output.parent.mkdir(parents=True, exist_ok=True)
     figure.savefig(output, dpi=110)
     plt.close(figure)
     return [f"{line}; drawn without it" for line in data.empty] + ([CUT] if data.cut else [])
