@@ -88,6 +88,17 @@ def write(inputs, outputs, context):
     elif mode == 9:
         outputs["current[1]"] = 3.0  # a member by its name, as `inputs["x[2]"]` reads one
         LOG.append(outputs["current[1]"])
+    elif mode == 10:
+        list(inputs)  # no collection of names: said so, not as a read of an undeclared `0`
+    elif mode == 11:
+        len(inputs)
+    elif mode == 12:
+        "sent" in outputs
+    elif mode == 13:
+        for _ in outputs:
+            pass
+    elif mode == 14 and not (inputs and outputs):  # truth is no count: a view is true
+        raise AssertionError("a view is false")
 """
 
 
@@ -135,6 +146,15 @@ def test_writes_are_taken_when_the_call_returns_and_read_back_by_item(tmp_path: 
         (6, "type", "level/mo is NaN"),
         (7, "undeclared-write", "`write/pf` assigned `inputs.sent`; inputs are read-only"),
         (8, "undeclared-write", "assigned `inputs.current[1]`; inputs are read-only"),
+        (
+            10,
+            "exception",
+            "`write/pf` raised TypeError: inputs cannot be iterated, counted or searched (`for`, `len`, `in`); ",
+        ),
+        (10, "exception", 'read a declared name: `inputs.current` or `inputs["current"]` (it reads: current, level'),
+        (11, "exception", "inputs cannot be iterated, counted or searched"),
+        (12, "exception", "outputs cannot be iterated, counted or searched"),
+        (13, "exception", 'write a declared name: `outputs.sent = …` or `outputs["sent"] = …` (it writes: sent,'),
     ],
 )
 def test_a_value_the_quick_test_rejects_gets_the_precise_message(
@@ -267,6 +287,11 @@ def test_a_memory_and_an_output_buffer_of_one_name_are_written_by_attribute_and_
         assert sim.state_of("twin/a.echo/ve").inputs["level"] == 40.0
     finally:
         sim.close()
+
+
+def test_a_view_is_true_though_it_cannot_be_counted(tmp_path: Path) -> None:
+    sim, _ = run(tmp_path, 14)
+    assert sim.faults == []
 
 
 def test_a_member_of_a_family_is_written_and_read_back_by_its_name(tmp_path: Path) -> None:

@@ -141,6 +141,31 @@ class Inputs:
     def __dir__(self) -> list[str]:
         return sorted({n for n, _, _ in self._earl_singles} | set(self.__dict__))
 
+    # Without these, `list(inputs)` and `x in inputs` would fall back on `inputs[0]`, `inputs[1]` …
+    # and fault as a read of an undeclared `0`. A view is no collection of its names: a name read
+    # by a loop would be a read the spec's declaration does not show where it is made.
+    def _earl_no_collection(self) -> TypeError:
+        declared = self.__dir__()
+        example = declared[0] if declared else "x"
+        return TypeError(
+            # no function's name: the fault that records the error names it
+            f"inputs cannot be iterated, counted or searched (`for`, `len`, `in`); "
+            f'read a declared name: `inputs.{example}` or `inputs["{example}"]` '
+            f"(it reads: {', '.join(declared) or 'nothing'})"
+        )
+
+    def __iter__(self) -> NoReturn:
+        raise self._earl_no_collection()
+
+    def __len__(self) -> NoReturn:
+        raise self._earl_no_collection()
+
+    def __contains__(self, name: object) -> NoReturn:
+        raise self._earl_no_collection()
+
+    def __bool__(self) -> bool:
+        return True  # as before `__len__` refused: `if inputs:` is no count
+
 
 def _compile_refresh(values: dict[str, Any], singles: list[tuple[str, dict[str, Any], str]]) -> Callable[[], None]:
     """One straight-line function copying each declared read into `values`: it runs before every call.
@@ -313,6 +338,29 @@ class Outputs:
 
     def __dir__(self) -> list[str]:
         return [name for name, _ in self._earl_single_writes()] + list(self._earl_families)
+
+    # as for `Inputs`: else `list(outputs)` reads `outputs[0]`, a fault about an undeclared `0`
+    def _earl_no_collection(self) -> TypeError:
+        declared = self.__dir__()
+        example = declared[0] if declared else "x"
+        return TypeError(
+            # no function's name: the fault that records the error names it
+            f"outputs cannot be iterated, counted or searched (`for`, `len`, `in`); "
+            f'write a declared name: `outputs.{example} = …` or `outputs["{example}"] = …` '
+            f"(it writes: {', '.join(declared) or 'nothing'})"
+        )
+
+    def __iter__(self) -> NoReturn:
+        raise self._earl_no_collection()
+
+    def __len__(self) -> NoReturn:
+        raise self._earl_no_collection()
+
+    def __contains__(self, name: object) -> NoReturn:
+        raise self._earl_no_collection()
+
+    def __bool__(self) -> bool:
+        return True  # as before `__len__` refused: `if outputs:` is no count
 
 
 class Context:
