@@ -896,6 +896,13 @@ def test_a_record_links_pattern_of_run_toml_that_matches_no_link_is_said(tmp_pat
     assert overridden.returncode == 0 and "matches no link" not in overridden.stderr, overridden.stderr
 
 
+def test_run_toml_s_record_links_are_not_checked_against_the_links_of_some_agents_only() -> None:
+    """The example's run.toml names links of every agent; a run of the grip agent has only its own."""
+    result = earl_cli("run", str(EXAMPLE), "--agents", "grip/a", "--environment", "none", "--duration", "10ms")
+    assert result.returncode == 0, result.stderr
+    assert "matches no link" not in result.stderr
+
+
 def test_a_stop_while_waiting_for_the_next_instant_is_made_at_once(tmp_path: Path) -> None:
     """Real time, periods of 20 s: the run sleeps between instants, and a stop must not wait for the next."""
     spec = counter_copy(tmp_path)
