@@ -1214,6 +1214,11 @@ def test_a_signal_that_is_no_number_is_refused_before_the_run_and_by_earl_plot(t
     assert earl_cli("run", str(spec), "--duration", "50ms", "--trace", str(trace)).returncode == 0
     text = earl_cli("plot", str(trace), "--signal", "a/a.cs.r.note", "-o", str(png))
     assert text.returncode == 1 and "`a/a.cs.r.note` is not a number" in text.stderr, text.stderr
+    # an optional string never sent is no number either: the channel's schema says it is text
+    (spec / "readings.py").write_text(READINGS.replace('"note": "reading"', '"note": None'))
+    assert earl_cli("run", str(spec), "--duration", "50ms", "--trace", str(trace)).returncode == 0
+    never = earl_cli("plot", str(trace), "--signal", "a/a.cs.r.note", "-o", str(png))
+    assert never.returncode == 1 and "`a/a.cs.r.note` is not a number" in never.stderr, never.stderr
     whole = earl_cli("plot", str(trace), "--signal", "a/a.cs.r", "-o", str(png))
     assert whole.returncode == 1 and "`a/a.cs.r` is not a number but has parts" in whole.stderr, whole.stderr
     assert "`a/a.cs.r.level`" in whole.stderr

@@ -264,12 +264,23 @@ def _null_is_absent(schema: Any, leaf: str) -> bool:
     that was absent, rather than an infinite real: JSON writes both as null, and only the channel's
     schema tells them apart. A null that the schema does not show to be a real (no schema, or an
     optional real, whose absence is the likelier) counts as absent."""
+    found = _leaf_schema(schema, leaf)
+    if not isinstance(found, dict):
+        return True
+    options = found.get("anyOf", [])
+    if any(isinstance(option, dict) and option.get("type") == "null" for option in options):
+        return True
+    return bool(found.get("type") != "number")
+
+
+def _leaf_schema(schema: Any, leaf: str) -> Any:
+    """The part of a channel's schema for `leaf` of its messages; None when the schema does not show it."""
     current = schema
     rest = leaf
     while rest:
         current = _present_branch(current)
         if not isinstance(current, dict):
-            return True
+            return None
         properties = current.get("properties")
         if isinstance(properties, dict):
             # a memory family's member is one property, `log[2]`: the longest name that starts `rest`
@@ -279,19 +290,14 @@ def _null_is_absent(schema: Any, leaf: str) -> bool:
                 default=None,
             )
             if name is None:
-                return True
+                return None
             current, rest = properties[name], rest[len(name) :].removeprefix(".")
         else:
             index = re.match(r"\[\d+\]", rest)
             if index is None:
-                return True
+                return None
             current, rest = current.get("items"), rest[index.end() :].removeprefix(".")
-    if not isinstance(current, dict):
-        return True
-    options = current.get("anyOf", [])
-    if any(isinstance(option, dict) and option.get("type") == "null" for option in options):
-        return True
-    return bool(current.get("type") != "number")
+    return current
 
 
 def _present_branch(schema: Any) -> Any:
@@ -362,8 +368,9 @@ def read_signals(path: Path, names: list[str]) -> Signals:
     valued: set[tuple[str, str]] = set()
     #: the leaves that held text: no number, which the plot says instead of "no value"
     texts: set[tuple[str, str]] = set()
-    #: (topic, leaf) -> whether a null there is an absent optional field (else an infinite real)
-    absent_when_null: dict[tuple[str, str], bool] = {}
+    #: (topic, leaf) -> whether a null there is an absent optional field (else an infinite real), and
+    #: whether that field holds text when present (an optional string never sent is no number either)
+    null_meaning: dict[tuple[str, str], tuple[bool, bool]] = {}
     stays: dict[str, list[tuple[float, str]]] = {}
     end = 0.0
     cut: list[bool] = []
@@ -390,12 +397,18 @@ def read_signals(path: Path, names: list[str]) -> Signals:
                     texts.add(key)
                     continue
                 if value is None:
-                    absent = absent_when_null.get((topic, raw))
-                    if absent is None:
-                        absent = absent_when_null[(topic, raw)] = _null_is_absent(channels[topic][1], raw)
+                    meaning = null_meaning.get((topic, raw))
+                    if meaning is None:
+                        schema = channels[topic][1]
+                        text = _present_branch(_leaf_schema(schema, raw))
+                        is_text = isinstance(text, dict) and text.get("type") == "string"
+                        meaning = null_meaning[(topic, raw)] = (_null_is_absent(schema, raw), is_text)
+                    if meaning[1]:
+                        texts.add(key)
+                        continue
                     # either way a gap in the line: an absent field has no value to hold until the next
                     number = math.nan
-                    if not absent:
+                    if not meaning[0]:
                         valued.add(key)
                 else:
                     number = float(value)
