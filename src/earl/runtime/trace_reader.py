@@ -431,9 +431,7 @@ def read_signals(path: Path, names: list[str]) -> Signals:
         ]
         if not matched:
             if any(owner == subsystem and pattern.match(leaf) for owner, leaf in texts):
-                raise TraceError(
-                    f"`{name}` is not a number: the trace holds text for it; a plot draws numbers and Booleans"
-                )
+                raise TraceError(f"`{name}` is not a number but text; a plot draws numbers and Booleans")
             if named:  # in the trace as null only: an optional field absent from every message
                 empty.append(f"`{name}` had no value in this run (an optional field never sent)")
                 leaf_hints.append(empty[-1])
