@@ -1501,6 +1501,20 @@ def test_a_constant_index_a_quantifier_puts_in_is_checked_for_every_value() -> N
         "`v/mi[3]` reads element 3 of a `double[3]`, whose elements are 0 to 2 (in the body of `all(J in …: …)`)"
     ]
     assert findings(text.replace("v/mi[J]", "v/mi[J - 1]"), "EARL-E030") == []
+    # an element read only when a guard on the index lets it (`or` stops at a true operand, `and` at a false
+    # one) is never read out of range: each neighbour of a sorted array, the first and the last body alike
+    for guarded in (
+        "all(J in 0..N - 1: J == N - 1 or v/mi[J] <= v/mi[J + 1])",
+        "all(J in 0..N - 1: J == 0 or v/mi[J - 1] <= v/mi[J])",
+        "all(J in 0..N - 1: not (J > 0) or v/mi[J - 1] <= v/mi[J])",
+        "any(J in 0..N: J < N and v/mi[J] > 0.0)",
+    ):
+        assert findings(text.replace("all(J in 1..N: v/mi[J] > 0.0)", guarded), "EARL-E030") == [], guarded
+    # a guard that lets the read through where it is out of range does not hide it
+    wrong = text.replace("all(J in 1..N: v/mi[J] > 0.0)", "all(J in 0..N - 1: J == 1 or v/mi[J - 1] <= v/mi[J])")
+    assert [d.message for d in findings(wrong, "EARL-E030")] == [
+        "`v/mi[0 - 1]` reads element -1 of a `double[3]`, whose elements are 0 to 2 (in the body of `all(J in …: …)`)"
+    ]
 
 
 def test_a_transition_condition_reading_unwritten_memory_is_reported() -> None:

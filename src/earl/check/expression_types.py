@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import operator
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 from earl.check.context import CheckContext
 from earl.model.elements import InputBuffer, Memory, Subsystem
@@ -66,6 +69,9 @@ class ExpressionTyper:
         self.problems: list[TypeProblem] = []
         # an index said out of range once: the unrolled bodies of a quantifier repeat each index's place
         self._indices_said: set[SourceLocation | None] = set()
+        # above 0 while typing operands that are never evaluated: `J == 2 or v/ib[J + 1]` with J = 2 reads no
+        # element 3, since `or` stops at its constant true operand (their types are still checked)
+        self._unreachable = 0
 
     def type_of(self, expression: Expression) -> str:
         if isinstance(expression, Literal):
@@ -100,8 +106,13 @@ class ExpressionTyper:
                     shown=expression_text(quantifier.body),
                 )
                 return BOOLEAN
+            stopped = 0
             for operand in expression.operands:
                 self._expect(operand, BOOLEAN, f"an operand of `{expression.operator}`")
+                if not stopped and _stops(expression.operator, operand):
+                    stopped = 1
+                    self._unreachable += 1
+            self._unreachable -= stopped
             return BOOLEAN
         if isinstance(expression, Negate):
             self._expect(expression.operand, NUMBER, "the operand of `-`")
@@ -173,6 +184,8 @@ class ExpressionTyper:
     def _check_indices_in(self, expression: Expression) -> None:
         """A constant index outside a fixed-size array anywhere in `expression`, said with the innermost
         unrolled quantifier around it: its place alone is that of every body."""
+        if self._unreachable:
+            return
         stack: list[tuple[Expression, str]] = [(expression, "")]
         while stack:
             node, within = stack.pop()
@@ -181,6 +194,15 @@ class ExpressionTyper:
                 within = f" (in the body of `{quantifier.quantifier}({quantifier.index} in …: …)`)"
             if isinstance(node, Read):
                 self._structure(node, check_indices=True, within=within)
+            if isinstance(node, BooleanOperation):
+                # a body's own guard, made constant by its index (`J == N or …`), ends its evaluation
+                evaluated: list[Expression] = []
+                for operand in node.operands:
+                    evaluated.append(operand)
+                    if _stops(node.operator, operand):
+                        break
+                stack.extend((child, within) for child in reversed(evaluated))
+                continue
             # the first body first: the first value out of range is the one said
             stack.extend((child, within) for child in reversed(list(children(node))))
 
@@ -218,7 +240,7 @@ class ExpressionTyper:
     def _read(self, read: Read) -> str:
         if read.target.kind is Kind.PRIMITIVE_PREDICATE:
             return BOOLEAN
-        current = self._structure(read, check_indices=True)
+        current = self._structure(read, check_indices=not self._unreachable)
         if current is None:
             return UNKNOWN
         if isinstance(current, PrimitiveType):
@@ -257,3 +279,43 @@ class ExpressionTyper:
 
 
 __all__ = ["BOOLEAN", "ExpressionTyper", "TypeProblem"]
+
+
+_ORDER: dict[str, Callable[[Any, Any], bool]] = {
+    "==": operator.eq,
+    "!=": operator.ne,
+    "<": operator.lt,
+    "<=": operator.le,
+    ">": operator.gt,
+    ">=": operator.ge,
+}
+
+
+def _stops(boolean_operator: str, operand: Expression) -> bool:
+    """Whether `operand`, a constant, ends the evaluation of the `and`/`or` it is an operand of."""
+    truth = constant_truth(operand)
+    return truth is (boolean_operator == "or")
+
+
+def constant_truth(expression: Expression) -> bool | None:
+    """The truth of a condition made of constants alone (`2 == 2`, once a quantifier put its index in);
+    None when it depends on what the subsystem reads."""
+    if isinstance(expression, Literal):
+        return expression.value if isinstance(expression.value, bool) else None
+    if isinstance(expression, Not):
+        truth = constant_truth(expression.operand)
+        return None if truth is None else not truth
+    if isinstance(expression, BooleanOperation):
+        truths = [constant_truth(operand) for operand in expression.operands]
+        deciding = expression.operator == "or"  # the value that decides an `or` alone, and an `and` its opposite
+        if deciding in truths:
+            return deciding
+        return (not deciding) if all(truth is not None for truth in truths) else None
+    if isinstance(expression, Comparison) and expression.operator in _ORDER:
+        try:
+            left = evaluate_constant(expression.left, {})
+            right = evaluate_constant(expression.right, {})
+            return bool(_ORDER[expression.operator](left, right))
+        except (ConstantError, TypeError):  # not constants, or constants that do not compare (`"a" < 1`)
+            return None
+    return None
