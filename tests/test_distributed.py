@@ -287,6 +287,36 @@ def test_peers_that_run_different_specifications_say_so_and_their_links_still_ca
     assert said not in receiver.output + sender.output, (receiver.output, sender.output)
 
 
+def test_a_peer_whose_token_names_no_specification_is_alive_and_not_compared(
+    tmp_path: Path, processes: list[Process]
+) -> None:
+    # an earlier earl's token is `alive/<agent>/<process>`, without the digest: it is a peer all the same
+    import zenoh
+
+    from earl.transport.zenoh_transport import default_config
+
+    deploy = deployment(tmp_path, [(["sender/a"], False), (["receiver/a"], False)])
+    sender_endpoint, receiver_endpoint = endpoints(deploy)
+    receiver = run(
+        processes,
+        tmp_path / "receiver.log",
+        [
+            *(str(PINGPONG), "--transport", "zenoh", "--deployment", str(deploy), "--duration", "1s"),
+            *("--agents", "receiver/a", "--wait-for-peers", "20s"),
+        ],
+    )
+    receiver.wait_for("waiting up to 20 s for sender/a", 30)
+    session = zenoh.open(default_config([sender_endpoint], [receiver_endpoint]))
+    try:
+        token = session.liveliness().declare_token("earl/pingPong/alive/sender%2Fa/0123456789ab")
+        receiver.wait_for("peers sender/a are alive; starting", 30)
+        assert receiver.finish(60) == 0, receiver.output
+        token.undeclare()  # type: ignore[no-untyped-call]
+    finally:
+        session.close()  # type: ignore[no-untyped-call]
+    assert "another specification" not in receiver.output
+
+
 def test_malformed_bytes_injected_on_a_link_key_are_counted_and_dropped(
     tmp_path: Path, processes: list[Process]
 ) -> None:

@@ -254,7 +254,7 @@ class ZenohTransport:
         self._declared.append(self.session.declare_queryable(f"earl/{escape(system)}/types/*", self._answer_type_query))
         self._declared.append(
             self.session.liveliness().declare_subscriber(
-                alive_prefix(system) + "*/*/*", self._on_liveliness, history=True
+                alive_prefix(system) + "**", self._on_liveliness, history=True
             )
         )
         self._declared.append(self.session.declare_subscriber(finished_prefix(system) + "*", self._on_finished))
@@ -334,8 +334,12 @@ class ZenohTransport:
 
     def _on_liveliness(self, sample: zenoh.Sample) -> None:
         """On Zenoh's thread: a process declared one of its agents alive, or that token went."""
-        chunks = str(sample.key_expr).rsplit("/", 3)
-        agent, process, specification = unescape(chunks[-3]), unescape(chunks[-2]), unescape(chunks[-1])
+        # `<agent>/<process>/<spec>`; a process of an earlier earl says no spec (`<agent>/<process>`)
+        chunks = str(sample.key_expr).removeprefix(alive_prefix(self.system)).split("/")
+        if len(chunks) not in (2, 3):
+            return  # not a token of earl's
+        agent, process = unescape(chunks[0]), unescape(chunks[1])
+        specification = unescape(chunks[2]) if len(chunks) == 3 else UNKNOWN_SPECIFICATION
         if process == self.process_id:
             return  # our own token
         if sample.kind == zenoh.SampleKind.PUT:
