@@ -98,6 +98,13 @@ def test_run_plot_records_the_memory_it_draws_and_refuses_a_signal_the_system_la
     assert time.monotonic() - started < 30  # before the run
     nowhere = earl_cli("run", str(SPECS / "counter"), "--plot", str(png), "--signal", "counter/a.cz.count")
     assert nowhere.returncode == 2 and "does not start with a subsystem of this system" in nowhere.stderr
+    # a signal of run.toml's `plot` is said as one of run.toml, not of --signal, which was not given
+    spec = counter_copy(tmp_path)
+    (spec.parent / "run.toml").write_text('plot = ["counter/a.cs.snet"]\n')
+    from_settings = earl_cli("run", str(spec.parent), "--duration", "50ms", "--plot", str(png))
+    assert from_settings.returncode == 2
+    assert "run.toml's plot: `counter/a.cs.snet`: `counter/a.cs` has no memory" in from_settings.stderr
+    assert "--signal" not in from_settings.stderr
 
 
 def test_a_plot_that_cannot_be_written_is_a_usage_error_said_before_anything_runs(tmp_path: Path) -> None:

@@ -167,6 +167,8 @@ def _run(arguments: argparse.Namespace) -> int:
         return usage_error(str(error))
     seed = arguments.seed if arguments.seed is not None else (settings.seed or 0)
     signals = arguments.signal if arguments.signal is not None else settings.plot
+    #: where the signals were named, for messages about them
+    signals_origin = "--signal" if arguments.signal is not None else "run.toml's plot:"
     if arguments.plot and not signals:
         return usage_error("--plot needs signals: name them with --signal, or `plot = [...]` in run.toml")
     if arguments.plot:
@@ -242,7 +244,7 @@ def _run(arguments: argparse.Namespace) -> int:
                 plotted, plotted_outputs = what_to_record(expanded, list(signals or []))
             except ValueError as error:
                 _close(transport)
-                return usage_error(f"--signal {error}")
+                return usage_error(f"{signals_origin} {error}")
             if agents:
                 plotted = [name for name in plotted if name.split(".", 1)[0] in agents]
             record_memory = sorted({*(record_memory or []), *plotted})
