@@ -1555,6 +1555,28 @@ def test_a_link_family_named_otherwise_is_said_as_a_family() -> None:
     assert found == ["link `m[K],drive` is not named after its ends; §2.5 suggests `m[K],d`"]
 
 
+def test_a_link_family_named_in_one_word_is_told_a_name_with_its_index() -> None:
+    """`link drives[K in 1..2]: … -> d[K]/re.drive`: the suggestion keeps the index on the end that is a family
+    member (`m[K],d[K]`), here taken by the family beside it, so the free name carries it too."""
+    text = add(FAMILY_AGENT.replace("link m[K in 1..2],d[K]:", "link drives[K in 1..2]:"))
+    found = [d.message for d in findings(text, "EARL-W010") if "drives" in d.message]
+    assert found == ["link `drives[K]` is not named after its ends; §2.5 suggests `m[K],d[K]`"]
+    both = add(
+        FAMILY_AGENT.replace("        drive/ib: double\n", "        drive/ib: double\n        gain/ib: double\n")
+        .replace("        cmd/ib: double\n", "        cmd/ib: double\n        gain/ob: double\n")
+        .replace(
+            "    link m[K in 1..2],d[K]: m[K]/ve.drive -> d[K]/re.drive\n",
+            "    link m[K in 1..2],d[K]: m[K]/ve.drive -> d[K]/re.drive\n"
+            "    link gains[K in 1..2]: m[K]/ve.gain -> d[K]/re.gain\n",
+        )
+    )
+    found = [d.message for d in findings(both, "EARL-W010") if "gains" in d.message]
+    assert found == [
+        "link `gains[K]` is not named after its ends; §2.5 suggests `m[K],d[K]`, but another link between them has "
+        "that name: name it `m[K],dGain[K]`"
+    ]
+
+
 TWO_LINKS = edit(
     ("        out/ob: double\n", "        out/ob: double\n        pose/ob: double\n"),
     ("emit/pf(x/mi -> out/ob)", "emit/pf(x/mi -> out/ob, pose/ob)"),

@@ -159,22 +159,41 @@ def link_names(context: CheckContext) -> Iterator[Finding]:
         taken = any([part.name for part in other.link.name] == expected for other in alongside)
         # the pair's name is another link's: the destination buffer, the message's content, tells them apart
         suggested_names = [expected[0], expected[1] + _capitalised(link.destination_buffer.name)] if taken else expected
-        name, suggested = link.link.name_text, ",".join(suggested_names)
+        name, suggested, pair = link.link.name_text, ",".join(suggested_names), ",".join(expected)
         family = link.link.family
         if family is not None and len(expected) == len(link.link.name):
             # a member of a link family: said as the family is written, its index kept on the indexed side
             name = _family_link_name(parts, link.link.name, family.index)
             suggested = _family_link_name(suggested_names, link.link.name, family.index)
+            pair = _family_link_name(expected, link.link.name, family.index)
+        elif family is not None:
+            # a family named otherwise (`gains[K in 1..N]`): the index goes on the ends that are family members
+            name = f"{parts[0]}[{family.index}]" if len(parts) == 1 else name
+            indexed = _indexed_ends(link)
+            suggested, pair = (
+                ",".join(
+                    f"{part}[{family.index}]" if end_indexed else part
+                    for part, end_indexed in zip(names, indexed, strict=True)
+                )
+                for names in (suggested_names, expected)
+            )
         if not taken:
             yield Finding(f"link `{name}` is not named after its ends; §2.5 suggests `{suggested}`", link.link.location)
             continue
         yield Finding(
-            f"link `{name}` is not named after its ends; §2.5 suggests `{expected[0]},{expected[1]}`, but another "
+            f"link `{name}` is not named after its ends; §2.5 suggests `{pair}`, but another "
             f"link between them has that name: name it `{suggested}`",
             link.link.location,
             "of two links between the same ends, name one `source,destination` and the other the same with what "
             "tells it apart after the destination's name (link names are unique, EARL-R002)",
         )
+
+
+def _indexed_ends(link: ResolvedLink) -> tuple[bool, bool]:
+    """Which of a link's ends (agents between agents, subsystems inside one) is a member of a family."""
+    if link.between_agents:
+        return link.source_agent.index is not None, link.destination_agent.index is not None
+    return link.source_subsystem.index is not None, link.destination_subsystem.index is not None
 
 
 def _ends_names(link: ResolvedLink) -> list[str]:
