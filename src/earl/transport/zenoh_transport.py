@@ -253,9 +253,7 @@ class ZenohTransport:
             raise TransportError(f"Zenoh could not start: {zenoh_reason(error)}") from None
         self._declared.append(self.session.declare_queryable(f"earl/{escape(system)}/types/*", self._answer_type_query))
         self._declared.append(
-            self.session.liveliness().declare_subscriber(
-                alive_prefix(system) + "**", self._on_liveliness, history=True
-            )
+            self.session.liveliness().declare_subscriber(alive_prefix(system) + "**", self._on_liveliness, history=True)
         )
         self._declared.append(self.session.declare_subscriber(finished_prefix(system) + "*", self._on_finished))
 
