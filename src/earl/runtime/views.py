@@ -77,7 +77,30 @@ class FamilyInputs:
         return f"<{self._name}[{', '.join(str(i) for i in self._members)}]>"
 
 
-class Inputs:
+class _NoCollection:
+    """What `Inputs` and `Outputs` share: neither is a collection of its names. Without this, `list(inputs)`
+    and `x in inputs` would fall back on `inputs[0]`, `inputs[1]` … and fault as a read of an undeclared
+    `0`; and a name reached by a loop would be a read or write the spec's declaration does not show."""
+
+    __slots__ = ()
+
+    def _earl_no_collection(self) -> TypeError:
+        raise NotImplementedError  # each view says it in its own words
+
+    def __iter__(self) -> NoReturn:
+        raise self._earl_no_collection()
+
+    def __len__(self) -> NoReturn:
+        raise self._earl_no_collection()
+
+    def __contains__(self, name: object) -> NoReturn:
+        raise self._earl_no_collection()
+
+    def __bool__(self) -> bool:
+        return True  # as before `__len__` refused: `if inputs:` is no count
+
+
+class Inputs(_NoCollection):
     """The declared reads of one function, as they were when its stage began.
 
     Before each call the runtime copies the current value of every declared single
@@ -141,9 +164,6 @@ class Inputs:
     def __dir__(self) -> list[str]:
         return sorted({n for n, _, _ in self._earl_singles} | set(self.__dict__))
 
-    # Without these, `list(inputs)` and `x in inputs` would fall back on `inputs[0]`, `inputs[1]` …
-    # and fault as a read of an undeclared `0`. A view is no collection of its names: a name read
-    # by a loop would be a read the spec's declaration does not show where it is made.
     def _earl_no_collection(self) -> TypeError:
         declared = self.__dir__()
         example = declared[0] if declared else "x"
@@ -153,18 +173,6 @@ class Inputs:
             f'read a declared name: `inputs.{example}` or `inputs["{example}"]` '
             f"(it reads: {', '.join(declared) or 'nothing'})"
         )
-
-    def __iter__(self) -> NoReturn:
-        raise self._earl_no_collection()
-
-    def __len__(self) -> NoReturn:
-        raise self._earl_no_collection()
-
-    def __contains__(self, name: object) -> NoReturn:
-        raise self._earl_no_collection()
-
-    def __bool__(self) -> bool:
-        return True  # as before `__len__` refused: `if inputs:` is no count
 
 
 def _compile_refresh(values: dict[str, Any], singles: list[tuple[str, dict[str, Any], str]]) -> Callable[[], None]:
@@ -249,7 +257,7 @@ class FamilyOutputs:
         return list(self._members)
 
 
-class Outputs:
+class Outputs(_NoCollection):
     """The declared writes of one function, checked against their declarations and types.
 
     `outputs.x = value` is a plain attribute store, as cheap as writing any Python object:
@@ -339,7 +347,6 @@ class Outputs:
     def __dir__(self) -> list[str]:
         return [name for name, _ in self._earl_single_writes()] + list(self._earl_families)
 
-    # as for `Inputs`: else `list(outputs)` reads `outputs[0]`, a fault about an undeclared `0`
     def _earl_no_collection(self) -> TypeError:
         declared = self.__dir__()
         example = declared[0] if declared else "x"
@@ -349,18 +356,6 @@ class Outputs:
             f'write a declared name: `outputs.{example} = …` or `outputs["{example}"] = …` '
             f"(it writes: {', '.join(declared) or 'nothing'})"
         )
-
-    def __iter__(self) -> NoReturn:
-        raise self._earl_no_collection()
-
-    def __len__(self) -> NoReturn:
-        raise self._earl_no_collection()
-
-    def __contains__(self, name: object) -> NoReturn:
-        raise self._earl_no_collection()
-
-    def __bool__(self) -> bool:
-        return True  # as before `__len__` refused: `if outputs:` is no count
 
 
 class Context:
