@@ -371,6 +371,10 @@ def test_the_digest_of_a_system_follows_equality_and_is_the_same_in_every_proces
     # comments, locations and where the text was read from are no part of the system
     again = earl.loads("// a copy\n" + system.to_earl().replace("//", "// said otherwise:"), "elsewhere/system.earl")
     assert again == system and model_digest(expand(again, {})) == digest
+    # numbers compare by value, as `==` does: `period 2.0 ms` is `period 2 ms`
+    text = system.to_earl()
+    same = earl.loads(text.replace("period 2 ms", "period 2.0 ms"))
+    assert "period 2.0 ms" in same.to_earl() and same == system and model_digest(expand(same, {})) == digest
     # another parameter value, a changed period, a changed condition: another system
     assert model_digest(expand(system, {"N": 7})) != digest
     text = system.to_earl()

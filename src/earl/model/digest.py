@@ -33,8 +33,12 @@ def _encode(root: object, write: Any) -> None:
         value = stack.pop()
         if isinstance(value, _Marker):
             write(value.text)
-        elif value is None or isinstance(value, (bool, int, float, str, bytes)):
-            # the type's name too: 1, 1.0, True and "1" are different values of a spec
+        elif isinstance(value, (int, float)) and not isinstance(value, bool):
+            # a number by its value, as `==` compares it: `period 10 ms` and `period 10.0 ms` are one system
+            whole = isinstance(value, int) or value.is_integer()
+            write(f"number:{int(value) if whole else repr(value)};".encode())
+        elif value is None or isinstance(value, (bool, str, bytes)):
+            # the type's name too: True, "1" and b"1" are different values of a spec
             write(f"{type(value).__name__}:{value!r};".encode())
         elif isinstance(value, Enum):
             write(f"{type(value).__name__}.{value.name};".encode())
