@@ -329,3 +329,22 @@ def test_a_recorder_without_idle_still_records_a_real_time_run() -> None:
     with earl.simulate(earl.loads(TEXT), environment=None, realtime=True, recorders=[counting]) as simulation:  # type: ignore[list-item]
         simulation.advance_to(0.05)
     assert counting.changes >= 1
+
+
+def test_a_kind_written_as_its_text_is_the_kind_at_run_time_as_for_the_checker() -> None:
+    """`ElementReference("command", "ib")`: Kind is a StrEnum, so the resolver and the checker take "ib" for
+    Kind.INPUT_BUFFER; the run took the read for one of memory and failed in its generated code (KeyError)."""
+    spec = Path(__file__).parent / "runtime_specs" / "counter"
+    written = earl.load(spec)
+    as_text = earl.load(spec)
+    relay = next(s for a in as_text.agents for s in a.subsystems if s.name == "relay")
+    store = next(f for f in relay.partial_transition_functions if f.name == "store")
+    store.reads[0] = ElementReference("command", "ib")  # type: ignore[arg-type]
+    assert not [d for d in check(as_text) if d.severity.name == "ERROR"]
+    runs = []
+    for system in (written, as_text):
+        simulation = earl.simulate(system)
+        simulation.advance_to(0.2)
+        runs.append({name: simulation.state_of(name).memory for name in simulation.network.by_name})
+        simulation.close()
+    assert runs[0] == runs[1]

@@ -250,7 +250,7 @@ def _engine(
 
 def _data_type(subsystem: Subsystem, reference: ElementReference) -> DataType:
     key = reference_key(reference)
-    if reference.kind is Kind.OUTPUT_BUFFER:
+    if reference.kind == Kind.OUTPUT_BUFFER:
         for output in subsystem.output_buffers:
             if indexed(output.name, output.index) == key:
                 return output.data_type
@@ -438,7 +438,7 @@ def _constant_false(expression: Any, subsystem: Subsystem) -> bool:
     """`false`, or a primitive predicate defined as `false` (the manual's `false/pp`)."""
     if isinstance(expression, Literal):
         return expression.value is False
-    if isinstance(expression, Read) and expression.target.kind is Kind.PRIMITIVE_PREDICATE and not expression.path:
+    if isinstance(expression, Read) and expression.target.kind == Kind.PRIMITIVE_PREDICATE and not expression.path:
         predicate = subsystem.primitive_predicate(expression.target.name)
         return (
             predicate is not None and isinstance(predicate.expression, Literal) and predicate.expression.value is False

@@ -102,7 +102,7 @@ def _named(expression: Expression) -> list[str]:
     return [
         reference_key(node.target)
         for node in walk(expression)
-        if isinstance(node, Read) and node.target.kind is Kind.PRIMITIVE_PREDICATE
+        if isinstance(node, Read) and node.target.kind == Kind.PRIMITIVE_PREDICATE
     ]
 
 
@@ -201,11 +201,11 @@ def _source(expression: Expression) -> str:
 def _read(read: Read) -> str:
     target = read.target
     key = repr(reference_key(target))
-    if target.kind is Kind.PRIMITIVE_PREDICATE:
+    if target.kind == Kind.PRIMITIVE_PREDICATE:
         if read.path:
             raise PredicateCompileError(f"`{target.name}/pp` is a Boolean: it has no fields or elements")
         return f"pp[{key}]({_ARGUMENTS})"
-    if target.kind is Kind.INPUT_BUFFER:
+    if target.kind == Kind.INPUT_BUFFER:
         base = f"ib[{key}]"
     elif target.kind in (Kind.MEMORY_INPUT, Kind.MEMORY):
         base = f"mem[{key}]"
@@ -243,7 +243,7 @@ def _call(call: Call) -> str:
     if len(call.arguments) != 1 or not isinstance(call.arguments[0], Read):
         raise PredicateCompileError(f"`{call.function}` takes one input buffer")
     argument = call.arguments[0]
-    if argument.target.kind is not Kind.INPUT_BUFFER:
+    if argument.target.kind != Kind.INPUT_BUFFER:
         raise PredicateCompileError(f"`{call.function}` takes an input buffer (`/ib`)")
     key = repr(reference_key(argument.target))
     if call.function == "newData":

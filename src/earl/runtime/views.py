@@ -425,10 +425,10 @@ def build_inputs(
     families: dict[str, dict[int, tuple[dict[str, Any], str]]] = {}
     full: dict[str, tuple[dict[str, Any], str]] = {}
     for reference in reads:
-        store = input_values if reference.kind is Kind.INPUT_BUFFER else memory_values
+        store = input_values if reference.kind == Kind.INPUT_BUFFER else memory_values
         key = reference_key(reference)
         index = reference_index(reference)
-        suffix = "ib" if reference.kind is Kind.INPUT_BUFFER else "mi"
+        suffix = "ib" if reference.kind == Kind.INPUT_BUFFER else "mi"
         full[f"{key}/{suffix}"] = (store, key)
         if index is None:
             # an input buffer and a memory may share a name: then only `inputs["x/ib"]` tells them apart
@@ -451,7 +451,7 @@ def build_outputs(
     families: dict[str, dict[int, _Target]] = {}
     targets = outputs._earl_targets
     for reference in writes:
-        is_memory = reference.kind is not Kind.OUTPUT_BUFFER
+        is_memory = reference.kind != Kind.OUTPUT_BUFFER
         key = reference_key(reference)
         spelled = f"{key}/{'mo' if is_memory else 'ob'}"
         index = reference_index(reference)
