@@ -348,3 +348,15 @@ def test_a_kind_written_as_its_text_is_the_kind_at_run_time_as_for_the_checker()
         runs.append({name: simulation.state_of(name).memory for name in simulation.network.by_name})
         simulation.close()
     assert runs[0] == runs[1]
+
+
+@pytest.mark.parametrize("period", ["2 ms", 0.002, 2, 0])
+def test_a_period_that_is_no_duration_is_named_by_to_earl_not_left_out(period: object) -> None:
+    """The printer wrote only the body items it knew: `period = "2 ms"` vanished from the text, which then
+    read back as a subsystem without a period (EARL-E017, far from the mistake)."""
+    from earl.model.validate import ModelTypeError
+
+    system = earl.load(Path(__file__).parent / "runtime_specs" / "counter")
+    system.agents[0].control_subsystem.period = period  # type: ignore[assignment,union-attr]
+    with pytest.raises(ModelTypeError, match=r"system\.agents\[0\]\.subsystems\[0\]\.period: expected Duration"):
+        system.to_earl()

@@ -236,7 +236,7 @@ def _subsystem(printer: _Printer, subsystem: Subsystem) -> None:
     printer.line(1, f"{header} {{", subsystem.comments)
     depth = 2
     groups: list[list[object]] = [
-        [*([subsystem.period] if subsystem.period else []), *subsystem.parameters],
+        [*([subsystem.period] if subsystem.period is not None else []), *subsystem.parameters],
         [*subsystem.input_buffers, *subsystem.output_buffers],
         list(subsystem.memories),
         list(subsystem.primitive_predicates),
@@ -299,6 +299,8 @@ def _body_item(printer: _Printer, depth: int, item: object) -> None:
         printer.line(depth, text, item.comments)
     elif isinstance(item, StageSet):
         printer.line(depth, f"stage {item.name} = {_pf_set(item.functions)}", item.comments)
+    else:  # a model built in Python (`period = "2 ms"`): never left out without a word (to_earl says where)
+        raise TypeError(f"not a declaration of a subsystem: {item!r}")
 
 
 def _basic_behaviour(printer: _Printer, depth: int, behaviour: BasicBehaviour) -> None:
