@@ -360,3 +360,19 @@ def test_a_period_that_is_no_duration_is_named_by_to_earl_not_left_out(period: o
     system.agents[0].control_subsystem.period = period  # type: ignore[assignment,union-attr]
     with pytest.raises(ModelTypeError, match=r"system\.agents\[0\]\.subsystems\[0\]\.period: expected Duration"):
         system.to_earl()
+
+
+def test_a_subsystem_built_twice_in_python_is_said_of_its_agent_not_of_the_subsystem_before_it() -> None:
+    from earl import ControlSubsystem, VirtualEffector
+
+    system = earl.loads(TEXT)
+    agent = system.agents[0]
+    agent.subsystems.append(VirtualEffector("drive"))
+    agent.subsystems.append(VirtualEffector("drive"))
+    agent.subsystems.append(ControlSubsystem())
+    said = [d.message for d in check(system) if d.code == "EARL-R002"]
+    # said of the agent (the message names it), not "(in `a/a.drive/ve`)", the subsystem declared before
+    assert said == [
+        "`drive/ve` of `a/a` is declared twice",
+        "the Control Subsystem `cs` of `a/a` is declared twice (first declared at line 3)",
+    ]

@@ -735,6 +735,7 @@ class Resolver:
         for subsystem in agent.subsystems:
             key = (subsystem.name, subsystem.kind)
             if key in table.subsystems:
+                self._place = f"`{agent.name}/a`"  # not the subsystem declared before it
                 what = (
                     "the Control Subsystem `cs`"
                     if subsystem.kind is Kind.CONTROL_SUBSYSTEM
