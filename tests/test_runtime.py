@@ -287,6 +287,21 @@ def test_state_of_an_unknown_subsystem_suggests_the_right_name() -> None:
         sim.state_of("counter/a.relay")
 
 
+def test_state_of_a_family_s_base_name_names_its_members() -> None:
+    """`manip/a.motorController/ve` is no subsystem: its members are; the closest name by spelling was one of
+    them picked at random (`[3]` of three)."""
+    sim = earl.simulate(earl.load(Path(__file__).parent.parent / "examples" / "pick_and_place"), environment=None)
+    try:
+        with pytest.raises(KeyError) as raised:
+            sim.state_of("manip/a.motorController/ve")
+        assert str(raised.value) == (
+            "`manip/a.motorController/ve` is a family of subsystems, each run on its own: name a member, "
+            "`manip/a.motorController[1]/ve` … `manip/a.motorController[6]/ve`"
+        )
+    finally:
+        sim.close()
+
+
 def test_the_real_time_scheduler_paces_by_the_wall_clock_and_measures_lateness() -> None:
     sim, events = simulate(SPECS / "counter", realtime=True)
     sim.advance_to(0.05)

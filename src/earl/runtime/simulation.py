@@ -282,6 +282,14 @@ class Simulation:
         if engine is None:
             from earl.diagnostics import did_you_mean
 
+            members = _members_of(subsystem, list(self.network.by_name)) if isinstance(subsystem, str) else []
+            if members:  # the base name of a family: each member runs on its own
+                shown = (
+                    f"`{members[0]}` … `{members[-1]}`" if len(members) > 2 else " and ".join(f"`{m}`" for m in members)
+                )
+                raise UnknownSubsystem(
+                    f"`{subsystem}` is a family of subsystems, each run on its own: name a member, {shown}"
+                )
             hint = did_you_mean(subsystem, list(self.network.by_name)) if isinstance(subsystem, str) else None
             hint = hint or f"subsystems are named like `{next(iter(self.network.by_name), 'manip/a.cs')}`"
             raise UnknownSubsystem(f"no subsystem `{subsystem}` in this run. {hint}".strip())
@@ -384,6 +392,15 @@ def _refuse_wrong_arguments(system: object, trace: object, **lists: object) -> N
 
 class RecordingWarning(UserWarning):
     """An option that chooses what the trace records chooses nothing (`earl run` says it in its own words)."""
+
+
+def _members_of(family: str, names: list[str]) -> list[str]:
+    """The subsystems of a run that are members of `family` (`manip/a.drive/ve`: `manip/a.drive[1]/ve`, …; an
+    agent family's too: `worker/a.cs`: `worker[1]/a.cs`, …), in the run's order."""
+    import re
+
+    plain = re.compile(r"\[\d+\]")
+    return [name for name in names if name != family and plain.sub("", name) == family]
 
 
 class UnknownSubsystem(KeyError):
