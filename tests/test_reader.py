@@ -323,3 +323,55 @@ def test_a_robot_holds_every_member_of_an_agent_family_with_star() -> None:
     assert "    worker[*]/a\n" in system.to_earl()
     members = [reference_text(member) for member in expand(system).robots[0].agents]
     assert members == ["worker[1]/a", "worker[2]/a", "worker[3]/a"]
+
+
+_ROBOT_WITH_A_LINK_FAMILY = """\
+system robotLinks
+
+param N: int = 2
+
+alpha/a {
+    cs {
+        period 10 ms
+        out[K in 1..N]/ob: double
+    }
+}
+
+worker[K in 1..N]/a {
+    cs {
+        period 10 ms
+        in/ib: double
+    }
+}
+
+link alpha,worker[K in 1..N]: alpha/a.cs.out[K] -> worker[K]/a.cs.in
+
+oneRobot/r {
+    alpha/a
+    worker[*]/a
+    LINK
+}
+"""
+
+
+def test_a_robot_names_a_link_family_as_it_is_declared_and_holds_every_member() -> None:
+    # the robot's reference was read as `alpha,worker[K]` and refused (EARL-R057) with the hint to write what
+    # was written
+    system = earl.loads(_ROBOT_WITH_A_LINK_FAMILY.replace("LINK", "link alpha,worker[K in 1..N]"), "links.earl")
+    assert [reference.name for reference in system.robots[0].links] == ["alpha,worker[K in 1..N]"]
+    assert "    link alpha,worker[K in 1..N]\n" in system.to_earl()
+    assert [reference.name for reference in expand(system).robots[0].links] == ["alpha,worker[1]", "alpha,worker[2]"]
+    # a member alone is told to name the family whole
+    with pytest.raises(earl.EarlError) as refused:
+        earl.loads(_ROBOT_WITH_A_LINK_FAMILY.replace("LINK", "link alpha,worker[1]"), "links.earl")
+    (problem,) = refused.value.diagnostics
+    assert problem.code == "EARL-R057"
+    assert problem.hint == "a robot names a link family whole, as it is declared: `link alpha,worker[K in 1..N]`"
+    # a robot that names the family but not its agents is told so for its members (EARL-E004)
+    from earl.check import check
+
+    outside = _ROBOT_WITH_A_LINK_FAMILY.replace("LINK", "link alpha,worker[K in 1..N]").replace("    worker[*]/a\n", "")
+    said = [d.message for d in check(earl.loads(outside, "links.earl")) if d.code == "EARL-E004"]
+    assert said == [
+        "robot `oneRobot/r` refers to link `alpha,worker[1..2]`, but `worker[1..2]/a` is not one of its agents"
+    ]

@@ -1274,6 +1274,10 @@ class Resolver:
     def _robots(self) -> None:
         seen: dict[str, Any] = {}
         links = {link.name_text for link in self.system.links}
+        #: link families by their name without indices: a robot naming one member (`alpha,worker[1]`) is told
+        families = {
+            _without_indices(link.name_text): link.name_text for link in self.system.links if link.family is not None
+        }
         for robot in self.system.robots:
             self._place = f"`{robot.name}/r`"
             if robot.name in seen:
@@ -1295,12 +1299,20 @@ class Resolver:
                 self._indices(reference, table.family, {}, star=True)
             for reference in robot.links:
                 if reference.name not in links:
+                    family = families.get(_without_indices(reference.name))
                     self.error(
                         f"robot `{robot.name}/r` refers to the link `{reference.name}`, which is not declared",
                         reference.location,
                         "EARL-R057",
-                        did_you_mean(reference.name, links),
+                        f"a robot names a link family whole, as it is declared: `link {family}`"
+                        if family is not None
+                        else did_you_mean(reference.name, links),
                     )
+
+
+def _without_indices(name: str) -> str:
+    """`alpha,worker` for `alpha,worker[K in 1..N]` and `alpha,worker[1]`."""
+    return re.sub(r"\[[^\]]*\]", "", name)
 
 
 def _names(expression: Expression) -> list[Name]:

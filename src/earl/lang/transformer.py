@@ -68,6 +68,7 @@ from earl.model.expressions import (
 )
 from earl.model.kinds import Kind
 from earl.model.location import SourceLocation
+from earl.model.text import family_text
 from earl.model.types import (
     MAX_ARRAY_DIMENSIONS,
     PRIMITIVE_TYPES,
@@ -239,8 +240,16 @@ class ElementBuilder:
         return Star(self._loc(index)) if isinstance(index, Token) and index.type == "STAR" else index
 
     def robot_link(self, meta: Meta, children: list[Any]) -> ElementReference:
-        parts, _family = children[0]
-        text = ",".join(p.name if p.index is None else f"{p.name}[{_index_source(p.index)}]" for p in parts)
+        parts, family = children[0]
+        # a link family is named as it is declared (`alpha,worker[K in 1..N]`), the way `name_text` writes it
+        text = ",".join(
+            p.name
+            if p.index is None
+            else family_text(p.name, family)
+            if family is not None and p.declares_family
+            else f"{p.name}[{_index_source(p.index)}]"
+            for p in parts
+        )
         return ElementReference(text, Kind.INTER_AGENT_LINK, (), self._loc(meta))
 
     def agent(self, meta: Meta, children: list[Any]) -> Agent:

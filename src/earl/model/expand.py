@@ -124,13 +124,24 @@ def expand(system: System, overrides: Mapping[str, Value] | None = None) -> Syst
             for index in members:
                 inner = {**environment, agent.family.index: index}
                 expanded.agents.append(_agent(agent, inner, index, cache))
+    #: a link family's declared name (`alpha,worker[K in 1..N]`) -> its members' (`alpha,worker[1]`, …)
+    link_members: dict[str, list[str]] = {}
     for link in system.links:
-        expanded.links.extend(_links(link, environment))
+        members_of_link = _links(link, environment)
+        expanded.links.extend(members_of_link)
+        if link.family is not None:
+            link_members[link.name_text] = [member.name_text for member in members_of_link]
     for robot in expanded.robots:
         robot.agents = [
             member
             for reference in robot.agents
             for member in _members(reference, agent_members.get(reference.name), environment)
+        ]
+        # a robot that names a link family holds each of its members, as it holds each member of `worker[*]/a`
+        robot.links = [
+            replace(reference, name=name)
+            for reference in robot.links
+            for name in link_members.get(reference.name, [reference.name])
         ]
     expanded.order = [*expanded.parameters, *expanded.types, *expanded.agents, *expanded.links, *expanded.robots]
     return expanded
