@@ -375,3 +375,38 @@ def test_a_robot_names_a_link_family_as_it_is_declared_and_holds_every_member() 
     assert said == [
         "robot `oneRobot/r` refers to link `alpha,worker[1..2]`, but `worker[1..2]/a` is not one of its agents"
     ]
+
+
+def test_a_quantifier_index_that_hides_the_family_s_or_an_outer_one_is_r015() -> None:
+    # inside `d[K in 1..N]/ve`, `any(K in 1..N: …)` made every `K` of its body the quantifier's, silently
+    text = """\
+system sh
+
+param N: int = 2
+
+a/a {
+    cs {
+        period 1 ms
+        c[K in 1..N]/ob: double
+    }
+    d[K in 1..N]/ve {
+        period 1 ms
+        v[J in 1..N]/ib: double
+        p/pp = any(K in 1..N: v[K]/ib > 0.0)
+        q/pp = any(J in 1..N: any(J in 1..N: v[J]/ib > 0.0))
+        r/pp = any(I in 1..N: v[I]/ib > 0.0)
+    }
+    link cs,d[K in 1..N]: cs.c[K] -> d[K]/ve.v[1]
+}
+"""
+    with pytest.raises(earl.EarlError) as refused:
+        earl.loads(text, "sh.earl")
+    said = [
+        (d.code, d.message, d.location.line, d.location.column)
+        for d in refused.value.diagnostics
+        if d.location is not None
+    ]
+    assert said == [
+        ("EARL-R015", "the index `K` is already in use here", 13, 16),
+        ("EARL-R015", "the index `J` is already in use here", 14, 31),
+    ]

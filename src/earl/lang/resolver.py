@@ -1052,6 +1052,14 @@ class Resolver:
                     self.unknown_name(node, node_scope)
                 continue
             if isinstance(node, Quantifier):
+                if node.index in node_scope:  # it would hide the family's (or outer quantifier's) index
+                    self.error(
+                        f"the index `{node.index}` is already in use here",
+                        node.location,
+                        "EARL-R015",
+                        f"give `{node.quantifier}` another index letter: inside it, `{node.index}` would no longer "
+                        "be the one outside",
+                    )
                 for bound in (node.first, node.last):
                     stack.append((bound, node_scope))
                 first = self.constant_integer(node.first, node_scope, "the first index of `any`/`all`")
