@@ -48,7 +48,7 @@ READING_CODES: dict[str, str] = {
     "EARL-R012": "an unknown data type",
     "EARL-R013": "a negative array size, or a value of more than ten million elements",
     "EARL-R014": "a constant or index that is not a whole number",
-    "EARL-R015": "a family index already in use",
+    "EARL-R015": "an index already in use (a family's or a quantifier's)",
     "EARL-R016": "an empty or negative family range",
     "EARL-R017": "a family range too large, or families that multiply beyond 4,000,000 elements",
     "EARL-R018": "a FIFO without room for a message, or with an unknown overflow policy (a model built in Python)",
