@@ -731,6 +731,32 @@ CASES: list[Case] = [
         BASE,
     ),
     Case(
+        "EARL-W047",
+        edit(("        take/pf(inp/ib -> y/mo)\n", "        take/pf(inp/ib, inp/ib -> y/mo)\n")),
+        27,
+        25,
+        "`take/pf` of a2/a.cs reads `inp/ib` twice",
+        BASE,
+    ),
+    Case(
+        "EARL-W047",
+        edit(
+            ("            tf = {compute/pf} then {emit/pf}", "            tf = {compute/pf, compute/pf} then {emit/pf}")
+        ),
+        11,
+        31,
+        "stage 1 of `run/bb` of a1/a.cs runs `compute/pf` twice",
+        BASE,
+    ),
+    Case(
+        "EARL-W047",
+        edit(("    a2/a\n    link a1,a2\n", "    a2/a\n    a1/a\n    link a1,a2\n")),
+        45,
+        5,
+        "robot `r/r` holds `a1/a` twice",
+        BASE,
+    ),
+    Case(
         "EARL-E044",
         edit(("        take/pf(inp/ib -> y/mo)\n", '        take/pf(inp/ib -> y/mo) = python "take"\n')),
         27,

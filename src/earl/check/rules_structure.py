@@ -7,6 +7,7 @@ from collections.abc import Iterator
 from earl.check.context import CheckContext
 from earl.check.registry import Finding, rule
 from earl.diagnostics import Severity
+from earl.model.expressions import ElementReference
 from earl.model.kinds import KIND_TITLES, Kind
 from earl.model.text import instance_name, reference_text, subsystem_name
 
@@ -206,3 +207,42 @@ def implementations_name_a_function(context: CheckContext) -> Iterator[Finding]:
                     location,
                     'write `python "module:function"`, e.g. `python "robot.arm:move"`',
                 )
+
+
+@rule("EARL-W047", Severity.WARNING, "a list says each thing once", "§2.1, §2.2")
+def lists_say_each_thing_once(context: CheckContext) -> Iterator[Finding]:
+    """What a partial transition function or a Python predicate reads and writes, the functions of one stage,
+    the agents and links of a robot: each is named once. A repeat changes nothing when the system runs (a
+    set is meant), so it is a slip, often for another name that was meant and is now missing."""
+    for agent, subsystem in context.distinct_subsystems():
+        owner = subsystem_name(agent, subsystem)
+        lists: list[tuple[str, list[ElementReference]]] = []
+        for function in subsystem.partial_transition_functions:
+            lists.append((f"`{function.name}/pf` of {owner} reads", function.reads))
+            lists.append((f"`{function.name}/pf` of {owner} writes", function.writes))
+        for predicate in subsystem.primitive_predicates:
+            lists.append((f"`{predicate.name}/pp` of {owner} reads", predicate.reads))
+        for behaviour in subsystem.basic_behaviours:
+            for number, stage in enumerate(behaviour.transition_function.stages, start=1):
+                lists.append((f"stage {number} of `{behaviour.name}/bb` of {owner} runs", stage))
+        for stage_set in subsystem.stage_sets:
+            lists.append((f"the stage set `{stage_set.name}` of {owner} holds", stage_set.functions))
+        yield from _repeats(lists)
+    for robot in context.declared.robots:
+        yield from _repeats(
+            [(f"robot `{robot.name}/r` holds", robot.agents), (f"robot `{robot.name}/r` refers to", robot.links)]
+        )
+
+
+def _repeats(lists: list[tuple[str, list[ElementReference]]]) -> Iterator[Finding]:
+    for what, references in lists:
+        named: set[str] = set()
+        for reference in references:
+            text = reference.name if reference.kind is Kind.INTER_AGENT_LINK else reference_text(reference)
+            if text in named:
+                yield Finding(
+                    f"{what} `{text}` twice",
+                    reference.location,
+                    "name it once; was another name meant?",
+                )
+            named.add(text)
