@@ -584,3 +584,34 @@ def test_the_agents_table_names_every_robot_a_family_drawn_once_belongs_to(tmp_p
     assert main(["doc", str(spec), "-o", str(tmp_path / "site")]) == 0
     markdown = (tmp_path / "site" / "index.md").read_text(encoding="utf-8")
     assert "| [`worker[K]/a`](#agent-worker-K-a) | `fleetRobot/r, otherRobot/r` |" in markdown
+
+
+def _summary(spec: Path, site: Path, *options: str) -> str:
+    """The overview's first paragraph: how many agents, which robot holds which, how many links."""
+    assert main(["doc", str(spec), *options, "-o", str(site)]) in (0, 1)
+    lines = (site / "index.md").read_text(encoding="utf-8").splitlines()
+    return lines[lines.index("## System " + lines[0].split(":")[0].removeprefix("# ")) + 2]
+
+
+def test_the_summary_says_which_robot_holds_which_agent(tmp_path: Path) -> None:
+    """mobile_robot's coordinator/a belongs to no robot: the overview must not put both agents in
+    mobileRobot/r."""
+    summary = _summary(ROOT / "examples" / "mobile_robot" / "system.earl", tmp_path / "mobile")
+    assert summary.startswith(
+        "2 agents. mobileRobot/r holds base/a; coordinator/a belongs to no robot. 2 inter-agent links. "
+    )
+
+
+def test_the_summary_counts_members_of_agent_and_link_families(tmp_path: Path) -> None:
+    """fleet: `worker[K in 1..3]/a`, members 1 and 2 in fleetRobot/r, and two link families of three
+    links each; declared and concrete counts are both said, and member 3 is in no robot."""
+    spec = Path(__file__).parent / "doc_specs" / "fleet" / "system.earl"
+    assert _summary(spec, tmp_path / "declared").startswith(
+        "2 agents (4 once the family worker[K]/a is expanded). fleetRobot/r holds boss/a, worker[1]/a and "
+        "worker[2]/a; worker[3]/a belongs to no robot. 2 inter-agent links declared, 2 of them link families: "
+        "6 once expanded. "
+    )
+    assert _summary(spec, tmp_path / "expanded", "--expand").startswith(
+        "4 agents. fleetRobot/r holds boss/a, worker[1]/a and worker[2]/a; worker[3]/a belongs to no robot. "
+        "6 inter-agent links. "
+    )

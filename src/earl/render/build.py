@@ -23,7 +23,7 @@ from earl.render.targets import TargetError, all_subsystems, find_agent, find_be
 from earl.render.views.activity import activity_view
 from earl.render.views.agent import agent_view
 from earl.render.views.fsm import fsm_view
-from earl.render.views.system import system_view
+from earl.render.views.system import Placement, robot_placements, system_view
 from earl.render.views.types import agent_types, types_view
 
 VIEWS = ("system", "agent", "fsm", "activity", "types")
@@ -48,6 +48,11 @@ class Subject:
     @property
     def shown(self) -> System:
         return self.context.system if self.expand else self.declared
+
+    @cached_property
+    def placements(self) -> dict[int, Placement]:
+        """By the shown agent's `id`: the robots that hold it, and which members of a family each holds."""
+        return robot_placements(self.shown, self.context.system, self.context.instances)
 
     def agent_type(self, agent: Agent) -> AgentType | None:
         """Table 1's row for an agent; the checker computes it (families count every member)."""

@@ -12,7 +12,7 @@ element it is about.  Names in tables and expressions link to where they are def
 from __future__ import annotations
 
 import re
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
 from earl import __version__
@@ -57,7 +57,13 @@ from earl.render.tables import (
 from earl.render.views.activity import activity_view
 from earl.render.views.agent import agent_links, agent_view
 from earl.render.views.fsm import fsm_view
-from earl.render.views.system import InterAgentLink, inter_agent_links, robot_numbers, system_view
+from earl.render.views.system import (
+    InterAgentLink,
+    inter_agent_links,
+    member_list,
+    robot_numbers,
+    system_view,
+)
 from earl.render.views.types import agent_types, closure, types_view
 
 _REFERENCE = re.compile(r"\b([A-Za-z_]\w*)((?:\[[^\]]*\])?)/(pp|ib|ob|mi|mo|m|bb|pf)\b")
@@ -192,13 +198,10 @@ class DocumentBuilder:
     # ------------------------------------------------------------------ §3.1: the system
     def overview(self, system: System) -> Section:
         section = Section(text(f"System {system.name}"), "system", 2)
-        robots = ", ".join(f"{r.name}/r" for r in system.robots)
         section.add(
             Paragraph(
                 text(
-                    f"{len(system.agents)} agent{'s' if len(system.agents) != 1 else ''}"
-                    + (f" in {robots}" if robots else "")
-                    + f", {len(system.links)} inter-agent link{'s' if len(system.links) != 1 else ''}. "
+                    f"{self.agents_summary(system)} {self.links_summary(system)} "
                     "The type of each agent is computed from its subsystems and links as in the manual's Table 1."
                 )
             )
@@ -214,6 +217,48 @@ class DocumentBuilder:
                 diagram = Diagram(diagram.view, diagram.header, diagram.dot, "types-between-agents", diagram.names)
                 section.add(self.figure(diagram, "dataTypes transmitted between the agents (cf. Figure 9)"))
         return section
+
+    def agents_summary(self, system: System) -> str:
+        """How many agents, and which robot holds which: `2 agents. mobileRobot/r holds base/a;
+        coordinator/a belongs to no robot.`  A family drawn once counts once, and the sentence says how
+        many agents it stands for; a robot holding some of its members names them (`worker[1]/a`)."""
+        families = [a for a in system.agents if a.family is not None and a.index is None]
+        sentence = _count(len(system.agents), "agent")
+        if families:
+            expanded = sum(len(self.subject.context.instances(agent)) for agent in system.agents)
+            names = _and(agent_name(agent) for agent in families)
+            sentence += f" ({expanded} once the famil{'ies' if len(families) > 1 else 'y'} {names} {'are' if len(families) > 1 else 'is'} expanded)"
+        if not system.robots:
+            return sentence + "; the specification declares no robot."
+        placements = self.subject.placements
+        clauses = []
+        for number, robot in enumerate(system.robots):
+            held = []
+            for agent in system.agents:
+                for share in placements[id(agent)].shares:
+                    if share.robot == number:
+                        held += [agent_name(agent)] if share.members is None else member_list(agent, share.members)
+            clauses.append(f"{robot.name}/r holds {_and(held) if held else 'no agent'}")
+        outside = []
+        for agent in system.agents:
+            placement = placements[id(agent)]
+            if not placement.shares:
+                outside.append(agent_name(agent))
+            elif placement.outside:
+                outside += member_list(agent, placement.outside)
+        if outside:
+            clauses.append(f"{_and(outside)} belong{'' if len(outside) > 1 else 's'} to no robot")
+        return f"{sentence}. " + "; ".join(clauses) + "."
+
+    def links_summary(self, system: System) -> str:
+        """How many inter-agent links: a link family (`link boss,worker[K in 1..N]`) is one declaration
+        standing for a link per member, and the sentence counts both."""
+        families = [link for link in system.links if link.family is not None and link.index is None]
+        sentence = _count(len(system.links), "inter-agent link")
+        if families:
+            concrete = len(self.subject.context.system.links)
+            sentence += f" declared, {len(families)} of them link famil{'y' if len(families) == 1 else 'ies'}: {concrete} once expanded"
+        return sentence + "."
 
     def agents_table(self, system: System) -> Table:
         context = self.subject.context
@@ -632,6 +677,16 @@ def _cs(agent: Agent) -> Subsystem:
     cs = agent.control_subsystem
     assert cs is not None  # inter_agent_links only returns agents with a control subsystem
     return cs
+
+
+def _count(number: int, noun: str) -> str:
+    return f"{number} {noun}{'' if number == 1 else 's'}"
+
+
+def _and(names: Iterable[str]) -> str:
+    """`a`, `a and b`, `a, b and c`."""
+    listed = list(names)
+    return listed[0] if len(listed) == 1 else ", ".join(listed[:-1]) + " and " + listed[-1]
 
 
 def _type_words(written: str) -> list[str]:

@@ -6,7 +6,7 @@ The Input and Output Buffers of the Control Subsystems are the ends of the links
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from earl.model.elements import Agent, Link, System
@@ -168,6 +168,109 @@ def system_view(system: System, agent_type: AgentTypeOf = lambda agent: None) ->
     for statement in link_nodes.get(None, []) + edges:
         graph.add(statement)
     return Diagram("system", graph.header, graph.source(), "system", (*names, *link_names))
+
+
+#: The concrete agents a shown agent stands for: itself, or every member of a family drawn once.
+Instances = Callable[[Agent], list[Agent]]
+
+
+@dataclass(frozen=True)
+class RobotShare:
+    """The part of one shown agent a robot holds."""
+
+    robot: int  # the robot's number in `system.robots`
+    #: the family members it holds (`worker[1]`, `worker[2]`), or None when it holds the whole agent
+    members: tuple[int, ...] | None = None
+
+
+@dataclass(frozen=True)
+class Placement:
+    """Where the robots put one shown agent.
+
+    A family drawn once may be split: `fleetRobot/r` lists `worker[1]/a`, `otherFleet/r` lists
+    `worker[2]/a`, and `worker[3]/a` belongs to no robot; then no robot holds the family as a whole.
+    """
+
+    shares: tuple[RobotShare, ...] = ()
+    #: the members of a family drawn once that no robot lists (a family in no robot at all has no shares)
+    outside: tuple[int, ...] = ()
+
+    @property
+    def robot(self) -> int | None:
+        """The robot that holds all of the agent, where it is drawn; None when none does."""
+        if len(self.shares) == 1 and self.shares[0].members is None and not self.outside:
+            return self.shares[0].robot
+        return None
+
+    @property
+    def split(self) -> bool:
+        """Its members are in different robots, or some in a robot and others in none."""
+        return any(share.members is not None for share in self.shares)
+
+
+def robot_placements(
+    shown: System, concrete: System | None = None, instances: Instances | None = None
+) -> dict[int, Placement]:
+    """By the shown agent's `id`: which robots hold it, and which of its members each holds.
+
+    `concrete` is the expanded system (its robots list members: `worker[1]`, or every member for
+    `worker`) and `instances` gives a shown agent's members in it; without them `shown` is taken as
+    concrete.  A member two robots list belongs to the first (the checker reports the second).
+    """
+    concrete = shown if concrete is None else concrete
+    members_of: Instances = instances if instances is not None else (lambda agent: [agent])
+    agents_by_key = {element_key(a, Kind.AGENT): a for a in concrete.agents}
+    robot_of: dict[int, int] = {}
+    for number, robot in enumerate(concrete.robots):
+        for reference in robot.agents:
+            for agent in _robot_members(reference, agents_by_key):
+                robot_of.setdefault(id(agent), number)
+    placements: dict[int, Placement] = {}
+    for agent in shown.agents:
+        members = members_of(agent) or [agent]
+        if agent.family is None or agent.index is not None:
+            # one agent, or one member of an expanded family: wholly in a robot or in none
+            whole = robot_of.get(id(members[0]))
+            placements[id(agent)] = Placement(() if whole is None else (RobotShare(whole),))
+            continue
+        held: dict[int, list[int]] = {}
+        outside: list[int] = []
+        for member in members:
+            index = member.index if member.index is not None else 0
+            holder = robot_of.get(id(member))
+            if holder is None:
+                outside.append(index)
+            else:
+                held.setdefault(holder, []).append(index)
+        if not held:
+            placements[id(agent)] = Placement()
+        elif len(held) == 1 and not outside:
+            placements[id(agent)] = Placement((RobotShare(next(iter(held))),))
+        else:
+            shares = tuple(RobotShare(number, tuple(held[number])) for number in sorted(held))
+            placements[id(agent)] = Placement(shares, tuple(outside))
+    return placements
+
+
+def member_list(agent: Agent, members: Sequence[int]) -> list[str]:
+    """`worker[1]/a`, `worker[3]/a`: members of a family drawn once, by their numbers."""
+    return [f"{agent.name}[{index}]/a" for index in members]
+
+
+def member_names(agent: Agent, members: Sequence[int]) -> str:
+    return ", ".join(member_list(agent, members))
+
+
+def robot_text(system: System, agent: Agent, placement: Placement) -> str:
+    """Table 1's robot column: `fleetRobot/r`; for a split family `fleetRobot/r (worker[1]/a),
+    otherFleet/r (worker[2]/a), no robot (worker[3]/a)`; `—` for an agent in no robot."""
+    parts = []
+    for share in placement.shares:
+        name = f"{system.robots[share.robot].name}/r"
+        parts.append(name if share.members is None else f"{name} ({member_names(agent, share.members)})")
+    if parts and placement.outside:
+        parts.append(f"no robot ({member_names(agent, placement.outside)})")
+    return ", ".join(parts) or "—"
 
 
 def robot_numbers(system: System) -> dict[int, int]:
