@@ -7,6 +7,7 @@ diagram kind.  Needs Graphviz's `dot` (scripts/setup.sh installs it).
 
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
 import xml.etree.ElementTree as ElementTree
@@ -390,3 +391,72 @@ def test_the_fsm_view_shows_what_each_state_waits_for_and_how_long(system: Syste
     diagram, and the document that shows it, say it under the state's behaviour."""
     drawn = svg_text(build_diagram(system, "fsm", "manip/a.cs").svg())
     assert "obligatory motorControllerState[*]/ib;" in drawn and "timeout 4 ms" in drawn
+
+
+SPLIT_FAMILY = """\
+system robots
+
+fleetRobot/r {
+    worker[1]/a
+}
+
+otherFleet/r {
+    worker[2]/a
+}
+
+allRobot/r {
+    helper[1]/a
+    helper[2]/a
+}
+
+worker[K in 1..3]/a {
+    cs {
+        period 10 ms
+    }
+}
+
+helper[K in 1..2]/a {
+    cs {
+        period 10 ms
+    }
+}
+
+supervisor/a {
+    cs {
+        period 100 ms
+    }
+}
+"""
+
+
+def _clusters(dot: str) -> dict[str, str]:
+    """The statements inside each robot's cluster of a system view's DOT text, by the cluster's name."""
+    clusters = {}
+    for part in dot.split("subgraph cluster_robot_")[1:]:
+        body = part[: part.index("\n    }")]
+        clusters[re.search(r"<b>([^<]+)</b>", body).group(1)] = body  # type: ignore[union-attr]
+    return clusters
+
+
+def test_a_family_split_over_robots_is_drawn_outside_them_naming_where_each_member_is() -> None:
+    """`worker[1]/a` in fleetRobot/r, `worker[2]/a` in otherFleet/r, `worker[3]/a` in no robot: drawn once,
+    the family is in no robot, and each robot holds a dashed stand-in for its members, tied to the family.
+    `helper[K]/a`, whose members are all in allRobot/r, is drawn inside it."""
+    system = earl.loads(SPLIT_FAMILY, "robots.earl")
+    diagram = build_diagram(system, "system")
+    clusters = _clusters(diagram.dot)
+    assert "worker[1]/a" in clusters["fleetRobot/r"] and "worker[2]/a" not in clusters["fleetRobot/r"]
+    assert "worker[2]/a" in clusters["otherFleet/r"] and "worker[1]/a" not in clusters["otherFleet/r"]
+    assert all("n_agent_worker_K__a [" not in body for body in clusters.values())
+    assert "n_agent_helper_K__a [" in clusters["allRobot/r"]
+    drawn = svg_text(diagram.svg())
+    for line in ("fleetRobot/r: worker[1]/a", "otherFleet/r: worker[2]/a", "no robot: worker[3]/a"):
+        assert line in drawn
+    mermaid = mermaid_of(Subject(system), "system", None)
+    other_fleet = mermaid[mermaid.index("«Robot» otherFleet/r") :].split("    end")[0]
+    assert "worker[2]/a<br/>member of worker[K]/a" in other_fleet
+    assert "no robot: worker[3]/a" in mermaid
+    # every member drawn: each in the robot that lists it, worker[3]/a in none
+    expanded = _clusters(build_diagram(system, "system", expand=True).dot)
+    assert "n_agent_worker_1__a [" in expanded["fleetRobot/r"] and "n_agent_worker_2__a [" in expanded["otherFleet/r"]
+    assert all("n_agent_worker_3__a [" not in body for body in expanded.values())

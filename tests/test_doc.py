@@ -583,7 +583,20 @@ def test_the_agents_table_names_every_robot_a_family_drawn_once_belongs_to(tmp_p
     spec.write_text(fleet.replace("    worker[2]/a\n}\n", "    worker[2]/a\n}\n\notherRobot/r {\n    worker[3]/a\n}\n"))
     assert main(["doc", str(spec), "-o", str(tmp_path / "site")]) == 0
     markdown = (tmp_path / "site" / "index.md").read_text(encoding="utf-8")
-    assert "| [`worker[K]/a`](#agent-worker-K-a) | `fleetRobot/r, otherRobot/r` |" in markdown
+    row = (
+        "| [`worker[K]/a`](#agent-worker-K-a) | `fleetRobot/r (worker[1]/a, worker[2]/a), otherRobot/r (worker[3]/a)` |"
+    )
+    assert row in markdown
+
+
+def test_the_agents_table_says_which_members_of_a_family_drawn_once_are_in_no_robot(tmp_path: Path) -> None:
+    """fleet's robot lists `worker[1]/a` and `worker[2]/a` only: the family's row must not put all of
+    `worker[K]/a` in fleetRobot/r."""
+    spec = Path(__file__).parent / "doc_specs" / "fleet" / "system.earl"
+    assert main(["doc", str(spec), "-o", str(tmp_path / "site")]) == 0
+    markdown = (tmp_path / "site" / "index.md").read_text(encoding="utf-8")
+    row = "| [`worker[K]/a`](#agent-worker-K-a) | `fleetRobot/r (worker[1]/a, worker[2]/a), no robot (worker[3]/a)` |"
+    assert row in markdown
 
 
 def _summary(spec: Path, site: Path, *options: str) -> str:

@@ -76,7 +76,7 @@ def diagram_of(subject: Subject, view: str, target: str | None) -> Diagram:
     if view == "system":
         if target is not None:
             raise TargetError("the system view shows the whole system; leave out --target")
-        return system_view(system, subject.agent_type)
+        return system_view(system, subject.agent_type, subject.placements)
     if view == "agent":
         agent = find_agent(system, target) if target is not None else _only_agent(system)
         return agent_view(agent, system)

@@ -31,7 +31,8 @@ def diagram_for(element: object) -> Diagram | None:
     if isinstance(element, System):
         from earl.render.build import Subject
 
-        return system_view(element, Subject(element).agent_type)
+        subject = Subject(element)
+        return system_view(element, subject.agent_type, subject.placements)
     if isinstance(element, Agent):
         return agent_view(element)
     if isinstance(element, Subsystem):

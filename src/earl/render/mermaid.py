@@ -7,13 +7,12 @@ links agents directly (the buffers go in the link's label) and a transition from
 
 from __future__ import annotations
 
-from earl.model.elements import FSM, Subsystem
-from earl.model.kinds import Kind
+from earl.model.elements import FSM, Agent, Subsystem
 from earl.model.text import expression_text
 from earl.render.build import Subject
-from earl.render.names import agent_name, element_key, link_label, lookup, qualified_subsystem_name
+from earl.render.names import agent_name, link_label, qualified_subsystem_name
 from earl.render.targets import TargetError, find_subsystem, only_fsm
-from earl.render.views.system import inter_agent_links
+from earl.render.views.system import inter_agent_links, member_names, member_placement_lines
 
 
 def text(value: str) -> str:
@@ -29,30 +28,39 @@ def _identifier(prefix: str, name: str) -> str:
 def system_mermaid(subject: Subject) -> str:
     system = subject.shown
     lines = ["---", f"title: ibd [System] {system.name}", "---", "flowchart LR"]
-    agents_by_key = {element_key(a, Kind.AGENT): a for a in system.agents}
-    placed: set[int] = set()
+    placements = subject.placements
 
-    def agent_line(indent: str, agent_index: int) -> str:
-        agent = system.agents[agent_index]
+    def agent_line(indent: str, agent: Agent) -> str:
         name = agent_name(agent)
         row = subject.agent_type(agent)
         kind = f"<br/>{text(row.name)}: {text(row.description)}" if row is not None else ""
-        return f'{indent}{_identifier("a", name)}["«Agent» {text(name)}{kind}"]'
+        # a family split over robots is drawn outside them, saying where its members are
+        where = "".join(f"<br/>{text(line)}" for line in member_placement_lines(system, agent, placements[id(agent)]))
+        return f'{indent}{_identifier("a", name)}["«Agent» {text(name)}{kind}{where}"]'
 
-    positions = {id(a): n for n, a in enumerate(system.agents)}
+    member_edges: list[str] = []
     for number, robot in enumerate(system.robots):
         lines.append(f'    subgraph robot_{number}["«Robot» {text(robot.name)}/r"]')
-        for reference in robot.agents:
-            found = lookup(agents_by_key, reference)
-            members = [found] if found is not None else [a for k, a in agents_by_key.items() if k[0] == reference.name]
-            for agent in members:
-                if id(agent) not in placed:
-                    placed.add(id(agent))
-                    lines.append(agent_line("        ", positions[id(agent)]))
+        for agent in system.agents:
+            placement = placements[id(agent)]
+            if placement.robot == number:
+                lines.append(agent_line("        ", agent))
+                continue
+            for share in placement.shares:
+                if share.robot == number and share.members is not None:
+                    # the members this robot holds, as a stand-in tied to the family drawn outside
+                    stand_in = _identifier(f"m{number}", agent_name(agent))
+                    held = member_names(agent, share.members)
+                    plural = "s" if len(share.members) > 1 else ""
+                    lines.append(
+                        f'        {stand_in}(["«Agent» {text(held)}<br/>member{plural} of {text(agent_name(agent))}"])'
+                    )
+                    member_edges.append(f"    {stand_in} -.- {_identifier('a', agent_name(agent))}")
         lines.append("    end")
     for agent in system.agents:
-        if id(agent) not in placed:
-            lines.append(agent_line("    ", positions[id(agent)]))
+        if placements[id(agent)].robot is None:
+            lines.append(agent_line("    ", agent))
+    lines += member_edges
     for link in inter_agent_links(system):
         label = f"{link_label(link.link)}: {link.source_end}/ob → {link.destination_end}/ib : {link.data_type}"
         source = _identifier("a", agent_name(link.source))

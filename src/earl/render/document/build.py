@@ -61,7 +61,7 @@ from earl.render.views.system import (
     InterAgentLink,
     inter_agent_links,
     member_list,
-    robot_numbers,
+    robot_text,
     system_view,
 )
 from earl.render.views.types import agent_types, closure, types_view
@@ -207,7 +207,12 @@ class DocumentBuilder:
             )
         )
         section.add(self.agents_table(system))
-        section.add(self.figure(system_view(system, self.subject.agent_type), "Structure of the system (cf. Figure 8)"))
+        section.add(
+            self.figure(
+                system_view(system, self.subject.agent_type, self.subject.placements),
+                "Structure of the system (cf. Figure 8)",
+            )
+        )
         links = inter_agent_links(system)
         if links:
             section.add(self.links_table(links))
@@ -267,15 +272,10 @@ class DocumentBuilder:
             + [cell(f"|{kind}|") for kind in ("cs", "ve", "re", "vr", "rr", "aa")]
         ]
         rows = []
-        robot_of = robot_numbers(system)
         for agent in system.agents:
             name = agent_name(agent)
-            if agent.family is not None and agent.index is None:
-                # a family drawn once: every robot that lists one of its members (or all of them)
-                robots = [f"{r.name}/r" for r in system.robots if any(a.name == agent.name for a in r.agents)]
-                robot = ", ".join(robots) or "—"
-            else:
-                robot = f"{system.robots[robot_of[id(agent)]].name}/r" if id(agent) in robot_of else "—"
+            # a family drawn once may be split over robots: the cell names the members each holds
+            robot = robot_text(system, agent, self.subject.placements[id(agent)])
             row = self.subject.agent_type(agent)
             instances = context.instances(agent) or [agent]
             first = instances[0]

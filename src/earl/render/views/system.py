@@ -93,8 +93,13 @@ def end_name(buffer: Indexed, reference: ElementReference | None) -> str:
     return indexed_name(buffer)
 
 
-def system_view(system: System, agent_type: AgentTypeOf = lambda agent: None) -> Diagram:
+def system_view(
+    system: System, agent_type: AgentTypeOf = lambda agent: None, placements: dict[int, Placement] | None = None
+) -> Diagram:
+    """`placements` (from `robot_placements`) say which robots hold which members of a family drawn
+    once; without them every agent is taken as concrete (the system is an expanded one)."""
     graph = Graph(f"ibd [System] {system.name}")
+    placements = robot_placements(system) if placements is None else placements
     links = inter_agent_links(system)
     ports_in: dict[int, list[Port]] = {id(a): [] for a in system.agents}
     ports_out: dict[int, list[Port]] = {id(a): [] for a in system.agents}
@@ -111,6 +116,10 @@ def system_view(system: System, agent_type: AgentTypeOf = lambda agent: None) ->
         nodes[id(agent)] = node_id("agent", name)
         title = ["<i>«Agent»</i>", f"<b>{html(name)}</b>"]
         notes = [note for note in (family_note(agent),) if note]
+        placement = placements[id(agent)]
+        if placement.split:
+            # no robot holds the whole family: it is drawn outside the robots, saying where its members are
+            notes += member_placement_lines(system, agent, placement)
         row = agent_type(agent)
         if row is not None:
             notes.append(f"{row.name}: {row.description}")
@@ -123,17 +132,31 @@ def system_view(system: System, agent_type: AgentTypeOf = lambda agent: None) ->
         statements[id(agent)] = f'{nodes[id(agent)]} [shape="plain", label={label}, tooltip="{html(name)}"];'
 
     positions = {id(agent): position for position, agent in enumerate(system.agents)}
-    agents_by_key = {element_key(a, Kind.AGENT): a for a in system.agents}
-    #: robot number of each agent a robot lists (the first robot that lists it)
-    robot_of: dict[int, int] = {}
-    members: list[list[Agent]] = []
-    for number, robot in enumerate(system.robots):
-        members.append([])
-        for reference in robot.agents:
-            for agent in _robot_members(reference, agents_by_key):
-                if id(agent) not in robot_of:
-                    robot_of[id(agent)] = number
-                    members[number].append(agent)
+    #: what each robot draws inside it: whole agents, and for a split family a dashed stand-in naming
+    #: the members the robot holds, tied by a dotted line to the family drawn outside the robots
+    inside: list[list[str]] = [[] for _ in system.robots]
+    member_edges: list[str] = []
+    for agent in system.agents:
+        placement = placements[id(agent)]
+        if placement.robot is not None:
+            inside[placement.robot].append(statements[id(agent)])
+            continue
+        for share in placement.shares:
+            if share.members is None:
+                continue
+            held = member_names(agent, share.members)
+            stand_in = node_id("members", str(share.robot), agent_name(agent))
+            label = (
+                f'<<i>«Agent»</i><br/><b>{html(held)}</b><br/><font point-size="9" color="#555555">'
+                f"member{'s' if len(share.members) > 1 else ''} of {html(agent_name(agent))}</font>>"
+            )
+            inside[share.robot].append(
+                f'{stand_in} [shape="box", style="dashed,rounded", color="#777777", label={label}, tooltip="{html(held)}"];'
+            )
+            member_edges.append(
+                f'{stand_in} -> {nodes[id(agent)]} [style="dotted", arrowhead="none", color="#777777", '
+                f'tooltip="{html(held)} in {html(system.robots[share.robot].name)}/r"];'
+            )
 
     # A link's label node sits in the robot that holds both its ends: dot keeps a cluster's nodes in one
     # band of ranks, so a label node outside it would squeeze every agent of the robot into one column.
@@ -147,7 +170,8 @@ def system_view(system: System, agent_type: AgentTypeOf = lambda agent: None) ->
         destination = f"{nodes[id(link.destination)]}:{_port('ib', link.destination_end)}:w"
         backward = positions[id(link.destination)] < positions[id(link.source)]
         node, *link_edges = link_statements(number, source, destination, name, link.data_type, backward)
-        source_robot, destination_robot = robot_of.get(id(link.source)), robot_of.get(id(link.destination))
+        source_robot = placements[id(link.source)].robot
+        destination_robot = placements[id(link.destination)].robot
         shared = source_robot if source_robot == destination_robot else None
         link_nodes.setdefault(shared, []).append(node)
         edges.extend(link_edges)
@@ -157,15 +181,15 @@ def system_view(system: System, agent_type: AgentTypeOf = lambda agent: None) ->
         names.append(robot_name)
         graph.add(f"subgraph cluster_robot_{number} {{")
         graph.add(f'  label=<<i>«Robot»</i> <b>{html(robot_name)}</b>>; style="dashed,rounded"; color="#777777";')
-        for agent in members[number]:
-            graph.add("  " + statements[id(agent)])
+        for statement in inside[number]:
+            graph.add("  " + statement)
         for node in link_nodes.get(number, []):
             graph.add("  " + node)
         graph.add("}")
     for agent in system.agents:
-        if id(agent) not in robot_of:
+        if placements[id(agent)].robot is None:
             graph.add(statements[id(agent)])
-    for statement in link_nodes.get(None, []) + edges:
+    for statement in link_nodes.get(None, []) + edges + member_edges:
         graph.add(statement)
     return Diagram("system", graph.header, graph.source(), "system", (*names, *link_names))
 
@@ -261,6 +285,18 @@ def member_names(agent: Agent, members: Sequence[int]) -> str:
     return ", ".join(member_list(agent, members))
 
 
+def member_placement_lines(system: System, agent: Agent, placement: Placement) -> list[str]:
+    """`fleetRobot/r: worker[1]/a`, …, `no robot: worker[3]/a`: where a split family's members are."""
+    lines = [
+        f"{system.robots[share.robot].name}/r: {member_names(agent, share.members)}"
+        for share in placement.shares
+        if share.members is not None
+    ]
+    if placement.outside:
+        lines.append(f"no robot: {member_names(agent, placement.outside)}")
+    return lines
+
+
 def robot_text(system: System, agent: Agent, placement: Placement) -> str:
     """Table 1's robot column: `fleetRobot/r`; for a split family `fleetRobot/r (worker[1]/a),
     otherFleet/r (worker[2]/a), no robot (worker[3]/a)`; `—` for an agent in no robot."""
@@ -271,18 +307,6 @@ def robot_text(system: System, agent: Agent, placement: Placement) -> str:
     if parts and placement.outside:
         parts.append(f"no robot ({member_names(agent, placement.outside)})")
     return ", ".join(parts) or "—"
-
-
-def robot_numbers(system: System) -> dict[int, int]:
-    """By the agent's `id`: the number of the first robot that lists it (one agent, one member of a
-    family, or every member); agents of no robot are absent."""
-    agents_by_key = {element_key(a, Kind.AGENT): a for a in system.agents}
-    robot_of: dict[int, int] = {}
-    for number, robot in enumerate(system.robots):
-        for reference in robot.agents:
-            for agent in _robot_members(reference, agents_by_key):
-                robot_of.setdefault(id(agent), number)
-    return robot_of
 
 
 def _robot_members(reference: ElementReference, agents: dict[Key, Agent]) -> list[Agent]:
