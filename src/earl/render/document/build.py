@@ -46,7 +46,15 @@ from earl.render.document.tree import (
     text,
     with_code,
 )
-from earl.render.names import agent_name, indexed_name, qualified_subsystem_name, slug, subsystem_name
+from earl.render.names import (
+    Indexed,
+    agent_name,
+    indexed_name,
+    link_label,
+    qualified_subsystem_name,
+    slug,
+    subsystem_name,
+)
 from earl.render.tables import (
     composition_table,
     condition_table,
@@ -59,6 +67,7 @@ from earl.render.views.agent import agent_links, agent_view
 from earl.render.views.fsm import fsm_view
 from earl.render.views.system import (
     InterAgentLink,
+    end_name,
     inter_agent_links,
     member_list,
     robot_text,
@@ -641,12 +650,29 @@ def _buffer_links(system: System, agent: Agent) -> BufferLinks:
         source = qualified_subsystem_name(agent, link.source)
         destination = qualified_subsystem_name(agent, link.destination)
         output, input_ = indexed_name(link.output), indexed_name(link.input)
-        label = ",".join(p.name for p in link.link.name)
+        # A family drawn once has one row per buffer, but a link may reach one member only
+        # (`link cs,mc[2]: cs.special -> mc[2]/ve.boost`): each end is named as the link names it,
+        # and the row of a family's buffer says which member the link starts from or goes into.
+        source_end = _end(link.source, link.link.source.subsystem, link.output, link.link.source.buffer)
+        destination_end = _end(
+            link.destination, link.link.destination.subsystem, link.input, link.link.destination.buffer
+        )
+        label = link_label(link.link)
+        own_source = f"{subsystem_name(link.source)}.{output}"
+        own_destination = f"{subsystem_name(link.destination)}.{input_}"
         table.setdefault((id(link.source), "ob", output), []).append(
-            (slug("ib", destination, input_), f"{destination}.{input_}/ib", label)
+            (
+                slug("ib", destination, input_),
+                f"{agent_name(agent)}.{destination_end}/ib",
+                label if source_end == own_source else f"{label}, from {source_end}",
+            )
         )
         table.setdefault((id(link.destination), "ib", input_), []).append(
-            (slug("ob", source, output), f"{source}.{output}/ob", label)
+            (
+                slug("ob", source, output),
+                f"{agent_name(agent)}.{source_end}/ob",
+                label if destination_end == own_destination else f"{label}, into {destination_end}",
+            )
         )
     for outer in inter_agent_links(system):
         source = qualified_subsystem_name(outer.source, _cs(outer.source))
@@ -671,6 +697,19 @@ def _buffer_links(system: System, agent: Agent) -> BufferLinks:
                 )
             )
     return table
+
+
+def _end(
+    subsystem: Subsystem, subsystem_reference: ElementReference, buffer: Indexed, buffer_reference: ElementReference
+) -> str:
+    """`mc[2]/ve.boost`: a link's end inside an agent as the link names it, a single member where it
+    names one of a family drawn once, else the family (`mc[K]/ve.command`)."""
+    owner = (
+        "cs"
+        if subsystem.kind is Kind.CONTROL_SUBSYSTEM
+        else f"{end_name(subsystem, subsystem_reference)}/{subsystem.kind.value}"
+    )
+    return f"{owner}.{end_name(buffer, buffer_reference)}"
 
 
 def _cs(agent: Agent) -> Subsystem:
