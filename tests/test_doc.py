@@ -672,3 +672,42 @@ def test_the_buffers_table_says_which_member_a_link_reaches_with_its_real_name(t
     assert rows["current/ob"] == "→ [`arm/a.cs.extra/ib`](#ib-arm-a-cs-extra) (mc[3],cs, from mc[3]/ve.current) |"
     assert rows["extra/ib"] == "← [`arm/a.mc[3]/ve.current/ob`](#ob-arm-a-mc-K-ve-current) (mc[3],cs) |"
     assert rows["command/ib"] == "← [`arm/a.cs.cmd[K]/ob`](#ob-arm-a-cs-cmd-K) (cs,mc[K]) |"
+
+
+TWO_WAYS = """\
+system dup
+
+a1/a {
+    cs {
+        period 10 ms
+        c/m: int = 0
+        lo/pp = c/mi < 3
+        hi/pp = c/mi > 5
+        b1/bb {
+            tf = {}
+            tc = lo/pp or hi/pp
+        }
+        fsm {
+            initial one
+            state one: b1/bb
+            state two: b1/bb
+            one -> two when lo/pp priority 1
+            one -> two when hi/pp priority 2
+            two -> one when lo/pp priority 1
+        }
+    }
+}
+"""
+
+
+def test_two_transitions_between_the_same_states_get_distinct_anchors(tmp_path: Path) -> None:
+    """`one -> two when lo/pp` and `one -> two when hi/pp` are both valid and both named `one,two`:
+    each row of Table 5 has its own id, in the HTML and in the Markdown, and every link still resolves."""
+    system = earl.loads(TWO_WAYS, "dup.earl")
+    result = write_site(Subject(system), check(system), tmp_path)
+    page = _Page()
+    page.feed(result.html.read_text(encoding="utf-8"))  # refuses a duplicate id
+    assert {"t-a1-a-cs-one-two", "t-a1-a-cs-one-two-2"} <= page.ids
+    assert sorted(set(page.links) - page.ids) == []
+    ids = re.findall(r'<a id="([^"]+)"></a>', (tmp_path / "index.md").read_text(encoding="utf-8"))
+    assert len(ids) == len(set(ids))

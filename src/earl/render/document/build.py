@@ -479,14 +479,19 @@ class DocumentBuilder:
     def conditions_table(self, subsystem: Subsystem, qualified: str, scope: Scope) -> Table:
         header = [[cell("t"), cell("PREDICATE (initial condition ic)"), cell("priority")]]
         rows: list[list[Cell]] = []
+        #: transitions between the same two states, with different conditions, are valid and share a name:
+        #: the second `one,two` is anchored `…-one-two-2`, so every id of the page stays unique
+        seen: dict[str, int] = {}
         for row in transition_table(subsystem):
+            seen[row.name] = seen.get(row.name, 0) + 1
+            anchor = slug("t", qualified, row.name) + ("" if seen[row.name] == 1 else f"-{seen[row.name]}")
             if row.source is None:
                 name: Content = (Code(f"i,{row.destination}/t"), Text(f" where i ≠ {row.destination}"))
             else:
                 name = code(f"{row.name}/t")
             rows.append(
                 [
-                    cell(name, anchor=slug("t", qualified, row.name)),
+                    cell(name, anchor=anchor),
                     cell(self.expression_content(row.predicate, scope)),
                     cell("—" if row.priority is None else str(row.priority)),
                 ]
