@@ -21,6 +21,7 @@ from earl.check import check
 from earl.cli.main import main
 from earl.render.build import Subject
 from earl.render.document import write_site
+from earl.render.mermaid import mermaid_of
 from earl.render.tables import composition_table, condition_table, memory_table, predicate_table, transition_table
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -213,19 +214,20 @@ def test_markdown_has_table_6_with_bullets_and_every_image(site: Path) -> None:
 
 
 class _Cells(HTMLParser):
-    """The text of every table cell of an HTML page, spaces collapsed."""
+    """The text of every table cell (or of every element `tags` names) of an HTML page, spaces collapsed."""
 
-    def __init__(self) -> None:
+    def __init__(self, tags: tuple[str, ...] = ("td", "th")) -> None:
         super().__init__()
+        self.tags = tags
         self.cells: list[str] = []
         self._text: list[str] | None = None
 
     def handle_starttag(self, tag: str, attrs: list[tuple[str, str | None]]) -> None:
-        if tag in ("td", "th"):
+        if tag in self.tags:
             self._text = []
 
     def handle_endtag(self, tag: str) -> None:
-        if tag in ("td", "th") and self._text is not None:
+        if tag in self.tags and self._text is not None:
             self.cells.append(" ".join("".join(self._text).split()))
             self._text = None
 
@@ -711,3 +713,49 @@ def test_two_transitions_between_the_same_states_get_distinct_anchors(tmp_path: 
     assert sorted(set(page.links) - page.ids) == []
     ids = re.findall(r'<a id="([^"]+)"></a>', (tmp_path / "index.md").read_text(encoding="utf-8"))
     assert len(ids) == len(set(ids))
+
+
+ENTITIES = """\
+system esc
+
+a1/a {
+    cs {
+        period 10 ms
+        s/m: string = "<&>"
+        c/m: int = 0
+        b1/bb {
+            tf = {}
+            tc = c/mi < 3 and s/mi != "&amp;<x>"
+        }
+        fsm {
+            initial one
+            state one: b1/bb
+            state two: b1/bb
+            one -> two when c/mi < 3 and s/mi != "&lt;" priority 1
+        }
+    }
+}
+"""
+
+
+def test_markdown_and_mermaid_show_ampersands_and_entities_as_written(tmp_path: Path) -> None:
+    """A spec's strings `"&amp;<x>"` and `"&lt;"` are shown as written: index.md read as GitHub reads it
+    says in its findings and tables what index.html says, and Mermaid does not turn `&lt;` into `<`."""
+    from markdown_it import MarkdownIt
+
+    system = earl.loads(ENTITIES, "esc.earl")
+    diagnostics = check(system)
+    findings = [d.message for d in diagnostics if '"&amp;<x>"' in d.message]
+    assert findings  # the checker quotes the strings in a finding, which goes into a bullet list
+    write_site(Subject(system), diagnostics, tmp_path)
+    page = (tmp_path / "index.html").read_text(encoding="utf-8")
+    read = MarkdownIt("commonmark").enable("table").render((tmp_path / "index.md").read_text(encoding="utf-8"))
+    assert _markdown_cells_missing_from_the_html(tmp_path) == []
+    shown, written = _Cells(("li",)), _Cells(("li",))
+    shown.feed(page)
+    written.feed(read)
+    assert written.cells == shown.cells
+    assert any('"&amp;<x>"' in item for item in written.cells)
+    assert any('"&amp;<x>"' in cell for cell in _cells(read))
+    mermaid = mermaid_of(Subject(system), "fsm", None)
+    assert "&lt;" not in mermaid and "#38;lt;" in mermaid

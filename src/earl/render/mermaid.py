@@ -16,8 +16,11 @@ from earl.render.views.system import inter_agent_links, member_names, member_pla
 
 
 def text(value: str) -> str:
-    """A Mermaid quoted label: quotes and characters Mermaid reads as markup become entity codes."""
-    replacements = {'"': "#quot;", "<": "#lt;", ">": "#gt;", "#": "#35;", "|": "#124;"}
+    """A Mermaid quoted label: quotes and characters Mermaid reads as markup become entity codes.
+
+    `&` is one of them: Mermaid draws labels as HTML, where a spec's string `"&lt;"` would be shown as
+    `"<"`; written `#38;lt;` it is shown as written."""
+    replacements = {'"': "#quot;", "<": "#lt;", ">": "#gt;", "#": "#35;", "|": "#124;", "&": "#38;"}
     return "".join(replacements.get(c, c) for c in value)
 
 

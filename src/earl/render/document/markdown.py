@@ -28,7 +28,16 @@ from earl.render.document.tree import (
 
 
 def _escape(text: str) -> str:
-    return text.replace("\\", "\\\\").replace("|", "\\|").replace("*", "\\*").replace("_", "\\_").replace("<", "&lt;")
+    """Text that Markdown shows as written.  `&` becomes `&amp;` before `<` becomes `&lt;`: Markdown
+    reads entities in text, so a spec's string `"&amp;<x>"` would otherwise be shown as `"&<x>"`."""
+    return (
+        text.replace("&", "&amp;")
+        .replace("\\", "\\\\")
+        .replace("|", "\\|")
+        .replace("*", "\\*")
+        .replace("_", "\\_")
+        .replace("<", "&lt;")
+    )
 
 
 def _code(text: str, in_table: bool) -> str:
