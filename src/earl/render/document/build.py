@@ -271,7 +271,7 @@ class DocumentBuilder:
         sentence = _count(len(system.links), "inter-agent link")
         if families:
             concrete = len(self.subject.context.system.links)
-            sentence += f" declared, {len(families)} of them link famil{'y' if len(families) == 1 else 'ies'}: {concrete} once expanded"
+            sentence += f" declared, {len(families)} of them {'a link family' if len(families) == 1 else 'link families'}: {concrete} once expanded"
         return sentence + "."
 
     def agents_table(self, system: System) -> Table:
