@@ -23,6 +23,7 @@ from earl.export.sysml_expressions import ExpressionWriter, literal
 from earl.export.sysml_names import Namespace, is_basic_name, name_text, quoted, readable
 from earl.model import (
     Agent,
+    Arithmetic,
     BooleanOperation,
     Comparison,
     ElementReference,
@@ -30,6 +31,7 @@ from earl.model import (
     IndexAccess,
     Kind,
     Literal,
+    Negate,
     Not,
     Read,
     System,
@@ -305,6 +307,23 @@ def test_not_and_comparisons_get_sysml_parentheses() -> None:
     assert (
         writer.text(Comparison("==", Comparison("<", x, Literal(1)), Literal(True))) == "(x_ib.msg.speed < 1) == true"
     )
+
+
+def test_the_operand_of_a_unary_operator_is_a_primary_expression() -> None:
+    """KerML's `UnaryExpression: operator operand=ExtentExpression` takes a primary expression: `not not b`
+    and `--x` are refused by the OMG pilot's grammar, `not (not b)` and `-(-x)` are what EARL means."""
+    b = _read("b", Kind.MEMORY_INPUT)
+    x = _read("x", Kind.MEMORY_INPUT)
+    writer = _writer()
+    assert writer.text(Not(Not(b))) == "not (not b_mi.data)"
+    assert writer.text(Comparison(">", Negate(Negate(x)), Literal(0.0))) == "-(-x_mi.data) > 0.0"
+    assert writer.text(Negate(Literal(-1.0))) == "-(-1.0)"
+    assert writer.text(Negate(Arithmetic("-", x, Literal(1.0)))) == "-(x_mi.data - 1.0)"
+    assert writer.text(Not(Comparison("==", b, Literal(True)))) == "not (b_mi.data == true)"
+    # a unary operand of a binary operator stays bare: the grammar's operands are unary expressions there
+    assert writer.text(Arithmetic("-", x, Literal(-1.0))) == "x_mi.data - -1.0"
+    assert writer.text(Arithmetic("*", Negate(x), x)) == "-x_mi.data * x_mi.data"
+    assert writer.text(BooleanOperation("and", (Not(b), b))) == "not b_mi.data and b_mi.data"
 
 
 def test_indices_move_from_zero_based_to_one_based() -> None:

@@ -4,7 +4,8 @@ The two notations differ in three places that matter:
 
 - `not` is a unary operator in SysML v2 and binds tighter than any binary one,
   where EARL's `not a == b` means `not (a == b)`: operands are parenthesised by
-  SysML's own precedence, never copied from the EARL text;
+  SysML's own precedence, never copied from the EARL text; the operand of a
+  unary operator must be a primary expression (`not (not a)`, `-(-x)`);
 - a read of a buffer or memory goes through the library's `msg` and `data`
   features (`manipulatorCommand_ib.msg.emergencyStopCommand`, manual §2.2);
 - EARL indexes arrays from 0 and SysML's `#(i)` from 1.
@@ -86,10 +87,12 @@ class ExpressionWriter:
             return self._read(expression), _PRIMARY
         if isinstance(expression, Call):
             return self._call(expression), _PRIMARY
+        # KerML's `UnaryExpression: operator operand=ExtentExpression` takes a primary expression (or
+        # `all …`): a unary operand of a unary operator is parenthesised, `not (not a)`, `-(-x)`, never `--x`.
         if isinstance(expression, Not):
-            return "not " + self._operand(expression.operand, _UNARY), _UNARY
+            return "not " + self._operand(expression.operand, _PRIMARY), _UNARY
         if isinstance(expression, Negate):
-            return "-" + self._operand(expression.operand, _UNARY), _UNARY
+            return "-" + self._operand(expression.operand, _PRIMARY), _UNARY
         if isinstance(expression, BooleanOperation):
             own = _OR if expression.operator == "or" else _AND
             parts = [self._operand(operand, own, strict=True) for operand in expression.operands]
