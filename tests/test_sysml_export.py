@@ -495,3 +495,64 @@ def test_a_comment_that_closes_a_block_is_in_the_element_s_doc() -> None:
     assert exported.index("the agent's last word") < exported.index("the subsystem's last word")
     # what ends the file is about no element: an editor's mode line is no doc of the system
     assert "vim" not in export_sysml(earl.loads(text + "// vim: set ft=earl:\n", "closing.earl"))
+
+
+_OPTIONAL_ARRAYS = """system opt
+
+type Row = double[3]
+
+struct Cmd {
+    target: double[3]?
+    path: double[]?
+    must: double[3]
+    row: Row?
+    rows: Row[2]
+}
+
+r1/r {
+    a1/a
+}
+
+a1/a {
+    cs {
+        period 10 ms
+        cmd/ib: Cmd
+        hi/pp = newData(cmd/ib.target) and cmd/ib.target[0] > 1.0 and cmd/ib.rows[1][0] > 0.0
+        same/pp = cmd/ib.target == [1.0, 2.0, 3.0] and cmd/ib.rows[1] != [0.0, 0.0, 0.0]
+        b1/bb {
+            tf = {}
+            tc = hi/pp or same/pp
+        }
+        fsm {
+            initial one
+            state one: b1/bb
+        }
+    }
+}
+"""
+
+
+def test_an_optional_array_field_is_absent_or_one_whole_array() -> None:
+    """`double[3]?` is absent or exactly three values: `[0..3]` admitted one or two, and `double[]?` as `[*]`
+    could not tell an absent array from an empty one. It is one value of a definition holding the array."""
+    exported = export_sysml(earl.loads(_OPTIONAL_ARRAYS, "opt.earl"))
+    assert "attribute target : 'double[3]'[0..1];" in exported
+    assert "attribute path : 'double[]'[0..1];" in exported
+    assert "attribute must : EARL::double[3] ordered nonunique;" in exported
+    assert re.search(
+        r"attribute def 'double\[3\]' \{[^}]*attribute elements : EARL::double\[3\] ordered nonunique;", exported
+    )
+    assert re.search(
+        r"attribute def 'double\[\]' \{[^}]*attribute elements : EARL::double\[\*\] ordered nonunique;", exported
+    )
+    # an alias of an array, as one value, is not named as the alias itself (`'Row'` is `Row` in SysML)
+    assert "attribute row : 'Row value'[0..1];" in exported
+    assert "attribute rows : 'Row value'[2] ordered nonunique;" in exported
+    assert "attribute def 'Row'" not in exported
+    # reads go through `elements`; newData is about the field itself
+    assert "EARL::newData(cmd_ib.msg.target) and cmd_ib.msg.target.elements#(1) > 1.0" in exported
+    assert "cmd_ib.msg.rows#(2).elements#(1) > 0.0" in exported
+    assert (
+        "cmd_ib.msg.target.elements == (1.0, 2.0, 3.0) and cmd_ib.msg.rows#(2).elements != (0.0, 0.0, 0.0)" in exported
+    )
+    assert not syntax_errors(exported)

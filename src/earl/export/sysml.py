@@ -276,10 +276,14 @@ class _Writer:
 
     def array_definition(self, helper: str, array: DataType) -> None:
         with self.block(f"attribute def {helper}"):
-            self.doc(
-                f"The EARL array type {type_text(array)}, as a value: an array of arrays cannot be a multiplicity."
-            )
+            self.doc(f"The EARL array type {type_text(array)} as one value, for arrays of arrays and optional arrays.")
             self.emit(f"attribute elements : {self.typed(array)};")
+
+    def array_value(self, array: DataType) -> str:
+        """The name of the definition holding `array` (an array type, or the name of an alias of one) as one
+        value: `'double[3]'`, `'JointPosition value'` (not `'JointPosition'`, which is the alias's own name)."""
+        text = f"{array.name} value" if isinstance(array, TypeReference) else type_text(array)
+        return self.helper_types.setdefault(text, (quoted(text), array))[0]
 
     def shape(self, data_type: DataType) -> tuple[str, str | None]:
         """The SysML type of a value and, for an array, its size: SysML v2 has multiplicities, not array types."""
@@ -292,18 +296,19 @@ class _Writer:
         element, inner = self.shape(data_type.element)
         if inner is not None:
             # An array of arrays: the inner array becomes a definition of its own (`'double[3]'`).
-            text = type_text(data_type.element)
-            self.helper_types.setdefault(text, (quoted(text), data_type.element))
-            element = self.helper_types[text][0]
+            element = self.array_value(data_type.element)
         return element, "*" if data_type.size is None else _size_text(data_type)
 
     def typed(self, data_type: DataType, optional: bool = False) -> str:
-        """A type with its multiplicity: `EARL::double[3] ordered nonunique`, `OperPosition[0..1]`."""
+        """A type with its multiplicity: `EARL::double[3] ordered nonunique`, `OperPosition[0..1]`, and for an
+        optional array `'double[3]'[0..1]`: absent, or one value holding exactly its elements ([0..3] would
+        admit one or two, and [*] could not tell an absent variable array from an empty one)."""
         element, size = self.shape(data_type)
         if size is None:
             return element + ("[0..1]" if optional else "")
-        multiplicity = f"[0..{size}]" if optional and size != "*" else f"[{size}]"
-        return f"{element}{multiplicity} ordered nonunique"
+        if optional:
+            return f"{self.array_value(data_type)}[0..1]"
+        return f"{element}[{size}] ordered nonunique"
 
     # ------------------------------------------------------------------ the system (§2.1, Figure 2)
     def system_part(self) -> None:
@@ -436,7 +441,7 @@ class _Writer:
                 names.add(
                     behaviour.name, None, Kind.BASIC_BEHAVIOUR, self.named(namespace, f"{behaviour.name}/bb").name
                 )
-            expressions = ExpressionWriter(names.resolve)
+            expressions = self.expressions(names)
             for predicate in subsystem.primitive_predicates:
                 self.primitive_predicate(predicate, names, expressions)
             for function in subsystem.partial_transition_functions:
@@ -449,9 +454,12 @@ class _Writer:
                 self.fsm(subsystem, names, expressions)
         return names
 
+    def expressions(self, names: _SubsystemNames) -> ExpressionWriter:
+        return ExpressionWriter(names.resolve, names.data_type, self.system.type_named)
+
     def input_buffer(self, buffer: InputBuffer, namespace: Namespace, names: _SubsystemNames) -> None:
         named = self.named(namespace, _earl_name(buffer.name, buffer.index, Kind.INPUT_BUFFER))
-        names.add(buffer.name, buffer.index, Kind.INPUT_BUFFER, named.name)
+        names.add(buffer.name, buffer.index, Kind.INPUT_BUFFER, named.name, buffer.data_type)
         with self.block(f"port {named.declaration} : EARL::InputBuffer :> ib"):
             self.element_doc(buffer.location, *self.member_note(buffer.family is not None, buffer.index))
             self.emit(f"in item :>> msg : {self.typed(buffer.data_type)};")
@@ -463,19 +471,19 @@ class _Writer:
 
     def output_buffer(self, buffer: OutputBuffer, namespace: Namespace, names: _SubsystemNames) -> None:
         named = self.named(namespace, _earl_name(buffer.name, buffer.index, Kind.OUTPUT_BUFFER))
-        names.add(buffer.name, buffer.index, Kind.OUTPUT_BUFFER, named.name)
+        names.add(buffer.name, buffer.index, Kind.OUTPUT_BUFFER, named.name, buffer.data_type)
         with self.block(f"port {named.declaration} : EARL::OutputBuffer :> ob"):
             self.element_doc(buffer.location, *self.member_note(buffer.family is not None, buffer.index))
             self.emit(f"out item :>> msg : {self.typed(buffer.data_type)};")
 
     def memory(self, memory: Memory, namespace: Namespace, names: _SubsystemNames) -> None:
         named = self.named(namespace, _earl_name(memory.name, memory.index, Kind.MEMORY))
-        names.add(memory.name, memory.index, Kind.MEMORY, named.name)
+        names.add(memory.name, memory.index, Kind.MEMORY, named.name, memory.data_type)
         with self.block(f"item {named.declaration} : EARL::InternalMemory :> m"):
             self.element_doc(memory.location, *self.member_note(memory.family is not None, memory.index))
             initial = ""
             if memory.initial_value is not None:
-                initial = " := " + ExpressionWriter(names.resolve).text(memory.initial_value)
+                initial = " := " + self.expressions(names).text(memory.initial_value)
             self.emit(f"attribute :>> data : {self.typed(memory.data_type)}{initial};")
 
     # ------------------------------------------------------------------ behaviour (§2.2, Table 4, Figures 5 and 6)
@@ -727,9 +735,16 @@ class _SubsystemNames:
 
     def __init__(self) -> None:
         self._names: dict[tuple[str, int | None, Kind], str] = {}
+        self._types: dict[tuple[str, int | None, Kind], DataType] = {}
 
-    def add(self, name: str, index: int | None, kind: Kind, sysml_name: str) -> None:
+    def add(self, name: str, index: int | None, kind: Kind, sysml_name: str, data_type: DataType | None = None) -> None:
         self._names[(name, index, _memory_kind(kind))] = sysml_name
+        if data_type is not None:
+            self._types[(name, index, _memory_kind(kind))] = data_type
+
+    def data_type(self, reference: ElementReference) -> DataType | None:
+        """The data type of the buffer or memory `reference` names, for reading into it."""
+        return self._types.get((reference.name, _index_of(reference), _memory_kind(reference.kind)))
 
     def get(self, name: str, index: int | None, kind: Kind) -> str | None:
         return self._names.get((name, index, _memory_kind(kind)))

@@ -8,7 +8,9 @@ The two notations differ in three places that matter:
   unary operator must be a primary expression (`not (not a)`, `-(-x)`);
 - a read of a buffer or memory goes through the library's `msg` and `data`
   features (`manipulatorCommand_ib.msg.emergencyStopCommand`, manual §2.2);
-- EARL indexes arrays from 0 and SysML's `#(i)` from 1.
+- EARL indexes arrays from 0 and SysML's `#(i)` from 1;
+- an array that is one value (an element of an array of arrays, an optional array
+  field) is exported as an attribute definition holding `elements`, read through it.
 """
 
 from __future__ import annotations
@@ -38,9 +40,14 @@ from earl.model.expressions import (
 )
 from earl.model.kinds import Kind
 from earl.model.text import expression_text
+from earl.model.types import ArrayType, DataType, Field, StructType, TypeAlias, TypeDefinition, TypeReference
 
 #: How a reference to a buffer, memory or primitive predicate is written: the SysML name of its target.
 Resolver = Callable[[ElementReference], str]
+#: The data type of the buffer or memory a reference names (None: not known).
+TypeOf = Callable[[ElementReference], DataType | None]
+#: A data type of the specification by its name.
+TypeNamed = Callable[[str], TypeDefinition | None]
 
 # SysML v2 operator precedence, loosest first (KerML 8.2.5.8): or, and, equality, relational,
 # additive, multiplicative, unary, then primary expressions.
@@ -67,8 +74,10 @@ def literal(value: bool | int | float | str) -> str:
 class ExpressionWriter:
     """Writes the expressions of one subsystem, whose element names `resolve` knows."""
 
-    def __init__(self, resolve: Resolver) -> None:
+    def __init__(self, resolve: Resolver, type_of: TypeOf | None = None, type_named: TypeNamed | None = None) -> None:
         self.resolve = resolve
+        self.type_of = type_of
+        self.type_named = type_named
 
     def text(self, expression: Expression) -> str:
         return self._write(expression)[0]
@@ -121,24 +130,55 @@ class ExpressionWriter:
         )
         return f"({text})" if needed or nested_logic else text
 
-    def _read(self, read: Read) -> str:
+    def _read(self, read: Read, whole: bool = True) -> str:
+        """`whole`: the value read is used as a value, so an array held as one value is read as its `elements`."""
         target = read.target
         text = self.resolve(target)
         if target.kind is Kind.INPUT_BUFFER:
             text += ".msg"
         elif target.kind in (Kind.MEMORY, Kind.MEMORY_INPUT, Kind.MEMORY_OUTPUT):
             text += ".data"
+        # The type of what is read so far, and whether it is an array held as one value (docs/sysml.md:
+        # an element of an array of arrays, an optional array field), whose elements are its `elements`.
+        current = self.type_of(target) if self.type_of is not None else None
+        held = False
         previous: object = None
         for accessor in read.path:
             if isinstance(accessor, FieldAccess):
                 text += "." + name_text(accessor.name)
+                field = self._field(current, accessor.name)
+                current = field.data_type if field is not None else None
+                held = field is not None and field.optional and self._array(current) is not None
             elif isinstance(accessor, IndexAccess):
-                # An array of arrays is exported as values holding `elements` (docs/sysml.md).
-                text += (
-                    ".elements" if isinstance(previous, IndexAccess) else ""
-                ) + f"#({self._position(accessor.index)})"
+                if current is None:
+                    # Types unknown: only an element of an array of arrays is held as one value.
+                    held = isinstance(previous, IndexAccess)
+                text += (".elements" if held else "") + f"#({self._position(accessor.index)})"
+                array = self._array(current)
+                current = array.element if array is not None else None
+                held = current is not None and self._array(current) is not None
             previous = accessor
-        return text
+        return text + (".elements" if whole and held else "")
+
+    def _resolved(self, data_type: DataType | None) -> DataType | TypeDefinition | None:
+        """`data_type` with the spec's aliases followed to what they name."""
+        seen: set[str] = set()
+        while isinstance(data_type, TypeReference) and self.type_named is not None and data_type.name not in seen:
+            seen.add(data_type.name)
+            definition = self.type_named(data_type.name)
+            if isinstance(definition, TypeAlias):
+                data_type = definition.data_type
+            else:
+                return definition
+        return None if isinstance(data_type, TypeReference) else data_type
+
+    def _array(self, data_type: DataType | None) -> ArrayType | None:
+        resolved = self._resolved(data_type)
+        return resolved if isinstance(resolved, ArrayType) else None
+
+    def _field(self, data_type: DataType | None, name: str) -> Field | None:
+        resolved = self._resolved(data_type)
+        return resolved.field_named(name) if isinstance(resolved, StructType) else None
 
     def _position(self, index: Expression) -> str:
         """EARL's 0-based index as SysML's 1-based position."""
@@ -153,6 +193,9 @@ class ExpressionWriter:
             if call.function in ("timeout", "stale") and isinstance(argument, Read) and not argument.path:
                 # timeout() and stale() are about the buffer itself, not its message.
                 arguments.append(self.resolve(argument.target))
+            elif isinstance(argument, Read):
+                # newData(x/ib.field) is about the field, which may be absent, not about its elements.
+                arguments.append(self._read(argument, whole=False))
             else:
                 arguments.append(self.text(argument))
         return f"EARL::{call.function}(" + ", ".join(arguments) + ")"
