@@ -556,3 +556,58 @@ def test_an_optional_array_field_is_absent_or_one_whole_array() -> None:
         "cmd_ib.msg.target.elements == (1.0, 2.0, 3.0) and cmd_ib.msg.rows#(2).elements != (0.0, 0.0, 0.0)" in exported
     )
     assert not syntax_errors(exported)
+
+
+_TWO_WAYS = """system dup
+
+r1/r {
+    a1/a
+}
+
+a1/a {
+    cs {
+        period 10 ms
+        c/m: int = 0
+        lo/pp = c/mi < 3
+        hi/pp = c/mi > 5
+        b1/bb {
+            tf = {}
+            tc = lo/pp or hi/pp
+        }
+        fsm {
+            initial one
+            state one: b1/bb
+            state two: b1/bb
+            one -> two when lo/pp priority 1
+            one -> two when hi/pp priority 2
+            * -> one when hi/pp priority 3
+            two -> one when lo/pp priority 1
+        }
+    }
+}
+"""
+
+
+def test_transitions_are_written_in_the_order_they_are_tried_and_named_by_earl_names_only() -> None:
+    """`* -> one … priority 3` declared before `two -> one … priority 1` was written first, though the text's
+    order carries the priority; the second `one -> two` got the short name `<'one,two/t_2'>`, no EARL name."""
+    exported = export_sysml(earl.loads(_TWO_WAYS, "dup.earl"))
+    transitions = re.findall(r"transition (.*)\n\s+first (\w+)\n\s+if (\w+)\n", exported)
+    assert transitions == [
+        ("<'one,two/t'> one_two_t", "one", "lo_pp"),
+        ("<'two,one/t'> two_one_t", "two", "lo_pp"),
+        ("one_two_t_2", "one", "hi_pp"),
+        ("two_one_t_2", "two", "hi_pp"),
+    ]
+    assert "/t_2" not in exported
+    assert not syntax_errors(exported)
+
+
+def test_a_link_named_as_a_library_feature_gets_no_short_name() -> None:
+    """The export wrote `flow <'links'> links_2`: a short name `links` would be found where the library's
+    `links` is meant."""
+    text = SMALL.read_text(encoding="utf-8").replace("link supervisor,line", "link links")
+    assert "link links:" in text
+    exported = export_sysml(earl.loads(text, "small.earl"))
+    assert re.search(r"flow links_2 : EARL::InterAgentLink :> links", exported)
+    assert "<'links'>" not in exported

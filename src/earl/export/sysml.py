@@ -168,6 +168,7 @@ class _Writer:
         #: SysML names of agents, and of links by identity, for references between them.
         self.agent_names: dict[str, str] = {}
         self.link_names: dict[int, str] = {}
+        self.link_declarations: dict[int, str] = {}
         #: Per agent and subsystem (EARL names): the subsystem's SysML name and its elements' names, for link ends.
         self.scopes: dict[tuple[str, str], tuple[str, _SubsystemNames]] = {}
 
@@ -208,13 +209,11 @@ class _Writer:
 
     def named(self, namespace: Namespace, earl_name: str, preferred: str | None = None) -> _Named:
         """A readable, unique name, with the EARL name as short name when the two differ, unless that
-        short name is itself a name of the namespace: SysML resolves short names too, and an owned
-        `<'agents'>` would be found where the library's inherited `agents` is meant."""
-        clashes = namespace.taken(earl_name)
+        EARL name is a name or short name of the namespace already: SysML resolves short names too, and an
+        owned `<'agents'>` would be found where the library's inherited `agents` is meant."""
+        free = not namespace.taken(earl_name)
         name = namespace.claim(preferred or readable(earl_name))
-        if clashes and name != earl_name:
-            return _Named(name, name_text(name))
-        if name == earl_name:
+        if name == earl_name or not free or not namespace.claim_short(earl_name):
             return _Named(name, name_text(name))
         return _Named(name, f"<{quoted(earl_name)}> {name_text(name)}")
 
@@ -322,7 +321,8 @@ class _Writer:
                 # Claimed before any is written, so that links and robots can refer to every agent.
                 self.agent_names[earl_name] = self.named(namespace, earl_name).name
             for link in system.links:
-                self.link_names[id(link)] = self.named(namespace, link.name_text).name
+                named = self.named(namespace, link.name_text)
+                self.link_names[id(link)], self.link_declarations[id(link)] = named.name, named.declaration
             for agent in system.agents:
                 self.emit()
                 self.agent(agent)
@@ -387,8 +387,9 @@ class _Writer:
                     else _earl_name(subsystem.name, subsystem.index, subsystem.kind)
                 )
                 subsystem_names[id(subsystem)] = self.named(namespace, earl_sub)
-            agent_links = {id(link): self.named(namespace, link.name_text).name for link in agent.links}
-            self.link_names.update(agent_links)
+            for link in agent.links:
+                named = self.named(namespace, link.name_text)
+                self.link_names[id(link)], self.link_declarations[id(link)] = named.name, named.declaration
             for subsystem in agent.subsystems:
                 self.emit()
                 names = self.subsystem(subsystem, subsystem_names[id(subsystem)])
@@ -588,10 +589,11 @@ class _Writer:
             for state in fsm.states:
                 self.emit()
                 self.state(state, states[state.name], names)
-            short_names = Namespace()
-            for transition in fsm.transitions:
+            # SysML v2 has no priority: the text lists transitions in the order they are tried, as `earl run`
+            # does, priority 1 first, those without one last, declaration order among equals (docs/sysml.md).
+            for transition in sorted(fsm.transitions, key=lambda t: (t.priority is None, t.priority or 0)):
                 self.emit()
-                self.transition(transition, states, namespace, short_names, expressions)
+                self.transition(transition, states, namespace, expressions)
             for number, assumption in enumerate(fsm.assumptions, start=1):
                 self.emit()
                 name = namespace.claim(f"assumption{number}")
@@ -617,14 +619,13 @@ class _Writer:
         transition: Transition,
         states: dict[str, str],
         namespace: Namespace,
-        short_names: Namespace,
         expressions: ExpressionWriter,
     ) -> None:
         source = states.get(transition.source or "", transition.source or "")
         destination = states.get(transition.destination, transition.destination)
-        earl_name = short_names.claim(f"{transition.source},{transition.destination}/t")
-        name = namespace.claim(readable(earl_name))
-        self.emit(f"transition <{quoted(earl_name)}> {name_text(name)}")
+        # Table 5 names a transition by its states: a second `one -> two` is `one_two_t_2`, with no short name.
+        named = self.named(namespace, f"{transition.source},{transition.destination}/t")
+        self.emit(f"transition {named.declaration}")
         self.depth += 1
         self.emit(f"first {name_text(source)}")
         self.emit(f"if {expressions.text(transition.condition.expression)}")
@@ -653,9 +654,7 @@ class _Writer:
     # ------------------------------------------------------------------ links (§2.3)
     def link(self, link: Link, owner: Agent | None) -> None:
         resolved = next((r for r in self.context.links if r.link is link), None)
-        own = self.link_names[id(link)]
-        earl_name = link.name_text
-        declaration = _declaration(own, earl_name)
+        declaration = self.link_declarations[id(link)]
         # A system's links are its `links`; an agent's are between its subsystems and subset nothing.
         definition = "EARL::InterAgentLink :> links" if owner is None else "EARL::InterSubsystemLink"
         source = self.link_end(link.source.agent, link.source.subsystem, link.source.buffer, Kind.OUTPUT_BUFFER, owner)

@@ -228,10 +228,19 @@ class Namespace:
 
     def __init__(self, reserved: tuple[str, ...] = ()) -> None:
         self._taken: set[str] = set(reserved)
+        self._short: set[str] = set()
 
     def taken(self, name: str) -> bool:
-        """Whether `name` is given already here, or inherited from the library."""
-        return name in self._taken
+        """Whether `name` is given already here, as a name or a short name, or inherited from the library."""
+        return name in self._taken or name in self._short
+
+    def claim_short(self, earl_name: str) -> bool:
+        """Whether `earl_name` may be a short name here, claiming it if so: not when it is a name or short
+        name of the namespace already, since SysML resolves short names as names."""
+        if self.taken(earl_name):
+            return False
+        self._short.add(earl_name)
+        return True
 
     def claim(self, preferred: str) -> str:
         name = preferred
