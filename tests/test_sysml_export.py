@@ -611,3 +611,18 @@ def test_a_link_named_as_a_library_feature_gets_no_short_name() -> None:
     exported = export_sysml(earl.loads(text, "small.earl"))
     assert re.search(r"flow links_2 : EARL::InterAgentLink :> links", exported)
     assert "<'links'>" not in exported
+
+
+def test_a_comment_on_a_struct_field_is_the_field_s_doc() -> None:
+    """`value: double // the value` lost its comment, though every `// comment` is its element's doc."""
+    text = (
+        "system fields\n\nstruct Reading {\n    // how far, in metres\n    distance: double\n"
+        "    value: double // the value <v> & stuff\n    extra: double[2]?\n}\n"
+    )
+    exported = export_sysml(earl.loads(text, "fields.earl"))
+    value = re.search(r"attribute value : EARL::double \{\s*doc\s*/\*(.*?)\*/\s*\}", exported, re.DOTALL)
+    assert value is not None and "the value <v> & stuff" in value.group(1) and "fields.earl:6" in value.group(1)
+    distance = re.search(r"attribute distance : EARL::double \{\s*doc\s*/\*(.*?)\*/\s*\}", exported, re.DOTALL)
+    assert distance is not None and "how far, in metres" in distance.group(1)
+    assert "attribute extra : 'double[2]'[0..1];" in exported  # a field without a comment stays one line
+    assert not syntax_errors(exported)

@@ -261,7 +261,15 @@ class _Writer:
                 with self.block(f"attribute def {name}"):
                     self.element_doc(definition.location)
                     for field in definition.fields:
-                        self.emit(f"attribute {name_text(field.name)} : {self.typed(field.data_type, field.optional)};")
+                        declaration = (
+                            f"attribute {name_text(field.name)} : {self.typed(field.data_type, field.optional)}"
+                        )
+                        # A field someone commented gets the comment as its doc, and where it was written.
+                        if _comment_lines(self.comments.get(field.location) if field.location else None):
+                            with self.block(declaration):
+                                self.element_doc(field.location)
+                        else:
+                            self.emit(declaration + ";")
             else:
                 self.alias(name, definition)
 
