@@ -410,3 +410,38 @@ a/a {
         ("EARL-R015", "the index `K` is already in use here", 13, 16),
         ("EARL-R015", "the index `J` is already in use here", 14, 31),
     ]
+
+
+def test_a_link_whose_name_a_family_member_has_too_is_declared_twice() -> None:
+    # `link cs,mc[2]` beside the family `cs,mc[K in 1..N]`: two links named `cs,mc[2]` once expanded
+    text = """\
+system twice
+
+param N: int = 3
+
+a/a {
+    cs {
+        period 1 ms
+        c[K in 1..N]/ob: double
+        special/ob: double
+    }
+    mc[K in 1..N]/ve {
+        period 1 ms
+        c/ib: double
+        boost/ib: double
+    }
+    link cs,mc[K in 1..N]: cs.c[K] -> mc[K]/ve.c
+    link cs,mc[2]: cs.special -> mc[2]/ve.boost
+    link cs,mc[N + 1]: cs.special -> mc[1]/ve.boost
+}
+"""
+    with pytest.raises(earl.EarlError) as refused:
+        earl.loads(text, "twice.earl")
+    said = [(d.code, d.message, d.location.line) for d in refused.value.diagnostics if d.location is not None]
+    assert said == [
+        (
+            "EARL-R002",
+            "link `cs,mc[2]` (a member of the family `cs,mc[K in 1..N]`) is declared twice (first declared at line 16)",
+            17,
+        )
+    ]

@@ -42,6 +42,7 @@ from earl.model.expressions import (
     Star,
     children,
     evaluate_constant,
+    evaluate_integer,
 )
 from earl.model.graphs import cycles
 from earl.model.kinds import KIND_TITLES, Kind
@@ -1196,6 +1197,8 @@ class Resolver:
     # ------------------------------------------------------------------ links and robots
     def _links(self, links: Sequence[Link], scope: Scope, agent: _AgentTable | None) -> None:
         names: dict[str, Link] = {}
+        #: each link's name once its family is expanded (`cs,mc[2]`), and the declaration that gives it
+        members: dict[str, Link] = {}
         for link in links:
             name = link.name_text
             if name in names:
@@ -1210,6 +1213,18 @@ class Resolver:
             family = self.family_range(link.family, scope)
             if link.family is not None and family is not None:
                 link_scope[link.family.index] = family
+            for member in _member_names(link, family, scope):
+                first = members.setdefault(member, link)
+                if first is not link:  # `link cs,mc[2]` beside the family `cs,mc[K in 1..N]`: two links, one name
+                    families = [f"`{each.name_text}`" for each in (first, link) if each.family is not None]
+                    self.duplicate(
+                        f"link `{member}` (a member of the family {' and of '.join(families)})"
+                        if families
+                        else f"link `{member}`",
+                        link.location,
+                        first.location,
+                    )
+                    break
             for part in link.name:
                 if part.index is not None:
                     self.index_values(part.index, link_scope)
@@ -1327,6 +1342,25 @@ def _names(expression: Expression) -> list[Name]:
     from earl.model.expressions import walk
 
     return [node for node in walk(expression) if isinstance(node, Name)]
+
+
+def _member_names(link: Link, family: IndexRange | None, scope: Scope) -> list[str]:
+    """The names a link's members have once expanded: one for a single link, one per index of a family; none
+    when an index is not a constant here (its own error is said elsewhere)."""
+    values = _values(scope)
+    indices = family.values() if link.family is not None and family is not None else [None]
+    names = []
+    for member in indices:
+        environment = values if member is None else {**values, link.family.index: member}  # type: ignore[union-attr]
+        try:
+            parts = [
+                part.name if part.index is None else f"{part.name}[{evaluate_integer(part.index, environment)}]"
+                for part in link.name
+            ]
+        except ConstantError:
+            return []
+        names.append(",".join(parts))
+    return names
 
 
 def _values(scope: Scope) -> dict[str, Value]:
