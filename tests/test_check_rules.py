@@ -1669,3 +1669,37 @@ def test_a_predicate_s_depth_is_that_of_its_expression_with_each_named_predicate
     subsystem = next(s for a, s in context.subsystems() if a.name == "a1")
     depths = predicate_depths(subsystem)
     assert (depths["q"], depths["p"], depths["r"], depths["go"]) == (2, 3, 4, 2)
+
+
+def test_a_list_is_said_twice_as_written_not_once_expanded() -> None:
+    """`f/pf(x[K]/ib, x[1]/ib -> …)` in `mc[K in 1..N]/ve` names two buffers; in member 1 they are one, which
+    no edit of the declaration can say once: no W047. The same `x[K]/ib` twice is a slip in every member."""
+    text = """\
+system w47
+
+param N: int = 2
+
+a/a {
+    cs {
+        period 10 ms
+        o[K in 1..N]/ob: double
+    }
+    mc[K in 1..N]/ve {
+        period 10 ms
+        x[J in 1..N]/ib: double
+        y/m: double = 0.0
+        f/pf(x[K]/ib, x[1]/ib -> y/mo)
+        g/pf(x[K]/ib, x[K]/ib -> y/mo)
+        b/bb {
+            tf = {f/pf}
+            tc = true
+        }
+        fsm {
+            initial s
+            state s: b/bb
+        }
+    }
+    link cs,mc[K in 1..N]: cs.o[K] -> mc[K]/ve.x[1]
+}
+"""
+    assert [d.message for d in findings(text, "EARL-W047")] == ["`g/pf` of a/a.mc/ve reads `x[K]/ib` twice"]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Iterator
+from dataclasses import replace
 
 from earl.check.context import CheckContext
 from earl.check.registry import Finding, rule
@@ -214,7 +215,10 @@ def lists_say_each_thing_once(context: CheckContext) -> Iterator[Finding]:
     """What a partial transition function or a Python predicate reads and writes, the functions of one stage,
     the agents and links of a robot: each is named once. A repeat changes nothing when the system runs (a
     set is meant), so it is a slip, often for another name that was meant and is now missing."""
-    for agent, subsystem in context.distinct_subsystems():
+    # the lists as written: expanded, `x[K]/ib, x[1]/ib` are one buffer twice in member 1, which no edit of the
+    # declaration could name once
+    declared = [(agent, subsystem) for agent in context.declared.agents for subsystem in agent.subsystems]
+    for agent, subsystem in declared:
         owner = subsystem_name(agent, subsystem)
         lists: list[tuple[str, list[ElementReference]]] = []
         for function in subsystem.partial_transition_functions:
@@ -238,7 +242,7 @@ def _repeats(lists: list[tuple[str, list[ElementReference]]]) -> Iterator[Findin
     for what, references in lists:
         named: set[str] = set()
         for reference in references:
-            text = reference.name if reference.kind is Kind.INTER_AGENT_LINK else reference_text(reference)
+            text = _written(reference)
             if text in named:
                 yield Finding(
                     f"{what} `{text}` twice",
@@ -246,3 +250,15 @@ def _repeats(lists: list[tuple[str, list[ElementReference]]]) -> Iterator[Findin
                     "name it once; was another name meant?",
                 )
             named.add(text)
+
+
+def _written(reference: ElementReference) -> str:
+    """`c/ib`, `x[K]/mi`, `f/pf`, `b,a`: a reference as written, its kind given as text too (a model built in
+    Python may say `ElementReference("c", "ib")`, which the rest of earl takes for Kind.INPUT_BUFFER)."""
+    try:
+        kind = Kind(reference.kind)
+    except ValueError:
+        return repr(reference)
+    if kind is Kind.INTER_AGENT_LINK:
+        return reference.name
+    return reference_text(replace(reference, kind=kind)) if kind is not reference.kind else reference_text(reference)
