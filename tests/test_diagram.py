@@ -460,3 +460,42 @@ def test_a_family_split_over_robots_is_drawn_outside_them_naming_where_each_memb
     expanded = _clusters(build_diagram(system, "system", expand=True).dot)
     assert "n_agent_worker_1__a [" in expanded["fleetRobot/r"] and "n_agent_worker_2__a [" in expanded["otherFleet/r"]
     assert all("n_agent_worker_3__a [" not in body for body in expanded.values())
+
+
+def test_a_large_family_split_over_robots_names_its_members_by_ranges(tmp_path: Path) -> None:
+    """Every member of a family of 1,200 in one label was more than Graphviz reads (16,384 characters)."""
+    spec = tmp_path / "big.earl"
+    spec.write_text(
+        """\
+system big
+
+param N: int = 1200
+
+alpha/a {
+    cs {
+        period 10 ms
+        out[K in 1..N]/ob: double
+    }
+}
+
+worker[K in 1..N]/a {
+    cs {
+        period 10 ms
+        in/ib: double
+    }
+}
+
+link alpha,worker[K in 1..N]: alpha/a.cs.out[K] -> worker[K]/a.cs.in
+
+fleetRobot/r {
+    alpha/a
+    worker[1]/a
+    worker[5]/a
+}
+"""
+    )
+    picture = tmp_path / "system.svg"
+    assert main(["diagram", str(spec), "--view", "system", "-o", str(picture)]) == 0
+    drawn = picture.read_text()
+    assert "no robot: worker[2..4]/a, worker[6..1200]/a" in drawn
+    assert "worker[1]/a" in drawn and "worker[5]/a" in drawn and "worker[7]/a" not in drawn

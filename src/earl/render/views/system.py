@@ -277,8 +277,21 @@ def robot_placements(
 
 
 def member_list(agent: Agent, members: Sequence[int]) -> list[str]:
-    """`worker[1]/a`, `worker[3]/a`: members of a family drawn once, by their numbers."""
-    return [f"{agent.name}[{index}]/a" for index in members]
+    """`worker[1]/a`, `worker[3]/a`, `worker[5..1200]/a`: members of a family drawn once, by their numbers, a
+    run of three or more as a range (a label of every member of a large family is more than Graphviz takes)."""
+    named: list[str] = []
+    ordered = sorted(members)
+    start = 0
+    while start < len(ordered):
+        end = start
+        while end + 1 < len(ordered) and ordered[end + 1] == ordered[end] + 1:
+            end += 1
+        if end - start >= 2:
+            named.append(f"{agent.name}[{ordered[start]}..{ordered[end]}]/a")
+        else:
+            named += [f"{agent.name}[{index}]/a" for index in ordered[start : end + 1]]
+        start = end + 1
+    return named
 
 
 def member_names(agent: Agent, members: Sequence[int]) -> str:
