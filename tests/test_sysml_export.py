@@ -590,14 +590,16 @@ a1/a {
 
 def test_transitions_are_written_in_the_order_they_are_tried_and_named_by_earl_names_only() -> None:
     """`* -> one … priority 3` declared before `two -> one … priority 1` was written first, though the text's
-    order carries the priority; the second `one -> two` got the short name `<'one,two/t_2'>`, no EARL name."""
+    order carries the priority; the second `one -> two` got the short name `<'one,two/t_2'>`, no EARL name.
+    Names follow the declarations, as the document's Table 5 numbers them (the `*` one, declared first, is
+    `two_one_t`), so that a changed priority renames nothing."""
     exported = export_sysml(earl.loads(_TWO_WAYS, "dup.earl"))
     transitions = re.findall(r"transition (.*)\n\s+first (\w+)\n\s+if (\w+)\n", exported)
     assert transitions == [
         ("<'one,two/t'> one_two_t", "one", "lo_pp"),
-        ("<'two,one/t'> two_one_t", "two", "lo_pp"),
+        ("two_one_t_2", "two", "lo_pp"),
         ("one_two_t_2", "one", "hi_pp"),
-        ("two_one_t_2", "two", "hi_pp"),
+        ("<'two,one/t'> two_one_t", "two", "hi_pp"),
     ]
     assert "/t_2" not in exported
     assert not syntax_errors(exported)

@@ -597,11 +597,16 @@ class _Writer:
             for state in fsm.states:
                 self.emit()
                 self.state(state, states[state.name], names)
-            # SysML v2 has no priority: the text lists transitions in the order they are tried, as `earl run`
-            # does, priority 1 first, those without one last, declaration order among equals (docs/sysml.md).
+            # Named in declaration order, as Table 5 of the document numbers them (a second `one -> two` is
+            # `one_two_t_2` whatever its priority); SysML v2 has no priority, so the text lists them in the order
+            # they are tried, as `earl run` does: priority 1 first, those without one last (docs/sysml.md).
+            named = {
+                id(transition): self.named(namespace, f"{transition.source},{transition.destination}/t")
+                for transition in fsm.transitions
+            }
             for transition in sorted(fsm.transitions, key=lambda t: (t.priority is None, t.priority or 0)):
                 self.emit()
-                self.transition(transition, states, namespace, expressions)
+                self.transition(transition, states, named[id(transition)], expressions)
             for number, assumption in enumerate(fsm.assumptions, start=1):
                 self.emit()
                 name = namespace.claim(f"assumption{number}")
@@ -626,13 +631,12 @@ class _Writer:
         self,
         transition: Transition,
         states: dict[str, str],
-        namespace: Namespace,
+        named: _Named,
         expressions: ExpressionWriter,
     ) -> None:
         source = states.get(transition.source or "", transition.source or "")
         destination = states.get(transition.destination, transition.destination)
         # Table 5 names a transition by its states: a second `one -> two` is `one_two_t_2`, with no short name.
-        named = self.named(namespace, f"{transition.source},{transition.destination}/t")
         self.emit(f"transition {named.declaration}")
         self.depth += 1
         self.emit(f"first {name_text(source)}")
