@@ -445,3 +445,15 @@ a/a {
             17,
         )
     ]
+
+
+def test_a_quantifier_index_named_as_a_parameter_is_said_so() -> None:
+    text = (
+        "system p\n\nparam I: int = 1\nparam N: int = 2\n\na/a {\n    cs {\n        period 1 ms\n"
+        "        d[K in 1..N]/ib: double\n        p/pp = any(I in 1..N: d[I]/ib > 0.0)\n    }\n}\n"
+    )
+    with pytest.raises(earl.EarlError) as refused:
+        earl.loads(text, "p.earl")
+    (problem,) = refused.value.diagnostics
+    assert (problem.code, problem.message) == ("EARL-R015", "the index `I` has the name of a parameter in use here")
+    assert problem.hint == "give `any` another index letter: inside it, `I` would no longer be the parameter"

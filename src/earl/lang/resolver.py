@@ -643,7 +643,7 @@ class Resolver:
             return None
         if family.index in scope:
             self.error(
-                f"the index `{family.index}` is already in use here",
+                _in_use(family.index, scope),
                 family.location,
                 "EARL-R015",
                 "give the inner family another index letter",
@@ -1055,11 +1055,15 @@ class Resolver:
             if isinstance(node, Quantifier):
                 if node.index in node_scope:  # it would hide the family's (or outer quantifier's) index
                     self.error(
-                        f"the index `{node.index}` is already in use here",
+                        _in_use(node.index, node_scope),
                         node.location,
                         "EARL-R015",
                         f"give `{node.quantifier}` another index letter: inside it, `{node.index}` would no longer "
-                        "be the one outside",
+                        + (
+                            "be the one outside"
+                            if isinstance(node_scope[node.index], IndexRange | PerMember)
+                            else "be the parameter"
+                        ),
                     )
                 for bound in (node.first, node.last):
                     stack.append((bound, node_scope))
@@ -1342,6 +1346,13 @@ def _names(expression: Expression) -> list[Name]:
     from earl.model.expressions import walk
 
     return [node for node in walk(expression) if isinstance(node, Name)]
+
+
+def _in_use(index: str, scope: Scope) -> str:
+    """Why an index cannot be named `index` here: another index has that name, or a parameter."""
+    if isinstance(scope[index], IndexRange | PerMember):
+        return f"the index `{index}` is already in use here"
+    return f"the index `{index}` has the name of a parameter in use here"
 
 
 def _member_names(link: Link, family: IndexRange | None, scope: Scope) -> list[str]:
