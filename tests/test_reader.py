@@ -361,6 +361,14 @@ def test_a_robot_names_a_link_family_as_it_is_declared_and_holds_every_member() 
     assert [reference.name for reference in system.robots[0].links] == ["alpha,worker[K in 1..N]"]
     assert "    link alpha,worker[K in 1..N]\n" in system.to_earl()
     assert [reference.name for reference in expand(system).robots[0].links] == ["alpha,worker[1]", "alpha,worker[2]"]
+    # a single link named with a parameter is its one member, named with the parameter's value
+    single = _ROBOT_WITH_A_LINK_FAMILY.replace(
+        "link alpha,worker[K in 1..N]: alpha/a.cs.out[K] -> worker[K]/a.cs.in",
+        "link alpha,worker[N]: alpha/a.cs.out[N] -> worker[N]/a.cs.in",
+    ).replace("LINK", "link alpha,worker[N]")
+    assert [reference.name for reference in expand(earl.loads(single, "one.earl")).robots[0].links] == [
+        "alpha,worker[2]"
+    ]
     # a member alone is told to name the family whole
     with pytest.raises(earl.EarlError) as refused:
         earl.loads(_ROBOT_WITH_A_LINK_FAMILY.replace("LINK", "link alpha,worker[1]"), "links.earl")
@@ -457,3 +465,16 @@ def test_a_quantifier_index_named_as_a_parameter_is_said_so() -> None:
     (problem,) = refused.value.diagnostics
     assert (problem.code, problem.message) == ("EARL-R015", "the index `I` has the name of a parameter in use here")
     assert problem.hint == "give `any` another index letter: inside it, `I` would no longer be the parameter"
+
+
+def test_a_link_end_of_the_wrong_kind_is_told_the_kind_declared() -> None:
+    text = (
+        "system lamp\n\nlamp/a {\n    cs {\n        period 1 ms\n        voltage/ob: double\n    }\n"
+        "    driver/ve {\n        period 1 ms\n        voltage/ib: double\n    }\n"
+        "    link cs,driver: cs.voltage -> driver/re.voltage\n}\n"
+    )
+    with pytest.raises(earl.EarlError) as refused:
+        earl.loads(text, "lamp.earl")
+    (problem,) = refused.value.diagnostics
+    assert (problem.code, problem.message) == ("EARL-R053", "`lamp/a` has no subsystem `driver/re`")
+    assert problem.hint == "`driver` is its Virtual Effector: write `driver/ve`"

@@ -1270,11 +1270,16 @@ class Resolver:
         found = table.subsystems.get(key)
         if found is None:
             names = [n for (n, k) in table.subsystems if k is end.subsystem.kind]
+            # `driver/re` where `driver/ve` is declared: the kind, not the name, is what was mistyped
+            other_kinds = [k for (n, k) in table.subsystems if n == end.subsystem.name]
             self.error(
                 f"`{table.agent.name}/a` has no subsystem `{reference_text(end.subsystem)}`",
                 end.subsystem.location,
                 "EARL-R053",
-                did_you_mean(end.subsystem.name, names),
+                f"`{end.subsystem.name}` is its {KIND_TITLES[other_kinds[0]]}: write `{end.subsystem.name}/"
+                f"{other_kinds[0].value}`"
+                if other_kinds and other_kinds[0] is not Kind.CONTROL_SUBSYSTEM
+                else did_you_mean(end.subsystem.name, names),
             )
             return
         sub_table, sub_family = found

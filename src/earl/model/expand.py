@@ -124,13 +124,13 @@ def expand(system: System, overrides: Mapping[str, Value] | None = None) -> Syst
             for index in members:
                 inner = {**environment, agent.family.index: index}
                 expanded.agents.append(_agent(agent, inner, index, cache))
-    #: a link family's declared name (`alpha,worker[K in 1..N]`) -> its members' (`alpha,worker[1]`, …)
+    #: a link's declared name (`alpha,worker[K in 1..N]`) -> its members' (`alpha,worker[1]`, …)
     link_members: dict[str, list[str]] = {}
     for link in system.links:
         members_of_link = _links(link, environment)
         expanded.links.extend(members_of_link)
-        if link.family is not None:
-            link_members[link.name_text] = [member.name_text for member in members_of_link]
+        # a family's members; a single link's name with its parameters' values (`alpha,worker[N]`: `[2]`)
+        link_members[link.name_text] = [member.name_text for member in members_of_link]
     for robot in expanded.robots:
         robot.agents = [
             member
