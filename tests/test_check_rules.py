@@ -1702,4 +1702,4 @@ a/a {
     link cs,mc[K in 1..N]: cs.o[K] -> mc[K]/ve.x[1]
 }
 """
-    assert [d.message for d in findings(text, "EARL-W047")] == ["`g/pf` of a/a.mc/ve reads `x[K]/ib` twice"]
+    assert [d.message for d in findings(text, "EARL-W047")] == ["`g/pf` of a/a.mc[K]/ve reads `x[K]/ib` twice"]

@@ -166,6 +166,14 @@ def subsystem_name(agent: Agent, subsystem: Subsystem) -> str:
     own = (
         "cs"
         if subsystem.kind is Kind.CONTROL_SUBSYSTEM
-        else f"{instance_name(subsystem.name, subsystem.index)}/{subsystem.kind.value}"
+        else f"{_member_or_family(subsystem.name, subsystem.index, subsystem.family)}/{subsystem.kind.value}"
     )
-    return f"{instance_name(agent.name, agent.index)}/a.{own}"
+    return f"{_member_or_family(agent.name, agent.index, agent.family)}/a.{own}"
+
+
+def _member_or_family(name: str, index: int | None, family: Family | None) -> str:
+    """`motorController[3]` for a member; `motorController[K]` for a family as declared (a message about the
+    declaration is about every member), not `motorController`, which names none."""
+    if index is None and family is not None:
+        return f"{name}[{family.index}]"
+    return instance_name(name, index)
