@@ -1703,3 +1703,20 @@ a/a {
 }
 """
     assert [d.message for d in findings(text, "EARL-W047")] == ["`g/pf` of a/a.mc[K]/ve reads `x[K]/ib` twice"]
+
+
+def test_a_family_as_declared_is_named_with_its_index_in_messages() -> None:
+    """`worker/a.cs has no fsm`, `agent worker/a has a Virtual Effector …`: a family named without its index
+    names no subsystem and no agent; as declared it is `worker[K]/a`."""
+    text = (
+        "system f\n\nparam N: int = 3\n\nworker[K in 1..N]/a {\n    cs {\n        period 1 ms\n    }\n"
+        "    d[J in 1..2]/ve {\n        period 1 ms\n    }\n}\n"
+    )
+    said = {d.message for d in findings(text) if d.code in ("EARL-E006", "EARL-E008", "EARL-W043")}
+    assert said == {
+        "agent `worker[K]/a` has a Virtual Effector but no Real Effector",
+        "Virtual Effector `worker[K]/a.d[J]/ve` has no Input Buffer",
+        "Virtual Effector `worker[K]/a.d[J]/ve` has no Output Buffer",
+        "worker[K]/a.cs has no `fsm`: it never runs a behaviour, and `earl run` refuses it",
+        "worker[K]/a.d[J]/ve has no `fsm`: it never runs a behaviour, and `earl run` refuses it",
+    }

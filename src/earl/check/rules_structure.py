@@ -10,7 +10,7 @@ from earl.check.registry import Finding, rule
 from earl.diagnostics import Severity
 from earl.model.expressions import ElementReference
 from earl.model.kinds import KIND_TITLES, Kind
-from earl.model.text import instance_name, reference_text, subsystem_name
+from earl.model.text import agent_name, instance_name, reference_text, subsystem_name
 
 
 @rule("EARL-E001", Severity.ERROR, "a System contains at least one Robot", "§2.1, Figure 2")
@@ -77,7 +77,7 @@ def one_control_subsystem(context: CheckContext) -> Iterator[Finding]:
     one that talks to other agents."""
     for agent in context.declared.agents:
         if not agent.control_subsystems:
-            yield Finding(f"agent `{agent.name}/a` has no Control Subsystem", agent.location, "add `cs { … }`")
+            yield Finding(f"agent `{agent_name(agent)}` has no Control Subsystem", agent.location, "add `cs { … }`")
 
 
 def _pairs(context: CheckContext, virtual: Kind, real: Kind) -> Iterator[Finding]:
@@ -87,7 +87,7 @@ def _pairs(context: CheckContext, virtual: Kind, real: Kind) -> Iterator[Finding
         if has_virtual != has_real:
             present, missing = (virtual, real) if has_virtual else (real, virtual)
             yield Finding(
-                f"agent `{agent.name}/a` has a {KIND_TITLES[present]} but no {KIND_TITLES[missing]}",
+                f"agent `{agent_name(agent)}` has a {KIND_TITLES[present]} but no {KIND_TITLES[missing]}",
                 agent.location,
                 f"Equation (1): |{virtual.value}| ≥ 1 ⇔ |{real.value}| ≥ 1; add a `/{missing.value}` or remove the `/{present.value}`",
             )
@@ -122,7 +122,7 @@ def required_buffers(context: CheckContext) -> Iterator[Finding]:
     for agent in context.declared.agents:
         for subsystem in agent.subsystems:
             needs_input, needs_output = _REQUIRED_BUFFERS.get(subsystem.kind, (False, False))
-            name = f"{agent.name}/a.{subsystem.name}/{subsystem.kind.value}"
+            name = subsystem_name(agent, subsystem)
             if needs_input and not subsystem.input_buffers:
                 yield Finding(
                     f"{KIND_TITLES[subsystem.kind]} `{name}` has no Input Buffer",

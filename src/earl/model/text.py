@@ -171,6 +171,11 @@ def subsystem_name(agent: Agent, subsystem: Subsystem) -> str:
     return f"{_member_or_family(agent.name, agent.index, agent.family)}/a.{own}"
 
 
+def agent_name(agent: Agent) -> str:
+    """`manip/a`, `worker[3]/a` for a member, `worker[K]/a` for a family as declared."""
+    return f"{_member_or_family(agent.name, agent.index, agent.family)}/a"
+
+
 def _member_or_family(name: str, index: int | None, family: Family | None) -> str:
     """`motorController[3]` for a member; `motorController[K]` for a family as declared (a message about the
     declaration is about every member), not `motorController`, which names none."""
