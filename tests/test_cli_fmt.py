@@ -306,3 +306,15 @@ def test_comments_parted_only_by_code_stay_one_block(tmp_path: Path, capsys: pyt
         "            tc = true\n            // the work\n            // until true\n        }\n"
         in capsys.readouterr().out
     )
+
+
+def test_comments_at_a_robot_s_members_stay_where_they_were_written() -> None:
+    # a member is a reference, which had nowhere to keep a comment: every one moved to after the last member
+    text = (
+        "system c\n\nr/r {\n    // the arm\n    a/a  // trailing\n    // the gripper\n    b/a\n"
+        "    // the link between them\n    link b,a\n    // the end\n}\n\n"
+        "a/a {\n    cs {\n        period 1 ms\n\n        i/ib: double\n    }\n}\n\n"
+        "b/a {\n    cs {\n        period 1 ms\n\n        o/ob: double\n    }\n}\n\n"
+        "link b,a: b/a.cs.o -> a/a.cs.i\n"
+    )
+    assert earl.loads(text, "c.earl").to_earl() == text

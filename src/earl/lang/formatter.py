@@ -201,9 +201,11 @@ def _struct(printer: _Printer, struct: StructType) -> None:
 def _robot(printer: _Printer, robot: Robot) -> None:
     printer.line(0, f"{robot.name}/r {{", robot.comments)
     for agent in robot.agents:
-        printer.line(1, reference_text(agent))
+        member = reference_text(agent)
+        printer.line(1, member, robot.member_comments.get(member))
     for link in robot.links:
-        printer.line(1, f"link {link.name}")
+        member = f"link {link.name}"
+        printer.line(1, member, robot.member_comments.get(member))
     printer.close(0, robot.comments)
 
 

@@ -17,7 +17,8 @@ from earl.lang.driver import Driver, NotWellFormed
 from earl.lang.syntax_errors import translate
 from earl.lang.transformer import ElementBuilder, ParsedFile, SpecificationSyntaxError
 from earl.model.elements import FSM, Agent, BasicBehaviour, Robot, Subsystem
-from earl.model.location import SourceLocation
+from earl.model.location import Comments, SourceLocation
+from earl.model.text import reference_text
 from earl.model.types import StructType
 
 #: Larger files are refused before parsing.  The benchmark's thousand agents, written out in
@@ -255,7 +256,29 @@ def _statements(declarations: list[Any]) -> list[Any]:
             stack.extend(getattr(element, attribute) or ())
         if has_fsm and element.fsm is not None:
             stack.append(element.fsm)
+        if isinstance(element, Robot):
+            found.extend(_robot_members(element))
     return found
+
+
+class _RobotMember:
+    """A robot's member as the comments see it: where it was written, and the robot's `Comments` for it."""
+
+    __slots__ = ("comments", "location")
+
+    def __init__(self, location: SourceLocation, comments: Comments) -> None:
+        self.location = location
+        self.comments = comments
+
+
+def _robot_members(robot: Robot) -> list[_RobotMember]:
+    members = [(reference_text(agent), agent.location) for agent in robot.agents]
+    members += [(f"link {link.name}", link.location) for link in robot.links]
+    return [
+        _RobotMember(location, robot.member_comments.setdefault(text, Comments()))
+        for text, location in members
+        if location is not None
+    ]
 
 
 #: the elements written with braces around a body, which keep the comments that end it (`Comments.closing`)

@@ -506,6 +506,9 @@ class Robot:
     links: list[ElementReference] = field(default_factory=list)
     location: SourceLocation | None = location_field()
     comments: Comments = comments_field()
+    #: the comments written at each member (`a/a`, `link b,a`), so that `earl fmt` keeps them there: a
+    #: member is a reference, which carries none of its own
+    member_comments: dict[str, Comments] = field(default_factory=dict, compare=False, repr=False)
     kind: ClassVar[Kind] = Kind.ROBOT
 
 
