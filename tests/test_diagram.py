@@ -499,3 +499,18 @@ fleetRobot/r {
     drawn = picture.read_text()
     assert "no robot: worker[2..4]/a, worker[6..1200]/a" in drawn
     assert "worker[1]/a" in drawn and "worker[5]/a" in drawn and "worker[7]/a" not in drawn
+
+
+@pytest.mark.parametrize("index", ["J", "foo bar", "K + 1"])
+def test_a_family_target_with_an_index_that_is_neither_its_letter_nor_a_member_is_refused(
+    index: str, tmp_path: Path
+) -> None:
+    pick_and_place = Path(__file__).parent.parent / "examples" / "pick_and_place"
+    target = f"manip/a.motorController[{index}]/ve"
+    assert (
+        main(["diagram", str(pick_and_place), "--view", "fsm", "--target", target, "-o", str(tmp_path / "x.svg")]) == 2
+    )
+    for accepted in ("K", "2"):
+        target = f"manip/a.motorController[{accepted}]/ve"
+        out = tmp_path / f"{accepted}.svg"
+        assert main(["diagram", str(pick_and_place), "--view", "fsm", "--target", target, "-o", str(out)]) == 0

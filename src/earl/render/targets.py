@@ -59,10 +59,13 @@ def _matches(
         return segment.index is not None and segment.index.strip() == str(index)
     if family is None:
         return segment.index is None
-    # a family drawn once answers to its name, its index variable, or any member's number
+    # a family drawn once answers to its name, its index variable, or any member's number; not to another
+    # letter or text (`[J]` of `motorController[K]`, `[foo]`), which names nothing of it
     number = None if segment.index is None else segment.index.strip()
-    if number is None or number == family.index or not number.lstrip("-").isdigit():
+    if number is None or number == family.index:
         return True
+    if not number.lstrip("-").isdigit():
+        return False
     try:
         return int(number) in family_members(family, environment)
     except ConstantError:  # its range needs an agent's own parameters: the name alone decides
