@@ -682,7 +682,7 @@ def _buffer_links(system: System, agent: Agent) -> BufferLinks:
     for outer in inter_agent_links(system):
         source = qualified_subsystem_name(outer.source, _cs(outer.source))
         destination = qualified_subsystem_name(outer.destination, _cs(outer.destination))
-        label = outer.link.name_text
+        label = link_label(outer.link)  # `alpha,worker[K]`, as inside an agent
         if outer.source is agent:
             table.setdefault((id(_cs(agent)), "ob", outer.source_buffer), []).append(
                 (
