@@ -376,3 +376,12 @@ def test_a_subsystem_built_twice_in_python_is_said_of_its_agent_not_of_the_subsy
         "`drive/ve` of `a/a` is declared twice",
         "the Control Subsystem `cs` of `a/a` is declared twice (first declared at line 3)",
     ]
+
+
+def test_a_nan_that_no_text_can_say_is_named_where_it_is_by_to_earl() -> None:
+    system = earl.load(Path(__file__).parent / "runtime_specs" / "counter")
+    system.agents[0].control_subsystems[0].memories[0].initial_value = Literal(float("nan"))
+    with pytest.raises(
+        ValueError, match=r"^system\.agents\[0\]\.subsystems\[0\]\.memories\[0\]\.initial_value\.value: nan"
+    ):
+        system.to_earl()

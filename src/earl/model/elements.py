@@ -566,3 +566,10 @@ class System:
             from earl.model.validate import explained
 
             raise explained(self, error) from error
+        except ValueError as error:  # a value no text can say (`Literal(float("nan"))`): said where it is
+            from earl.model.validate import not_a_number
+
+            where = not_a_number(self)
+            if where is None:
+                raise
+            raise ValueError(f"{where}: {error}") from error

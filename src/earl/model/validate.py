@@ -147,6 +147,26 @@ def _hints(cls: type) -> dict[str, Any]:
         return {}
 
 
+def not_a_number(root: object, path: str = "system") -> str | None:
+    """Where the first NaN of `root`'s model tree is (`system.agents[0].subsystems[0].memories[0].initial_value
+    .value`): a value of the right type that no text of the language can say."""
+    stack: list[tuple[object, str]] = [(root, path)]
+    seen: set[int] = set()
+    budget = _LIMIT
+    while stack and budget > 0:
+        value, where = stack.pop()
+        budget -= 1
+        if isinstance(value, float) and value != value:
+            return where
+        if isinstance(value, list | tuple):
+            stack.extend((item, f"{where}[{position}]") for position, item in reversed(list(enumerate(value))))
+        elif dataclasses.is_dataclass(value) and not isinstance(value, type) and id(value) not in seen:
+            seen.add(id(value))
+            fields = [field for field in dataclasses.fields(value) if field.compare]
+            stack.extend((getattr(value, field.name, None), f"{where}.{field.name}") for field in reversed(fields))
+    return None
+
+
 class ModelTypeError(TypeError):
     """A value of a model built in Python is not of its declared type; the message says where."""
 
