@@ -318,3 +318,15 @@ def test_comments_at_a_robot_s_members_stay_where_they_were_written() -> None:
         "link b,a: b/a.cs.o -> a/a.cs.i\n"
     )
     assert earl.loads(text, "c.earl").to_earl() == text
+
+
+def test_a_member_a_robot_lists_twice_keeps_its_own_comments() -> None:
+    # both `a/a` shared one set of comments: the second's were printed at both, and reading failed (KeyError)
+    text = (
+        "system c\n\nr/r {\n    // first\n    a/a\n    b/a\n    // second\n    a/a  // tb\n"
+        "    link b,a  // l1\n    link b,a\n}\n\n"
+        "a/a {\n    cs {\n        period 1 ms\n\n        i/ib: double\n    }\n}\n\n"
+        "b/a {\n    cs {\n        period 1 ms\n\n        o/ob: double\n    }\n}\n\n"
+        "link b,a: b/a.cs.o -> a/a.cs.i\n"
+    )
+    assert earl.loads(text, "c.earl").to_earl() == text

@@ -510,7 +510,7 @@ def test_a_family_target_with_an_index_that_is_neither_its_letter_nor_a_member_i
     assert (
         main(["diagram", str(pick_and_place), "--view", "fsm", "--target", target, "-o", str(tmp_path / "x.svg")]) == 2
     )
-    for accepted in ("K", "2"):
+    for accepted in ("K", "2", "*", "N"):  # its letter, a member, every member, a parameter naming a member
         target = f"manip/a.motorController[{accepted}]/ve"
         out = tmp_path / f"{accepted}.svg"
         assert main(["diagram", str(pick_and_place), "--view", "fsm", "--target", target, "-o", str(out)]) == 0

@@ -630,6 +630,8 @@ def test_the_summary_counts_members_of_agent_and_link_families(tmp_path: Path) -
         "4 agents. fleetRobot/r holds boss/a, worker[1]/a and worker[2]/a; worker[3]/a belongs to no robot. "
         "6 inter-agent links. "
     )
+    # members named by a range are several: they belong, not belongs
+    assert "; worker[3..5]/a belong to no robot." in _summary(spec, tmp_path / "five", "--param", "N=5")
 
 
 MEMBER_ONLY_LINKS = """\

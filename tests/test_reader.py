@@ -478,3 +478,15 @@ def test_a_link_end_of_the_wrong_kind_is_told_the_kind_declared() -> None:
     (problem,) = refused.value.diagnostics
     assert (problem.code, problem.message) == ("EARL-R053", "`lamp/a` has no subsystem `driver/re`")
     assert problem.hint == "`driver` is its Virtual Effector: write `driver/ve`"
+
+
+def test_a_family_end_of_the_wrong_kind_is_told_with_its_indices() -> None:
+    text = (
+        "system lamp\n\nparam N: int = 2\n\nlamp/a {\n    cs {\n        period 1 ms\n        v[K in 1..N]/ob: double\n    }\n"
+        "    driver[K in 1..N]/ve {\n        period 1 ms\n        voltage/ib: double\n    }\n"
+        "    link cs,driver[K in 1..N]: cs.v[K] -> driver[K]/re.voltage\n}\n"
+    )
+    with pytest.raises(earl.EarlError) as refused:
+        earl.loads(text, "lamp.earl")
+    (problem,) = refused.value.diagnostics
+    assert problem.hint == "`driver` is its Virtual Effector: write `driver[K]/ve`"

@@ -628,3 +628,18 @@ def test_a_comment_on_a_struct_field_is_the_field_s_doc() -> None:
     assert distance is not None and "how far, in metres" in distance.group(1)
     assert "attribute extra : 'double[2]'[0..1];" in exported  # a field without a comment stays one line
     assert not syntax_errors(exported)
+
+
+def test_comments_at_a_robot_s_members_are_in_the_robot_s_doc() -> None:
+    """They are kept at the members now (`earl fmt`); a member is a reference in SysML too, so its comments
+    are the robot's doc, as they were when the reader gave them to the robot."""
+    text = (
+        "system c\n\nr/r {\n    // the arm\n    a/a  // trailing\n    b/a\n    link b,a  // the feed\n}\n\n"
+        "a/a {\n    cs {\n        period 1 ms\n\n        i/ib: double\n    }\n}\n\n"
+        "b/a {\n    cs {\n        period 1 ms\n\n        o/ob: double\n    }\n}\n\n"
+        "link b,a: b/a.cs.o -> a/a.cs.i\n"
+    )
+    exported = export_sysml(earl.loads(text, "c.earl"))
+    robot = re.search(r"part <'r/r'> r_r : EARL::Robot :> robots \{\s*doc\s*/\*(.*?)\*/", exported, re.DOTALL)
+    assert robot is not None
+    assert all(said in robot.group(1) for said in ("the arm", "trailing", "the feed"))

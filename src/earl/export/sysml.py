@@ -49,7 +49,7 @@ from earl.model.elements import (
 from earl.model.expressions import ElementReference, Literal
 from earl.model.kinds import Kind
 from earl.model.location import Comments, SourceLocation
-from earl.model.text import expression_text, instance_name
+from earl.model.text import expression_text, instance_name, robot_member_keys
 from earl.model.types import ArrayType, DataType, PrimitiveType, StructType, TypeAlias, TypeReference, type_text
 
 Value = bool | int | float | str
@@ -778,9 +778,20 @@ def _comments_by_location(system: System) -> dict[SourceLocation, Comments]:
         if location is not None and isinstance(comments, Comments):
             table[location] = comments
 
-    top: list[object] = [*system.parameters, *system.types, *system.robots, *system.links]
+    top: list[object] = [*system.parameters, *system.types, *system.links]
     for element in top:
         keep(element)
+    for robot in system.robots:
+        # a robot's members are references in SysML too (`agents = (…)`): their comments go in the robot's doc
+        at_members = [
+            said
+            for key in robot_member_keys(robot)
+            if (comments := robot.member_comments.get(key)) is not None
+            for said in [*comments.leading, *([comments.trailing] if comments.trailing else [])]
+        ]
+        own = robot.comments
+        if robot.location is not None:
+            table[robot.location] = Comments(list(own.leading), own.trailing, [*at_members, *own.closing])
     for agent in system.agents:
         keep(agent)
         for element in [*agent.parameters, *agent.links]:

@@ -33,7 +33,14 @@ from earl.model.elements import (
 )
 from earl.model.expressions import ElementReference
 from earl.model.location import Comments
-from earl.model.text import expression_text, family_text, index_text, literal_text, reference_text
+from earl.model.text import (
+    expression_text,
+    family_text,
+    index_text,
+    literal_text,
+    reference_text,
+    robot_member_keys,
+)
 from earl.model.types import DataType, StructType, TypeAlias, type_text
 
 INDENT = "    "
@@ -200,12 +207,9 @@ def _struct(printer: _Printer, struct: StructType) -> None:
 
 def _robot(printer: _Printer, robot: Robot) -> None:
     printer.line(0, f"{robot.name}/r {{", robot.comments)
-    for agent in robot.agents:
-        member = reference_text(agent)
-        printer.line(1, member, robot.member_comments.get(member))
-    for link in robot.links:
-        member = f"link {link.name}"
-        printer.line(1, member, robot.member_comments.get(member))
+    written = [reference_text(agent) for agent in robot.agents] + [f"link {link.name}" for link in robot.links]
+    for text, key in zip(written, robot_member_keys(robot), strict=True):
+        printer.line(1, text, robot.member_comments.get(key))
     printer.close(0, robot.comments)
 
 

@@ -18,7 +18,7 @@ from earl.lang.syntax_errors import translate
 from earl.lang.transformer import ElementBuilder, ParsedFile, SpecificationSyntaxError
 from earl.model.elements import FSM, Agent, BasicBehaviour, Robot, Subsystem
 from earl.model.location import Comments, SourceLocation
-from earl.model.text import reference_text
+from earl.model.text import robot_member_keys
 from earl.model.types import StructType
 
 #: Larger files are refused before parsing.  The benchmark's thousand agents, written out in
@@ -272,13 +272,15 @@ class _RobotMember:
 
 
 def _robot_members(robot: Robot) -> list[_RobotMember]:
-    members = [(reference_text(agent), agent.location) for agent in robot.agents]
-    members += [(f"link {link.name}", link.location) for link in robot.links]
     return [
-        _RobotMember(location, robot.member_comments.setdefault(text, Comments()))
-        for text, location in members
+        _RobotMember(location, robot.member_comments.setdefault(key, Comments()))
+        for key, location in zip(robot_member_keys(robot), _member_locations(robot), strict=True)
         if location is not None
     ]
+
+
+def _member_locations(robot: Robot) -> list[SourceLocation | None]:
+    return [agent.location for agent in robot.agents] + [link.location for link in robot.links]
 
 
 #: the elements written with braces around a body, which keep the comments that end it (`Comments.closing`)

@@ -11,7 +11,7 @@ from __future__ import annotations
 import itertools
 import re
 from collections.abc import Iterable, Iterator, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 from earl.diagnostics import Diagnostic, Severity, did_you_mean
@@ -1272,14 +1272,18 @@ class Resolver:
             names = [n for (n, k) in table.subsystems if k is end.subsystem.kind]
             # `driver/re` where `driver/ve` is declared: the kind, not the name, is what was mistyped
             other_kinds = [k for (n, k) in table.subsystems if n == end.subsystem.name]
+            hint = did_you_mean(end.subsystem.name, names)
+            if other_kinds and other_kinds[0] is not Kind.CONTROL_SUBSYSTEM:
+                # written with the end's own indices (`motor[K]/re` for `motor[K]/ve`)
+                corrected = replace(end.subsystem, kind=other_kinds[0])
+                hint = (
+                    f"`{end.subsystem.name}` is its {KIND_TITLES[other_kinds[0]]}: write `{reference_text(corrected)}`"
+                )
             self.error(
                 f"`{table.agent.name}/a` has no subsystem `{reference_text(end.subsystem)}`",
                 end.subsystem.location,
                 "EARL-R053",
-                f"`{end.subsystem.name}` is its {KIND_TITLES[other_kinds[0]]}: write `{end.subsystem.name}/"
-                f"{other_kinds[0].value}`"
-                if other_kinds and other_kinds[0] is not Kind.CONTROL_SUBSYSTEM
-                else did_you_mean(end.subsystem.name, names),
+                hint,
             )
             return
         sub_table, sub_family = found

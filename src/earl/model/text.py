@@ -31,7 +31,7 @@ from earl.model.expressions import (
 from earl.model.kinds import Kind
 
 if TYPE_CHECKING:
-    from earl.model.elements import Agent, Family, Link, Subsystem
+    from earl.model.elements import Agent, Family, Link, Robot, Subsystem
 
 # Binding strength, loosest first; a child binding more loosely than its parent needs parentheses.
 _OR, _AND, _NOT, _COMPARE, _SUM, _PRODUCT, _UNARY, _ATOM = range(8)
@@ -169,6 +169,19 @@ def subsystem_name(agent: Agent, subsystem: Subsystem) -> str:
         else f"{_member_or_family(subsystem.name, subsystem.index, subsystem.family)}/{subsystem.kind.value}"
     )
     return f"{_member_or_family(agent.name, agent.index, agent.family)}/a.{own}"
+
+
+def robot_member_keys(robot: Robot) -> list[str]:
+    """`a/a`, `link b,a`, …: the keys of `Robot.member_comments`, one per member as written (agents, then
+    links); a member written twice (EARL-W047) has keys of its own, `a/a (2)`, so neither takes the other's
+    comments."""
+    keys: list[str] = []
+    seen: dict[str, int] = {}
+    written = [reference_text(agent) for agent in robot.agents] + [f"link {link.name}" for link in robot.links]
+    for text in written:
+        seen[text] = seen.get(text, 0) + 1
+        keys.append(text if seen[text] == 1 else f"{text} ({seen[text]})")
+    return keys
 
 
 def agent_name(agent: Agent) -> str:

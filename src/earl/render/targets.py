@@ -62,8 +62,10 @@ def _matches(
     # a family drawn once answers to its name, its index variable, or any member's number; not to another
     # letter or text (`[J]` of `motorController[K]`, `[foo]`), which names nothing of it
     number = None if segment.index is None else segment.index.strip()
-    if number is None or number == family.index:
+    if number is None or number in (family.index, "*"):  # `[*]`: EARL's every member
         return True
+    if number in environment:  # a parameter, `[N]`: the member it is
+        number = str(environment[number])
     if not number.lstrip("-").isdigit():
         return False
     try:

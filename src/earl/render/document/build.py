@@ -261,7 +261,8 @@ class DocumentBuilder:
             elif placement.outside:
                 outside += member_list(agent, placement.outside)
         if outside:
-            clauses.append(f"{_and(outside)} belong{'' if len(outside) > 1 else 's'} to no robot")
+            many = len(outside) > 1 or any(".." in name for name in outside)  # `worker[3..5]/a` is three
+            clauses.append(f"{_and(outside)} belong{'' if many else 's'} to no robot")
         return f"{sentence}. " + "; ".join(clauses) + "."
 
     def links_summary(self, system: System) -> str:
