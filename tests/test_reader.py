@@ -490,3 +490,15 @@ def test_a_family_end_of_the_wrong_kind_is_told_with_its_indices() -> None:
         earl.loads(text, "lamp.earl")
     (problem,) = refused.value.diagnostics
     assert problem.hint == "`driver` is its Virtual Effector: write `driver[K]/ve`"
+
+
+def test_a_quantifier_index_named_as_a_parameter_computed_per_member_is_said_so() -> None:
+    # `param me: int = K` ranges as an index does; it is still a parameter
+    text = (
+        "system p\n\nparam N: int = 2\n\nw[K in 1..N]/a {\n    param me: int = K\n\n    cs {\n        period 1 ms\n"
+        "        d[J in 1..N]/ib: double\n        p/pp = any(me in 1..N: d[me]/ib > 0.0)\n    }\n}\n"
+    )
+    with pytest.raises(earl.EarlError) as refused:
+        earl.loads(text, "p.earl")
+    (problem,) = [d for d in refused.value.diagnostics if d.code == "EARL-R015"]
+    assert problem.message == "the index `me` has the name of a parameter in use here"

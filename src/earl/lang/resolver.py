@@ -108,6 +108,12 @@ class IndexRange:
 
 
 @dataclass(frozen=True)
+class ParameterRange(IndexRange):
+    """A whole-number parameter of a family computed from its index (`param joint: int = K`): it ranges as an
+    index does, but it is a parameter, which is how a message that names it must say it."""
+
+
+@dataclass(frozen=True)
 class PerMember:
     """A parameter of a family computed from its index, whose values are not whole numbers
     (`param GAIN: double = 0.5 * K`): in scope, with one value per member, known once expanded."""
@@ -258,7 +264,7 @@ class Resolver:
                 if type_name in _INTEGER_TYPES:
                     values = self.index_values(parameter.value, scope)
                     if values is not None and values:
-                        scope[parameter.name] = IndexRange(min(values), max(values))
+                        scope[parameter.name] = ParameterRange(min(values), max(values))
                 else:
                     self._member_values(parameter, type_name, scope)
                     scope[parameter.name] = PerMember(type_name)
@@ -1059,11 +1065,7 @@ class Resolver:
                         node.location,
                         "EARL-R015",
                         f"give `{node.quantifier}` another index letter: inside it, `{node.index}` would no longer "
-                        + (
-                            "be the one outside"
-                            if isinstance(node_scope[node.index], IndexRange | PerMember)
-                            else "be the parameter"
-                        ),
+                        + ("be the parameter" if _is_parameter(node_scope[node.index]) else "be the one outside"),
                     )
                 for bound in (node.first, node.last):
                     stack.append((bound, node_scope))
@@ -1357,9 +1359,14 @@ def _names(expression: Expression) -> list[Name]:
     return [node for node in walk(expression) if isinstance(node, Name)]
 
 
+def _is_parameter(value: object) -> bool:
+    """Whether a name in scope is a parameter's (a value, or one per family member), not an index's."""
+    return not isinstance(value, IndexRange) or isinstance(value, ParameterRange)
+
+
 def _in_use(index: str, scope: Scope) -> str:
     """Why an index cannot be named `index` here: another index has that name, or a parameter."""
-    if isinstance(scope[index], IndexRange | PerMember):
+    if not _is_parameter(scope[index]):
         return f"the index `{index}` is already in use here"
     return f"the index `{index}` has the name of a parameter in use here"
 
