@@ -177,7 +177,9 @@ def _agent_paths(top: tuple[str, ...], agent: Agent) -> Iterator[tuple[str, ...]
         if subsystem.fsm is not None:
             fsm = (*sub, "fsm")
             for state in subsystem.fsm.states:
-                yield (*fsm, state.name)
+                # `start` and `done` are what every state body inherits: such a state is `start_2`, without a
+                # short name, which would hide the inherited feature as well
+                yield (*fsm, f"{state.name}_2" if state.name in ("start", "done") else state.name)
             for transition in subsystem.fsm.transitions:
                 yield (*fsm, f"{transition.source},{transition.destination}/t")
             for number in range(1, len(subsystem.fsm.assumptions) + 1):
@@ -643,3 +645,14 @@ def test_comments_at_a_robot_s_members_are_in_the_robot_s_doc() -> None:
     robot = re.search(r"part <'r/r'> r_r : EARL::Robot :> robots \{\s*doc\s*/\*(.*?)\*/", exported, re.DOTALL)
     assert robot is not None
     assert all(said in robot.group(1) for said in ("the arm", "trailing", "the feed"))
+
+
+def test_states_named_start_or_done_do_not_hide_what_every_state_body_inherits() -> None:
+    """A state body has the features `start` and `done` (an action's first and last snapshots): a state named
+    `start` hid one, and `entry; then start;` could be read as the library's."""
+    spec = Path(__file__).parent.parent / "examples" / "mobile_robot" / "system.earl"
+    assert "state start:" in spec.read_text(encoding="utf-8")
+    exported = export_sysml(earl.load(spec))
+    assert "entry; then start_2;" in exported and "state start_2 : EARL::FSMState" in exported
+    assert not re.search(r"\bstate start\b", exported)
+    assert not syntax_errors(exported)

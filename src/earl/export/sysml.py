@@ -590,7 +590,9 @@ class _Writer:
         assert fsm is not None
         with self.block("exhibit state :>> fsm : EARL::FSM"):
             self.element_doc(fsm.location)
-            namespace = Namespace()
+            # a state body inherits the features `start` and `done` (Actions::Action's first and last snapshots):
+            # a state named so would hide them, and `entry; then start;` would be read against the library's
+            namespace = Namespace(("start", "done"))
             states = {state.name: namespace.claim(state.name) for state in fsm.states}
             initial = states.get(fsm.initial, fsm.initial)
             self.emit(f"entry; then {name_text(initial)};")
