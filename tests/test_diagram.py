@@ -514,3 +514,16 @@ def test_a_family_target_with_an_index_that_is_neither_its_letter_nor_a_member_i
         target = f"manip/a.motorController[{accepted}]/ve"
         out = tmp_path / f"{accepted}.svg"
         assert main(["diagram", str(pick_and_place), "--view", "fsm", "--target", target, "-o", str(out)]) == 0
+
+
+def test_an_fsm_or_behaviour_shown_alone_is_headed_without_a_dangling_dot(system: System) -> None:
+    """Shown alone (Jupyter), they know no owner: the headers were `stm [FSM] .fsm` and `act [Operation] .x/bb…`."""
+    from earl.render.jupyter import diagram_for
+
+    cs = system.agent("manip").control_subsystem  # type: ignore[union-attr]
+    assert cs is not None and cs.fsm is not None
+    fsm = diagram_for(cs.fsm)
+    behaviour = diagram_for(cs.basic_behaviour("jointMove"))
+    assert fsm is not None and behaviour is not None
+    assert fsm.header == "stm [FSM] fsm"
+    assert behaviour.header == "act [Operation] jointMove/bb.tf.execute()"

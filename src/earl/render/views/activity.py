@@ -42,7 +42,8 @@ def _action_label(reference: ElementReference, function: PartialTransitionFuncti
 
 def activity_view(behaviour: BasicBehaviour, owner: str, subsystem: Subsystem | None = None) -> Diagram:
     """`owner` names the subsystem (`manip/a.cs`); the header names the operation."""
-    operation = f"{owner}.{behaviour.name}/bb.tf.execute()"
+    # a behaviour shown alone (Jupyter) has no owner to name: no leading dot then
+    operation = f"{owner + '.' if owner else ''}{behaviour.name}/bb.tf.execute()"
     graph = Graph(f"act [Operation] {operation}", rankdir="TB")
     graph.graph_attributes.update(nodesep="0.4", ranksep="0.45")
     names = [f"{behaviour.name}/bb"]

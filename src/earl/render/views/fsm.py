@@ -58,7 +58,7 @@ def _state_label(state: State, subsystem: Subsystem | None, initial: bool) -> st
 
 def fsm_view(fsm: FSM, owner: str, subsystem: Subsystem | None = None, expand: bool = False) -> Diagram:
     """`owner` names the subsystem in the manual's dot notation (`manip/a.cs`)."""
-    graph = Graph(f"stm [FSM] {owner}.fsm", rankdir="TB")
+    graph = Graph(f"stm [FSM] {owner + '.' if owner else ''}fsm", rankdir="TB")  # no owner: an FSM shown alone
     graph.graph_attributes.update(nodesep="0.6", ranksep="0.7")
     names: list[str] = []
     graph.add('initial [shape="circle", style="filled", fillcolor="black", label="", width="0.18", fixedsize="true"];')
