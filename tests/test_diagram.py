@@ -527,3 +527,15 @@ def test_an_fsm_or_behaviour_shown_alone_is_headed_without_a_dangling_dot(system
     assert fsm is not None and behaviour is not None
     assert fsm.header == "stm [FSM] fsm"
     assert behaviour.header == "act [Operation] jointMove/bb.tf.execute()"
+
+
+def test_an_expanded_member_is_named_by_its_number_or_a_parameter_that_is_it(tmp_path: Path) -> None:
+    pick_and_place = Path(__file__).parent.parent / "examples" / "pick_and_place"
+    for target, code in [
+        ("manip/a.motorController[N]/ve", 0),
+        ("manip/a.motorController[6]/ve", 0),
+        ("manip/a.motorController[K]/ve", 2),
+    ]:
+        out = tmp_path / "m.mmd"
+        arguments = ["diagram", str(pick_and_place), "--view", "fsm", "--expand", "--target", target]
+        assert main([*arguments, "--format", "mermaid", "-o", str(out)]) == code, target

@@ -3,9 +3,11 @@
 A target is written in the manual's dot notation: an agent (`manip/a`), a
 subsystem (`manip/a.cs`, `manip/a.motorController/ve`), or a Basic Behaviour
 (`manip/a.cs.jointMove/bb`, optionally followed by `.tf` or `.tf.execute()`).
-A family is named without an index, or with its index variable
-(`motorController[K]/ve`); with `--expand`, a member is named by its number
-(`motorController[3]/ve`).
+A family is named without an index, with its index variable
+(`motorController[K]/ve`) or with `[*]`; with `--expand`, a member is named by its number
+(`motorController[3]/ve`) or a parameter whose value it is (`motorController[N]/ve`).
+Without `--expand` a member's number (or such a parameter) names the family it belongs to,
+which is what is drawn.
 """
 
 from __future__ import annotations
@@ -55,8 +57,11 @@ def _matches(
 ) -> bool:
     if segment.name != name or (segment.kind is not None and segment.kind != kind):
         return False
-    if index is not None:  # a member of an expanded family answers to its number only
-        return segment.index is not None and segment.index.strip() == str(index)
+    if index is not None:  # a member of an expanded family answers to its number, or a parameter that is it
+        written = None if segment.index is None else segment.index.strip()
+        if written is not None and written in environment:
+            written = str(environment[written])
+        return written == str(index)
     if family is None:
         return segment.index is None
     # a family drawn once answers to its name, its index variable, or any member's number; not to another
