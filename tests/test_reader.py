@@ -502,3 +502,10 @@ def test_a_quantifier_index_named_as_a_parameter_computed_per_member_is_said_so(
         earl.loads(text, "p.earl")
     (problem,) = [d for d in refused.value.diagnostics if d.code == "EARL-R015"]
     assert problem.message == "the index `me` has the name of a parameter in use here"
+
+
+def test_a_robot_member_may_be_named_with_a_parameter_of_the_system() -> None:
+    # `worker[N]/a` was EARL-R020, "`N` is not a parameter", though `param N` is declared
+    system = earl.loads(_ROBOT_OF_WORKERS.replace("MEMBERS", "worker[N]/a"), "crew.earl")
+    assert [reference_text(member) for member in expand(system).robots[0].agents] == ["worker[3]/a"]
+    assert "    worker[N]/a\n" in system.to_earl()

@@ -209,7 +209,7 @@ class Resolver:
             self._agent_body(table)
         self._place = "the links between agents"
         self._links(self.system.links, scope, agent=None)
-        self._robots()
+        self._robots(scope)
         self._place = None
         return self.diagnostics
 
@@ -1309,7 +1309,8 @@ class Resolver:
             return
         self._indices(end.buffer, declared.family, scope, star=False)
 
-    def _robots(self) -> None:
+    def _robots(self, scope: Scope) -> None:
+        """`scope`: the system's parameters, which a robot's member may name (`worker[N]/a`)."""
         seen: dict[str, Any] = {}
         links = {link.name_text for link in self.system.links}
         #: link families by their name without indices: a robot naming one member (`alpha,worker[1]`) is told
@@ -1334,7 +1335,7 @@ class Resolver:
                         did_you_mean(reference.name, self.agents),
                     )
                     continue
-                self._indices(reference, table.family, {}, star=True)
+                self._indices(reference, table.family, scope, star=True)
             for reference in robot.links:
                 if reference.name not in links:
                     family = families.get(_without_indices(reference.name))
