@@ -2,11 +2,9 @@
 
 from __future__ import annotations
 
-import operator
-from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
 
+from earl.check.constants import constant_value
 from earl.check.context import CheckContext
 from earl.model.elements import InputBuffer, Memory, Subsystem
 from earl.model.expressions import (
@@ -281,41 +279,6 @@ class ExpressionTyper:
 __all__ = ["BOOLEAN", "ExpressionTyper", "TypeProblem"]
 
 
-_ORDER: dict[str, Callable[[Any, Any], bool]] = {
-    "==": operator.eq,
-    "!=": operator.ne,
-    "<": operator.lt,
-    "<=": operator.le,
-    ">": operator.gt,
-    ">=": operator.ge,
-}
-
-
 def _stops(boolean_operator: str, operand: Expression) -> bool:
     """Whether `operand`, a constant, ends the evaluation of the `and`/`or` it is an operand of."""
-    truth = constant_truth(operand)
-    return truth is (boolean_operator == "or")
-
-
-def constant_truth(expression: Expression) -> bool | None:
-    """The truth of a condition made of constants alone (`2 == 2`, once a quantifier put its index in);
-    None when it depends on what the subsystem reads."""
-    if isinstance(expression, Literal):
-        return expression.value if isinstance(expression.value, bool) else None
-    if isinstance(expression, Not):
-        truth = constant_truth(expression.operand)
-        return None if truth is None else not truth
-    if isinstance(expression, BooleanOperation):
-        truths = [constant_truth(operand) for operand in expression.operands]
-        deciding = expression.operator == "or"  # the value that decides an `or` alone, and an `and` its opposite
-        if deciding in truths:
-            return deciding
-        return (not deciding) if all(truth is not None for truth in truths) else None
-    if isinstance(expression, Comparison) and expression.operator in _ORDER:
-        try:
-            left = evaluate_constant(expression.left, {})
-            right = evaluate_constant(expression.right, {})
-            return bool(_ORDER[expression.operator](left, right))
-        except (ConstantError, TypeError):  # not constants, or constants that do not compare (`"a" < 1`)
-            return None
-    return None
+    return constant_value(operand) is (boolean_operator == "or")

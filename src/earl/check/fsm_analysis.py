@@ -46,6 +46,7 @@ from fractions import Fraction
 from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
+from earl.check.constants import ORDERINGS, Constant, constant_value
 from earl.check.context import CheckContext
 from earl.check.expression_types import BOOLEAN, ExpressionTyper
 from earl.check.registry import Finding, rule
@@ -53,19 +54,15 @@ from earl.check.rules_behaviour import followable_definitions
 from earl.diagnostics import Severity
 from earl.model.elements import FSM, Agent, Assumption, State, Subsystem, Transition
 from earl.model.expressions import (
-    Arithmetic,
     BooleanOperation,
     Call,
     Comparison,
-    ConstantError,
     ElementReference,
     Expression,
     FieldAccess,
     Literal,
-    Negate,
     Not,
     Read,
-    evaluate_constant,
 )
 from earl.model.kinds import Kind
 from earl.model.text import expression_text, reference_text, subsystem_name
@@ -108,45 +105,8 @@ class Analysis:
     findings: dict[str, list[Finding]]
 
 
-Constant = bool | int | float | str
-
-_ORDERINGS = {
-    "<": lambda a, b: a < b,
-    "<=": lambda a, b: a <= b,
-    ">": lambda a, b: a > b,
-    ">=": lambda a, b: a >= b,
-    "==": lambda a, b: a == b,
-    "!=": lambda a, b: a != b,
-}
 #: `c < x` is `x > c`
 _MIRRORED = {"<": ">", "<=": ">=", ">": "<", ">=": "<=", "==": "==", "!=": "!="}
-
-
-def _constant(expression: Expression) -> Constant | None:
-    """The value of a sub-formula of constants (the expansion put family indices and parameters in)."""
-    if isinstance(expression, (Literal, Negate, Arithmetic)):
-        try:
-            return evaluate_constant(expression, {})
-        except ConstantError:
-            return None
-    if isinstance(expression, Not):
-        operand = _constant(expression.operand)
-        return (not operand) if isinstance(operand, bool) else None
-    if isinstance(expression, BooleanOperation):
-        values = [_constant(operand) for operand in expression.operands]
-        if not all(isinstance(value, bool) for value in values):
-            return None
-        return all(values) if expression.operator == "and" else any(values)
-    if isinstance(expression, Comparison):
-        left, right = _constant(expression.left), _constant(expression.right)
-        if left is None or right is None or isinstance(left, bool) != isinstance(right, bool):
-            return None
-        if isinstance(left, str) != isinstance(right, str):
-            return None
-        if expression.operator not in ("==", "!=") and (isinstance(left, (str, bool))):
-            return None
-        return bool(_ORDERINGS[expression.operator](left, right))
-    return None
 
 
 #: the most operands of one `and`/`or` the analysis looks into
@@ -213,7 +173,7 @@ class _Encoder:
         return self.bdd.var(name)
 
     def encode(self, expression: Expression) -> Function:
-        folded = _constant(expression)
+        folded = constant_value(expression)
         if isinstance(folded, bool):
             return self.bdd.true if folded else self.bdd.false
         if isinstance(expression, Not):
@@ -277,7 +237,7 @@ class _Encoder:
 
     def _comparison(self, comparison: Comparison) -> Function:
         text = expression_text(comparison)
-        left, right = _constant(comparison.left), _constant(comparison.right)
+        left, right = constant_value(comparison.left), constant_value(comparison.right)
         operator = comparison.operator
         if left is not None and right is None:
             left, right, operator = right, left, _MIRRORED[operator]
@@ -399,7 +359,7 @@ class _Encoder:
         for sample in samples:
             region = self.bdd.true
             for operator, constant, variable in atoms:
-                region &= variable if _ORDERINGS[operator](sample, constant) else ~variable
+                region &= variable if ORDERINGS[operator](sample, constant) else ~variable
             regions |= region
         return regions
 
