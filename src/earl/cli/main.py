@@ -1,6 +1,6 @@
 """The `earl` command: thin, it parses arguments, calls the library and prints.
 
-Exit codes (documented in README and docs/cli.md):
+Exit codes (documented in docs/language.md, "Errors and exit codes"):
     0  the specification is valid (or the command succeeded)
     1  the specification is invalid (or, with `fmt --check`, not canonical)
     2  usage error: a missing file, an unknown option, a bad value
