@@ -260,6 +260,14 @@ class _Context:
                 opened.pop()
         return opened
 
+    def after_arrow(self) -> bool:
+        """Whether an `->` was read since the innermost `(` still open: the write list of a header."""
+        opened = self.open_brackets()
+        if not opened or opened[-1].type != "LPAR":
+            return False
+        inside = self.values[max(i for i, v in enumerate(self.values) if v is opened[-1]) + 1 :]
+        return any(isinstance(value, Token) and str(value) == "->" for value in inside)
+
     def describe(self, terminals: list[str]) -> list[str]:
         """What the terminals are called, keywords and punctuation first, then kinds of token."""
         terminals = list(terminals)
@@ -628,7 +636,10 @@ def _bad_kind(token: Token, context: _Context, location: SourceLocation, path: s
     if str(token) == Kind.MEMORY.value and "MI" in context.expected:
         name = context.value(2)
         named = f"{name}" if isinstance(name, Token) and name.type == "NAME" else "x"
-        hint = f"memory is declared `{named}/m`, read as `{named}/mi` and written as `{named}/mo`; here, read it: `{named}/mi`"
+        # after the `->` of a partial transition function's header the memory is written, before it read
+        written = "MO" in context.expected and context.after_arrow()
+        use = f"write it: `{named}/mo`" if written else f"read it: `{named}/mi`"
+        hint = f"memory is declared `{named}/m`, read as `{named}/mi` and written as `{named}/mo`; here, {use}"
     if str(token) in (Kind.AGENT.value, Kind.ROBOT.value) and context.open_brackets():
         title = KIND_TITLES[Kind(str(token))]
         hint = f"an {title} is declared at the top level; " + (_unclosed_hint(context.open_brackets()) or "")
