@@ -293,9 +293,10 @@ def test_a_comment_that_ends_a_block_stays_in_it(tmp_path: Path, capsys: pytest.
     assert earl.load(again) == earl.load(path)
 
 
-def test_comments_parted_only_by_code_stay_one_block(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    """A comment above `tf` and one above `tc` gather at the end of the behaviour as one block: the
-    line of code between them is no blank line to keep."""
+def test_comments_at_a_behaviour_s_clauses_stay_where_they_were_written(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A comment above `tf` and one above `tc` stay there (they all gathered at the end of the behaviour)."""
     path = tmp_path / "behaviour.earl"
     path.write_text(
         "system s\nx/a {\n    cs {\n        period 1 ms\n        w/pf(->)\n        b/bb {\n            // the work\n"
@@ -303,9 +304,43 @@ def test_comments_parted_only_by_code_stay_one_block(tmp_path: Path, capsys: pyt
     )
     assert main(["fmt", str(path)]) == 0
     assert (
-        "            tc = true\n            // the work\n            // until true\n        }\n"
-        in capsys.readouterr().out
+        "        b/bb {\n            // the work\n            tf = {w/pf}\n            // until true\n            tc = true\n"
+        "        }\n" in capsys.readouterr().out
     )
+
+
+def test_comments_at_clauses_stay_on_their_lines() -> None:
+    """`period 5 ms  // fast`, `tc = …  // why`, `initial …  // why` and the lines of a state's body keep
+    their comments: each clause line had nowhere to keep one, so it went to the line below."""
+    text = (
+        "system s\n\na/a {\n    cs {\n        period 5 ms  // fast\n\n        in/ib: double\n\n"
+        "        p/pp = true\n\n        f/pf(in/ib ->)\n\n"
+        "        b/bb {\n            tf = {f/pf}  // the work\n            // until the command\n"
+        "            tc = p/pp  // came\n            ec = p/pp  // or not\n        }\n\n"
+        "        fsm {\n            initial b  // first\n"
+        "            state b: b/bb {  // waits\n                // the command\n"
+        "                obligatory in/ib  // every period\n                timeout 5 ms  // then stop\n"
+        "                // nothing more\n            }\n"
+        "            state c: b/bb { optional in/ib }  // written on one line\n\n"
+        "            b -> c when p/pp\n        }\n    }\n}\n"
+    )
+    system = earl.loads(text, "s.earl")
+    assert system.to_earl() == text
+    cs = system.agents[0].control_subsystem
+    assert cs is not None and cs.period_location is not None and cs.period_location.line == 5
+    assert cs.fsm is not None and cs.fsm.states[0].timeout_location is not None
+
+
+def test_comments_of_a_clause_written_on_several_lines_are_all_kept() -> None:
+    text = (
+        "system s\na/a {\n    cs {\n        period 5 ms\n        in/ib: double\n        j/ib: double\n"
+        "        f/pf(in/ib ->)\n        b/bb {\n            tf = {f/pf}\n            tc = true\n        }\n"
+        "        fsm {\n            initial b\n            state b: b/bb {\n                obligatory in/ib  // one\n"
+        "                obligatory j/ib  // two\n            }\n        }\n    }\n}\n"
+    )
+    formatted = earl.loads(text, "s.earl").to_earl()
+    assert "                // two\n                obligatory in/ib, j/ib  // one\n" in formatted
+    assert earl.loads(formatted, "s.earl").to_earl() == formatted
 
 
 def test_comments_at_a_robot_s_members_stay_where_they_were_written() -> None:

@@ -257,7 +257,10 @@ def _subsystem(printer: _Printer, subsystem: Subsystem) -> None:
             printer.blank()
         first = False
         for item in group:
-            _body_item(printer, depth, item)
+            if isinstance(item, Duration):  # the period, whose comments its subsystem keeps
+                printer.line(depth, f"period {duration_text(item)}", subsystem.clause_comments.get("period"))
+            else:
+                _body_item(printer, depth, item)
     for behaviour in subsystem.basic_behaviours:
         if not first:
             printer.blank()
@@ -312,10 +315,11 @@ def _body_item(printer: _Printer, depth: int, item: object) -> None:
 def _basic_behaviour(printer: _Printer, depth: int, behaviour: BasicBehaviour) -> None:
     printer.line(depth, f"{behaviour.name}/bb {{", behaviour.comments)
     stages = " then ".join(_pf_set(stage) for stage in behaviour.transition_function.stages) or "{}"
-    printer.line(depth + 1, f"tf = {stages}")
-    printer.line(depth + 1, f"tc = {expression_text(behaviour.terminal_condition.expression)}")
+    said = behaviour.clause_comments
+    printer.line(depth + 1, f"tf = {stages}", said.get("tf"))
+    printer.line(depth + 1, f"tc = {expression_text(behaviour.terminal_condition.expression)}", said.get("tc"))
     if behaviour.error_condition is not None:
-        printer.line(depth + 1, f"ec = {expression_text(behaviour.error_condition.expression)}")
+        printer.line(depth + 1, f"ec = {expression_text(behaviour.error_condition.expression)}", said.get("ec"))
     printer.close(depth, behaviour.comments)
 
 
@@ -323,7 +327,7 @@ def _fsm(printer: _Printer, depth: int, fsm: FSM) -> None:
     printer.line(depth, "fsm {", fsm.comments)
     if not isinstance(fsm.initial, str):  # a model built in Python: `initial None` would read back otherwise
         raise TypeError(f"the initial state is {fsm.initial!r}, not a name")
-    printer.line(depth + 1, f"initial {fsm.initial}")
+    printer.line(depth + 1, f"initial {fsm.initial}", fsm.clause_comments.get("initial"))
     for state in fsm.states:
         _state(printer, depth + 1, state)
     if fsm.transitions:
@@ -346,9 +350,36 @@ def _state(printer: _Printer, depth: int, state: State) -> None:
         group.append(f"optional {_references(state.optional)}")
     if state.timeout is not None:
         group.append(f"timeout {duration_text(state.timeout)}")
-    if group:
-        text += " { " + "  ".join(group) + " }"
-    printer.line(depth, text, state.comments)
+    said = state.clause_comments
+    if not any(_has_comments(c) for c in said.values()) and not state.comments.closing:
+        if group:
+            text += " { " + "  ".join(group) + " }"
+        printer.line(depth, text, state.comments)
+        return
+    # a body with comments in it is written a clause a line, each clause with the comments of the lines
+    # it was written on
+    printer.line(depth, text + " {", state.comments)
+    for clause in group:
+        printer.line(depth + 1, clause, _merged([c for k, c in said.items() if k.startswith(clause.split()[0] + " ")]))
+    printer.close(depth, state.comments)
+
+
+def _has_comments(comments: Comments) -> bool:
+    return bool(comments.leading or comments.trailing or comments.closing)
+
+
+def _merged(said: list[Comments]) -> Comments:
+    """The comments of several lines written as one: every one kept, the first end-of-line comment at
+    the end of the line, the others above it."""
+    merged = Comments()
+    for comments in said:
+        merged.leading.extend(comments.leading)
+        if comments.trailing:
+            if merged.trailing is None:
+                merged.trailing = comments.trailing
+            else:
+                merged.leading.append(comments.trailing)
+    return merged
 
 
 def _transition(printer: _Printer, depth: int, transition: Transition) -> None:

@@ -16,7 +16,7 @@ from earl.lang import reductions
 from earl.lang.driver import Driver, NotWellFormed
 from earl.lang.syntax_errors import translate
 from earl.lang.transformer import ElementBuilder, ParsedFile, SpecificationSyntaxError
-from earl.model.elements import FSM, Agent, BasicBehaviour, Robot, Subsystem
+from earl.model.elements import FSM, Agent, BasicBehaviour, Robot, State, Subsystem
 from earl.model.location import Comments, SourceLocation
 from earl.model.text import robot_member_keys
 from earl.model.types import StructType
@@ -258,7 +258,57 @@ def _statements(declarations: list[Any]) -> list[Any]:
             stack.append(element.fsm)
         if isinstance(element, Robot):
             found.extend(_robot_members(element))
+        elif isinstance(element, Subsystem):
+            found.extend(_clauses(element, [("period", element.period_location)]))
+        elif isinstance(element, BasicBehaviour):
+            error = element.error_condition
+            clauses = [
+                ("tf", element.transition_function.location),
+                ("tc", element.terminal_condition.location),
+                ("ec", error.location if error is not None else None),
+            ]
+            found.extend(_clauses(element, clauses))
+        elif isinstance(element, FSM):
+            found.extend(_clauses(element, [("initial", element.initial_location)]))
+        elif isinstance(element, State):
+            found.extend(_clauses(element, _state_clauses(element)))
     return found
+
+
+def _state_clauses(state: State) -> list[tuple[str, SourceLocation | None]]:
+    """The lines of a state's body: each line that names obligatory or optional buffers (at its first
+    buffer), and the timeout."""
+    clauses: list[tuple[str, SourceLocation | None]] = []
+    for clause, references in (("obligatory", state.obligatory), ("optional", state.optional)):
+        lines: dict[int, SourceLocation] = {}
+        for reference in references:
+            if reference.location is not None and reference.location.line > (state.location or reference.location).line:
+                lines.setdefault(reference.location.line, reference.location)
+        clauses.extend((f"{clause} {number}", location) for number, location in enumerate(lines.values()))
+    clauses.append(("timeout 0", state.timeout_location))
+    return clauses
+
+
+class _Clause:
+    """A clause (`period 2 ms`, `tc = …`, `initial idle`) as the comments see it: where it was written,
+    and its owner's `Comments` for it, made only when a comment comes to it."""
+
+    __slots__ = ("_key", "_owner", "location")
+
+    def __init__(self, location: SourceLocation, owner: dict[str, Comments], key: str) -> None:
+        self.location = location
+        self._owner = owner
+        self._key = key
+
+    @property
+    def comments(self) -> Comments:
+        return self._owner.setdefault(self._key, Comments())
+
+
+def _clauses(
+    element: Subsystem | BasicBehaviour | FSM | State, clauses: list[tuple[str, SourceLocation | None]]
+) -> list[_Clause]:
+    return [_Clause(location, element.clause_comments, key) for key, location in clauses if location is not None]
 
 
 class _RobotMember:
@@ -284,7 +334,7 @@ def _member_locations(robot: Robot) -> list[SourceLocation | None]:
 
 
 #: the elements written with braces around a body, which keep the comments that end it (`Comments.closing`)
-_BLOCKS: tuple[type, ...] = (StructType, Robot, Agent, Subsystem, BasicBehaviour, FSM)
+_BLOCKS: tuple[type, ...] = (StructType, Robot, Agent, Subsystem, BasicBehaviour, FSM, State)
 
 
 def attach_comments(declarations: list[Any], comments: list[Token], path: str, text: str | None = None) -> list[str]:

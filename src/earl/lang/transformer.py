@@ -344,6 +344,7 @@ class ElementBuilder:
                 _refuse_second(period, item, f" in `{subsystem.name}`")
                 period = item
                 subsystem.period = item.value
+                subsystem.period_location = item.location
             elif isinstance(item, Parameter):
                 subsystem.parameters.append(item)
             elif isinstance(item, InputBuffer):
@@ -554,6 +555,7 @@ class ElementBuilder:
                 _refuse_second(timeout, item, f" in state `{name}`")
                 timeout = item
                 state.timeout = item.value
+                state.timeout_location = item.location
         return state
 
     def buffer_group(self, meta: Meta, children: list[_BodyItem]) -> list[_BodyItem]:

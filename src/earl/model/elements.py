@@ -50,10 +50,11 @@ class Duration:
 def duration_problems(subsystem: Subsystem) -> list[tuple[str, str, SourceLocation | None]]:
     """`(what, problem, where)` for the subsystem's period and each state's timeout that
     `duration_problem` refuses: `("the period", "is -2 ms; it must be …", location)`."""
-    durations = [("the period", subsystem.period, subsystem.location)]
+    durations = [("the period", subsystem.period, subsystem.period_location or subsystem.location)]
     if subsystem.fsm is not None:
         durations += [
-            (f"the timeout of state `{state.name}`", state.timeout, state.location) for state in subsystem.fsm.states
+            (f"the timeout of state `{state.name}`", state.timeout, state.timeout_location or state.location)
+            for state in subsystem.fsm.states
         ]
     found = []
     for what, duration, location in durations:
@@ -238,6 +239,8 @@ class BasicBehaviour:
     error_condition: Predicate | None = None
     location: SourceLocation | None = location_field()
     comments: Comments = comments_field()
+    #: the comments at its `tf`, `tc` and `ec` lines, so that `earl fmt` keeps them there
+    clause_comments: dict[str, Comments] = field(default_factory=dict, compare=False, repr=False)
     kind: ClassVar[Kind] = Kind.BASIC_BEHAVIOUR
 
 
@@ -257,6 +260,11 @@ class State:
     location: SourceLocation | None = location_field()
     comments: Comments = comments_field()
     behaviour_location: SourceLocation | None = location_field()
+    #: where `timeout …` is written, for messages about it
+    timeout_location: SourceLocation | None = location_field()
+    #: the comments at the lines of its body (`obligatory`, `optional`, `timeout`), keyed by the clause
+    #: and the line's number among that clause's lines (`obligatory 0`), so that `earl fmt` keeps them
+    clause_comments: dict[str, Comments] = field(default_factory=dict, compare=False, repr=False)
 
 
 @dataclass
@@ -304,6 +312,8 @@ class FSM:
     comments: Comments = comments_field()
     #: where `initial NAME` names the initial state, for messages about it
     initial_location: SourceLocation | None = location_field()
+    #: the comments at its `initial` line, so that `earl fmt` keeps them there
+    clause_comments: dict[str, Comments] = field(default_factory=dict, compare=False, repr=False)
 
     def state_named(self, name: str) -> State | None:
         return next((state for state in self.states if state.name == name), None)
@@ -350,6 +360,10 @@ class Subsystem:
     comments: Comments = comments_field()
     #: In an expanded system, which member of `family` this element is (see earl.model.expand).
     index: int | None = None
+    #: where `period …` is written, for messages about it
+    period_location: SourceLocation | None = location_field()
+    #: the comments at its `period` line, so that `earl fmt` keeps them there
+    clause_comments: dict[str, Comments] = field(default_factory=dict, compare=False, repr=False)
     kind: ClassVar[Kind]
 
     def input_buffer(self, name: str) -> InputBuffer | None:
