@@ -406,3 +406,13 @@ def test_the_digest_walks_a_model_nested_deeper_than_pythons_recursion_limit() -
     for _ in range(sys.getrecursionlimit() * 2):
         deep = Not(deep)  # type: ignore[arg-type]
     assert model_digest(deep) != model_digest(Not(Literal(True)))
+
+
+def test_an_agent_and_a_robot_are_found_by_their_name_bare_or_with_their_kind() -> None:
+    import earl
+
+    system = earl.load(Path(__file__).parent.parent / "examples" / "pick_and_place")
+    assert system.agent("manip/a") is system.agent("manip") is not None
+    assert system.agent("manip/r") is None and system.agent("nobody/a") is None
+    robot = system.robots[0]
+    assert system.robot(f"{robot.name}/r") is system.robot(robot.name) is robot

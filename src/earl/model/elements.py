@@ -562,9 +562,14 @@ class System:
     imported_values: dict[str, object] = field(default_factory=dict, compare=False, repr=False)
 
     def agent(self, name: str) -> Agent | None:
+        """The agent called `name`, written bare (`manip`) or as the manual writes it (`manip/a`); None
+        when the system has none."""
+        name = name.removesuffix("/" + Kind.AGENT.value)
         return next((a for a in self.agents if a.name == name), None)
 
     def robot(self, name: str) -> Robot | None:
+        """The robot called `name` (`arm` or `arm/r`); None when the system has none."""
+        name = name.removesuffix("/" + Kind.ROBOT.value)
         return next((r for r in self.robots if r.name == name), None)
 
     def type_named(self, name: str) -> TypeDefinition | None:
