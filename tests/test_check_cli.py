@@ -349,6 +349,8 @@ def test_a_param_of_the_wrong_type_is_one_error_not_one_per_use(
     status, _, err = run(capsys, "check", str(EXAMPLE), "--param", f"N={value}")
     assert status == 1
     assert err.count("error[") == 1 and "EARL-R005" in err and fragment in err
+    # the caret is at the spec's own value, which is right: the message says where the wrong one came from
+    assert "given from outside the spec (`--param`" in err and "as the spec's own (marked) is" in err
 
 
 def test_a_problem_is_reported_once_at_the_place_it_was_written(

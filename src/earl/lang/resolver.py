@@ -277,10 +277,16 @@ class Resolver:
                     continue
             wrong = parameter_value_problem(type_name, value)
             if wrong is not None:
+                given = parameter.name in overrides
                 self.error(
-                    f"parameter `{parameter.name}` is `{type_name}` but {wrong}",
+                    f"parameter `{parameter.name}` is `{type_name}` but {wrong}"
+                    + (", given from outside the spec (`--param`, or `parameters=` in Python)" if given else ""),
                     parameter.value.location or parameter.location,
                     "EARL-R005",
+                    # the caret is at the spec's own value, which is not the wrong one: say what to change
+                    f"give `{parameter.name}` a value of type `{type_name}`, as the spec's own (marked) is"
+                    if given
+                    else None,
                 )
                 if parameter.name not in overrides:
                     continue
