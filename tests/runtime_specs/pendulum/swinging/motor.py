@@ -1,0 +1,12 @@
+from typing import Any
+
+
+def drive(inputs: Any, outputs: Any, context: Any) -> None:
+    plant = context.environment
+    actuator = f"motor{context.parameters['K']}"  # motor[2]/re drives the model's `motor2`
+    plant.set_input(actuator, inputs.current)  # amperes, limited to the actuator's ctrlrange
+    outputs.reading = plant.encoder(actuator)  # motor shaft, rad, in whole encoder counts
+
+
+def report(inputs: Any, outputs: Any, context: Any) -> None:
+    outputs.angle = inputs.reading
