@@ -9,6 +9,11 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
+import earl
+from earl.diagnostics import EarlError
+
 ROOT = Path(__file__).parent.parent
 PENDULUM = ROOT / "tests" / "runtime_specs" / "pendulum"
 PAGE = ROOT / "docs" / "simulation.md"
@@ -67,3 +72,49 @@ def test_the_page_lists_the_example_s_files_and_its_last_line(tmp_path: Path) ->
     result = earl_cli("run", str(PENDULUM), cwd=tmp_path)  # run.toml's duration, as the page runs it
     last = result.stdout.strip().splitlines()[-1]
     assert f"# … {last}" in section()
+
+
+# ------------------------------------------------------------------ mistakes in the model, said before the run
+
+
+def test_xml_that_is_not_well_formed_is_one_line_naming_the_file_and_line_at_run_toml_s_environment(
+    tmp_path: Path,
+) -> None:
+    copy = pendulum_copy(tmp_path, old="  </worldbody>", new="  </worldbod>")
+    result = earl_cli("run", str(copy), "--duration", "10ms", cwd=tmp_path)
+    assert result.returncode == 1, result.stdout
+    assert "\\n" not in result.stderr  # MuJoCo's line breaks, which a diagnostic would show escaped
+    first = result.stderr.splitlines()[0]
+    assert first.startswith("error[EARL-X020]: the environment `swinging.environment:make` failed to start")
+    assert f"MuJoCo could not read {copy / 'pendulum.xml'}, line 4: the element `<worldbody>`" in first
+    assert "closed by an end tag of another name (XML_ERROR_MISMATCHED_ELEMENT)" in first
+    # where the environment is named
+    assert " --> pendulum/run.toml:1:15" in result.stderr
+    assert '1 | environment = "swinging.environment:make"' in result.stderr
+
+
+def test_a_model_mujoco_refuses_is_one_line_naming_the_line_and_the_element(tmp_path: Path) -> None:
+    copy = pendulum_copy(tmp_path, old='joint="elbow"', new='joint="elbw"')
+    result = earl_cli("run", str(copy / "system.earl"), "--duration", "10ms", cwd=copy)
+    assert result.returncode == 1
+    assert "\\n" not in result.stderr
+    assert (
+        f"MuJoCo could not read {copy / 'pendulum.xml'}, line 17 (the element named `motor2`): "
+        "unknown transmission target 'elbw' for actuator id = 1"
+    ) in result.stderr
+    assert " --> run.toml:1:15" in result.stderr
+
+
+def test_an_environment_whose_advance_is_no_method_is_said_at_run_toml_s_line(tmp_path: Path) -> None:
+    copy = pendulum_copy(
+        tmp_path,
+        "swinging/environment.py",
+        old='    return MujocoPlant.from_file(MODEL, seed=seed, keyframe="start")',
+        new="    return type('World', (), {'advance': 0.001})()",
+    )
+    with pytest.raises(EarlError) as refused:
+        earl.simulate(earl.load(copy))
+    [diagnostic] = refused.value.diagnostics
+    assert diagnostic.code == "EARL-X020" and "`advance` is a float, not a method" in diagnostic.message
+    assert diagnostic.location is not None and diagnostic.location.file.endswith("run.toml")
+    assert (diagnostic.location.line, diagnostic.location.column) == (1, 15)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -206,3 +207,26 @@ def test_importing_earl_sim_without_a_display_loads_no_opengl_until_a_picture_is
     )
     # a run without pictures never loads PyOpenGL, and leaves MUJOCO_GL unset for the processes it starts
     assert result.stdout.splitlines() == ["False None", "egl mujoco.egl"]
+
+
+def test_mujoco_s_errors_on_reading_a_model_are_one_line_that_names_the_line(tmp_path: Path) -> None:
+    good = arm.robot_mjcf(3)
+    with pytest.raises(PlantError) as refused:
+        MujocoPlant.from_xml(good.replace("<worldbody>", "<worldbody>\n<body>", 1))
+    said = str(refused.value)
+    assert "\n" not in said
+    assert said.startswith("MuJoCo could not read the XML given to MujocoPlant.from_xml, line ")
+    assert "(MujocoPlant.from_file reads a file and names it here)" in said
+    model = tmp_path / "robot.xml"
+    model.write_text(good.replace("<joint ", "<joint dumping='1' ", 1))
+    with pytest.raises(PlantError) as refused:
+        MujocoPlant.from_file(model)
+    line = 1 + good[: good.index("<joint ")].count("\n")
+    assert str(refused.value) == (
+        f"MuJoCo could not read {model}, line {line} (element `<joint>`): "
+        "Schema violation: unrecognized attribute: 'dumping'"
+    )
+    with pytest.raises(PlantError, match=r"MuJoCo could not read the model: nowhere\.xml does not exist \(a relative"):
+        MujocoPlant.from_file("nowhere.xml")
+    with pytest.raises(PlantError, match=r"the XML given to MujocoPlant\.from_xml is empty"):
+        MujocoPlant.from_xml("  \n")

@@ -14,16 +14,19 @@ from __future__ import annotations
 
 import math
 import numbers
+import os
+import re
 import tomllib
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
-from earl.diagnostics import Diagnostic, EarlError, Severity
+from earl.diagnostics import Diagnostic, EarlError, Severity, SourceMap
 from earl.model.digest import model_digest
 from earl.model.elements import Duration, System
 from earl.model.expand import expand
+from earl.model.location import SourceLocation
 from earl.model.types import refuse_wrong_parameters
 from earl.runtime.binding import BindingProblem, resolve_callable, user_code_path
 from earl.runtime.builder import NANOSECONDS, Network, RemoteLinks, build_network, to_nanoseconds
@@ -124,6 +127,10 @@ class Simulation:
             # like `earl run`: the environment a run.toml next to the spec names, if any
             environment = read_run_settings(Path(system.source_file)).environment if system.source_file else None
         self.environment = _environment(environment, self.expanded, seed, directories, system)
+        #: where the environment is named (run.toml's line), for what is said of it before the run
+        self._environment_named = (
+            _setting_location(system, "environment", environment) if isinstance(environment, str) else (None, None)
+        )
         self.statistics = StatisticsRecorder()
         self._faults = _FaultList()
         own: list[Recorder] = [self.statistics, self._faults, *(recorders or [])]
@@ -176,7 +183,7 @@ class Simulation:
         self.scheduler = Scheduler(
             self.network,
             self.recorder,
-            _Guarded(self.environment),
+            _Guarded(self.environment, *self._environment_named),
             realtime=realtime,
             record_memory=memory,
             inbox=None if transport is None else transport.inbox,
@@ -419,13 +426,15 @@ class _Guarded:
 
     One call more per advance of the plant, which steps a physics engine each time."""
 
-    def __init__(self, environment: object) -> None:
+    def __init__(
+        self, environment: object, location: SourceLocation | None = None, sources: SourceMap | None = None
+    ) -> None:
         advance = getattr(environment, "advance", None)
         if advance is None:
             return
         if not callable(advance):
             message = f"the environment's `advance` is a {type(advance).__name__}, not a method"
-            raise EarlError([Diagnostic(Severity.ERROR, message, None, code="EARL-X020")])
+            raise EarlError([Diagnostic(Severity.ERROR, message, location, code="EARL-X020")], sources)
 
         def guarded(seconds: float) -> None:
             try:
@@ -445,13 +454,14 @@ def _environment(
 ) -> object:
     if not isinstance(environment, str):
         return environment
+    location, sources = _setting_location(system, "environment", environment)
     with user_code_path(directories):
         try:
             factory = resolve_callable(
-                environment, "the environment", None, arity=2, signature="def NAME(system, seed) -> object"
+                environment, "the environment", location, arity=2, signature="def NAME(system, seed) -> object"
             )
         except BindingProblem as problem:
-            raise EarlError([problem.diagnostic], system.sources) from None  # type: ignore[arg-type]
+            raise EarlError([problem.diagnostic], sources) from None
         try:
             return factory(expanded, seed)
         except Exception as error:
@@ -460,11 +470,36 @@ def _environment(
                     Diagnostic(
                         Severity.ERROR,
                         f"the environment `{environment}` failed to start: {type(error).__name__}: {error}",
-                        None,
+                        location,
                         code="EARL-X020",
                     )
-                ]
+                ],
+                sources,
             ) from None
+
+
+def _setting_location(system: System, key: str, value: str) -> tuple[SourceLocation | None, SourceMap]:
+    """Where the run.toml next to the spec sets `key` to `value`, if it does (a message about the environment
+    points at the line that names it), and the texts a diagnostic quotes: the spec's, and that run.toml's."""
+    sources = SourceMap()
+    if isinstance(system.sources, SourceMap):
+        sources.texts.update(system.sources.texts)
+    if not system.source_file:
+        return None, sources
+    path = Path(system.source_file).resolve().parent / "run.toml"  # as read_run_settings finds it
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError):
+        return None, sources
+    shown = os.path.relpath(path)
+    if shown.startswith(".."):
+        shown = str(path)
+    for number, line in enumerate(text.split("\n"), start=1):
+        setting = re.match(rf"\s*{re.escape(key)}\s*=\s*([\"'])(.*?)\1", line)
+        if setting is not None and setting[2] == value:
+            sources.add(shown, text)
+            return SourceLocation(shown, number, setting.start(1) + 1, number, setting.end(0)), sources
+    return None, sources
 
 
 @dataclass

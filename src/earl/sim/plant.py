@@ -18,6 +18,7 @@ data="GEAR COUNTS"/>`: it reports the actuated joint's position times the gear r
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -101,19 +102,35 @@ class MujocoPlant:
 
     @classmethod
     def from_xml(cls, xml: str, seed: int = 0, keyframe: str | None = None) -> MujocoPlant:
-        """Build from MJCF text (errors from MuJoCo are reported as `PlantError`)."""
+        """Build from MJCF text (errors from MuJoCo are reported as `PlantError`).
+
+        Files the text includes are looked for in the current directory; `from_file` finds them
+        next to the XML file, and its errors name that file."""
+        if not xml.strip():
+            raise PlantError("MuJoCo could not read the model: the XML given to MujocoPlant.from_xml is empty")
         try:
             model = mujoco.MjModel.from_xml_string(xml)
         except ValueError as error:
-            raise PlantError(f"MuJoCo could not read the model: {error}") from None
+            said = load_error("the XML given to MujocoPlant.from_xml", str(error))
+            raise PlantError(f"{said} (MujocoPlant.from_file reads a file and names it here)") from None
         return cls(model, seed, keyframe)
 
     @classmethod
     def from_file(cls, path: str | Path, seed: int = 0, keyframe: str | None = None) -> MujocoPlant:
+        """Build from an MJCF file: a relative `path` is taken from the current directory, the files
+        it includes (`<include>`, meshes) from the file's own directory."""
+        if not Path(path).is_file():
+            kind = "is a directory, not an XML file" if Path(path).is_dir() else "does not exist"
+            where = (
+                ""
+                if Path(path).is_absolute()
+                else f" (a relative path is taken from the current directory, {Path.cwd()})"
+            )
+            raise PlantError(f"MuJoCo could not read the model: {path} {kind}{where}")
         try:
             model = mujoco.MjModel.from_xml_path(str(path))
         except ValueError as error:
-            raise PlantError(f"{path}: MuJoCo could not read the model: {error}") from None
+            raise PlantError(load_error(str(path), str(error))) from None
         return cls(model, seed, keyframe)
 
     # ------------------------------------------------------------ time
@@ -294,3 +311,43 @@ def _pose(position: FloatArray, quaternion: FloatArray) -> Pose:
     p = (float(position[0]), float(position[1]), float(position[2]))
     q = (float(quaternion[0]), float(quaternion[1]), float(quaternion[2]), float(quaternion[3]))
     return Pose(p, q)
+
+
+#: what TinyXML2, MuJoCo's XML reader, means by the errors a hand-written model most often has
+_XML_ERRORS = {
+    "XML_ERROR_MISMATCHED_ELEMENT": "is closed by an end tag of another name",
+    "XML_ERROR_PARSING_ELEMENT": "has a malformed tag",
+    "XML_ERROR_PARSING_ATTRIBUTE": "has a malformed attribute",
+    "XML_ERROR_PARSING_TEXT": "has text outside any element (is it XML?)",
+    "XML_ERROR_PARSING_COMMENT": "has a comment that is not closed (`-->`)",
+    "XML_ERROR_PARSING": "is cut short or malformed: an element is not closed",
+    "XML_ERROR_EMPTY_DOCUMENT": "is empty",
+}
+_TINYXML = re.compile(
+    r"XML parse error \d+:\s*Error=(\w+) ErrorID=\d+ \(0x[0-9a-fA-F]+\) Line number=(\d+)(?::\s*(.*))?", re.S
+)
+#: the last line of MuJoCo's own errors: `Element 'joint', line 6` or `Element name 'motor2', id 1, line 16`
+_ELEMENT = re.compile(r"Element (name )?'([^']*)'(?:, id \d+)?, line (\d+)")
+_PREFIXES = re.compile(r"^(?:(?:XML Error|Error|ParseXML):\s*)+")
+
+
+def load_error(origin: str, error: str) -> str:
+    """MuJoCo's error on reading a model, on one line that names the XML (`origin`) and the line.
+
+    MuJoCo writes its errors over several lines (TinyXML2's for XML that is not well formed, its own
+    for a schema or model mistake); a diagnostic is one line, on which they would read `\\n`."""
+    tinyxml = _TINYXML.match(error.strip())
+    if tinyxml is not None:
+        kind, line, detail = tinyxml[1], tinyxml[2], (tinyxml[3] or "").strip()
+        element = re.fullmatch(r"XMLElement name=(\S+)", detail)
+        subject = f"the element `<{element[1]}>` that starts there" if element else "the XML"
+        what = _XML_ERRORS.get(kind, "is not well formed")
+        return f"MuJoCo could not read {origin}, line {line}: {subject} {what} ({kind})"
+    lines = [line.strip() for line in error.strip().splitlines() if line.strip()]
+    where = ""
+    if lines and (element := _ELEMENT.fullmatch(lines[-1])) is not None:
+        named, name, line = element[1], element[2], element[3]
+        where = f", line {line} ({'the element named' if named else 'element'} `{name if named else '<' + name + '>'}`)"
+        lines.pop()
+    said = "; ".join(_PREFIXES.sub("", line) for line in lines) or "no reason given"
+    return f"MuJoCo could not read {origin}{where}: {said}"
