@@ -118,3 +118,16 @@ def test_an_environment_whose_advance_is_no_method_is_said_at_run_toml_s_line(tm
     assert diagnostic.code == "EARL-X020" and "`advance` is a float, not a method" in diagnostic.message
     assert diagnostic.location is not None and diagnostic.location.file.endswith("run.toml")
     assert (diagnostic.location.line, diagnostic.location.column) == (1, 15)
+
+
+def test_an_encoder_of_zero_counts_is_said_at_its_line_before_the_run(tmp_path: Path) -> None:
+    copy = pendulum_copy(
+        tmp_path, old='"earl.encoder.motor1" data="100 4096"', new='"earl.encoder.motor1" data="100 0"'
+    )
+    result = earl_cli("run", str(copy), "--duration", "10ms", cwd=tmp_path)
+    assert result.returncode == 1
+    assert "ZeroDivisionError" not in result.stderr
+    assert (
+        f'PlantError: {copy / "pendulum.xml"}, line 21: the encoder <numeric name="earl.encoder.motor1" data="100 0"/> '
+        "has 0 counts per revolution: COUNTS, its second number, is a whole number, 1 or more"
+    ) in result.stderr

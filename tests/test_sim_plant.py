@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -230,3 +231,36 @@ def test_mujoco_s_errors_on_reading_a_model_are_one_line_that_names_the_line(tmp
         MujocoPlant.from_file("nowhere.xml")
     with pytest.raises(PlantError, match=r"the XML given to MujocoPlant\.from_xml is empty"):
         MujocoPlant.from_xml("  \n")
+
+
+@pytest.mark.parametrize(
+    ("data", "said"),
+    [
+        (
+            "100 0",
+            'data="100 0"/> has 0 counts per revolution: COUNTS, its second number, is a whole number, 1 or more',
+        ),
+        ("100 40.5", "has 40.5 counts per revolution"),
+        ("0 4096", "has the gear ratio 0: GEAR, its first number, is the motor shaft's turns per turn of the joint"),
+        ("100", 'has 1 numbers: write data="GEAR COUNTS"'),
+    ],
+)
+def test_an_encoder_s_numbers_are_checked_when_the_plant_is_built(data: str, said: str) -> None:
+    xml = arm.robot_mjcf(3)
+    declared = re.search(r'<numeric name="earl\.encoder\.motor2" data="[^"]*"', xml)
+    assert declared is not None
+    xml = xml.replace(declared[0], f'<numeric name="earl.encoder.motor2" data="{data}"')
+    line = 1 + xml[: xml.index('"earl.encoder.motor2"')].count("\n")
+    with pytest.raises(PlantError) as refused:
+        MujocoPlant.from_xml(xml)
+    message = str(refused.value)
+    assert message.startswith(
+        f'the XML given to MujocoPlant.from_xml, line {line}: the encoder <numeric name="earl.encoder.motor2"'
+    )
+    assert said in message
+
+
+def test_an_encoder_of_no_actuator_is_said_with_the_actuators_the_model_has() -> None:
+    xml = arm.robot_mjcf(3).replace('"earl.encoder.motor2"', '"earl.encoder.motr2"')
+    with pytest.raises(PlantError, match=r"names no actuator of the model: .*did you mean `motor2`\?"):
+        MujocoPlant.from_xml(xml)

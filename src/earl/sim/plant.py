@@ -27,6 +27,8 @@ import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
+from earl.diagnostics import did_you_mean
+
 ENCODER_PREFIX = "earl.encoder."
 
 FloatArray = NDArray[np.float64]
@@ -35,6 +37,22 @@ _FrameHook = Callable[["MujocoPlant"], None]
 
 class PlantError(ValueError):
     """A name that the model does not have, or a time that has already passed."""
+
+
+@dataclass(frozen=True)
+class XmlOrigin:
+    """Where a model's XML came from: what messages call it (a file name), and its text, to find a line in."""
+
+    name: str
+    text: str | None = None
+
+    def line_of(self, name: str) -> str:
+        """`NAME, line N` for the element whose `name="…"` is `name` (just `NAME` if the text does not show it:
+        an included file, or no text)."""
+        found = re.search(rf"""\bname\s*=\s*["']{re.escape(name)}["']""", self.text or "")
+        if found is None or self.text is None:
+            return self.name
+        return f"{self.name}, line {1 + self.text.count(chr(10), 0, found.start())}"
 
 
 @dataclass(frozen=True)
@@ -71,8 +89,13 @@ class Pose:
 class MujocoPlant:
     """One MuJoCo model and its state, advanced to each instant the runtime asks for."""
 
-    def __init__(self, model: mujoco.MjModel, seed: int = 0, keyframe: str | None = None) -> None:
+    def __init__(
+        self, model: mujoco.MjModel, seed: int = 0, keyframe: str | None = None, *, origin: XmlOrigin | None = None
+    ) -> None:
+        """`origin`: the XML the model was read from, for messages that point at its lines (`from_file` and
+        `from_xml` give it)."""
         self.model = model
+        self.origin = origin or XmlOrigin("the model's XML")
         self.data = mujoco.MjData(model)
         # views on the data's own buffers, made once (each `data.ctrl` makes a new view)
         self._ctrl = self.data.ctrl
@@ -108,12 +131,13 @@ class MujocoPlant:
         next to the XML file, and its errors name that file."""
         if not xml.strip():
             raise PlantError("MuJoCo could not read the model: the XML given to MujocoPlant.from_xml is empty")
+        origin = XmlOrigin("the XML given to MujocoPlant.from_xml", xml)
         try:
             model = mujoco.MjModel.from_xml_string(xml)
         except ValueError as error:
-            said = load_error("the XML given to MujocoPlant.from_xml", str(error))
+            said = load_error(origin.name, str(error))
             raise PlantError(f"{said} (MujocoPlant.from_file reads a file and names it here)") from None
-        return cls(model, seed, keyframe)
+        return cls(model, seed, keyframe, origin=origin)
 
     @classmethod
     def from_file(cls, path: str | Path, seed: int = 0, keyframe: str | None = None) -> MujocoPlant:
@@ -131,7 +155,7 @@ class MujocoPlant:
             model = mujoco.MjModel.from_xml_path(str(path))
         except ValueError as error:
             raise PlantError(load_error(str(path), str(error))) from None
-        return cls(model, seed, keyframe)
+        return cls(model, seed, keyframe, origin=XmlOrigin(str(path), Path(path).read_text(errors="replace")))
 
     # ------------------------------------------------------------ time
 
@@ -208,18 +232,47 @@ class MujocoPlant:
     # ------------------------------------------------------------ sensors
 
     def _read_encoders(self) -> dict[str, Encoder]:
+        """The encoders the model declares, each checked: a wrong number would fail in every reading
+        (a division by zero counts) or read nonsense, far from the line that is wrong."""
         encoders: dict[str, Encoder] = {}
         for i in range(self.model.nnumeric):
             name = self.model.numeric(i).name
             if not name.startswith(ENCODER_PREFIX):
                 continue
             actuator = name[len(ENCODER_PREFIX) :]
-            index = self._actuator(actuator)
-            data = self.model.numeric(i).data
+            data = [float(number) for number in self.model.numeric(i).data]
+            shown = " ".join(f"{number:g}" for number in data)
+            where = f'{self.origin.line_of(name)}: the encoder <numeric name="{name}" data="{shown}"/>'
+            if actuator not in self._actuators:
+                names = ", ".join(self.actuator_names()) or "none"
+                hint = did_you_mean(actuator, self._actuators)
+                raise PlantError(
+                    f"{where} names no actuator of the model: an encoder is `{ENCODER_PREFIX}ACTUATOR` "
+                    f"(the actuators: {names}){'; ' + hint if hint else ''}"
+                )
             if len(data) != 2:
-                raise PlantError(f'encoder `{name}` needs data="GEAR COUNTS", got {len(data)} numbers')
+                raise PlantError(f'{where} has {len(data)} numbers: write data="GEAR COUNTS", e.g. data="100 4096"')
+            gear_ratio, counts = data
+            if not math.isfinite(gear_ratio) or gear_ratio == 0:
+                raise PlantError(
+                    f"{where} has the gear ratio {gear_ratio:g}: GEAR, its first number, is the motor shaft's "
+                    'turns per turn of the joint, a number other than 0 (e.g. data="100 4096")'
+                )
+            if not (math.isfinite(counts) and counts >= 1 and counts == int(counts)):
+                raise PlantError(
+                    f"{where} has {counts:g} counts per revolution: COUNTS, its second number, is a whole "
+                    'number, 1 or more (e.g. data="100 4096")'
+                )
+            index = self._actuators[actuator]
             joint = int(self.model.actuator_trnid[index, 0])
-            encoders[actuator] = Encoder(actuator, int(self.model.jnt_qposadr[joint]), float(data[0]), int(data[1]))
+            if int(self.model.actuator_trntype[index]) != mujoco.mjtTrn.mjTRN_JOINT or int(
+                self.model.jnt_type[joint]
+            ) not in (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE):
+                raise PlantError(
+                    f"{where} is on an actuator that drives no hinge or slide joint: an encoder reads the angle "
+                    f"or position of the joint its actuator drives (`joint=` of `{actuator}`)"
+                )
+            encoders[actuator] = Encoder(actuator, int(self.model.jnt_qposadr[joint]), gear_ratio, int(counts))
         return encoders
 
     def encoder(self, actuator: str) -> float:
