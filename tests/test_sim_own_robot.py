@@ -131,3 +131,84 @@ def test_an_encoder_of_zero_counts_is_said_at_its_line_before_the_run(tmp_path: 
         f'PlantError: {copy / "pendulum.xml"}, line 21: the encoder <numeric name="earl.encoder.motor1" data="100 0"/> '
         "has 0 counts per revolution: COUNTS, its second number, is a whole number, 1 or more"
     ) in result.stderr
+
+
+def spec_line(copy: Path, text: str) -> int:
+    lines = (copy / "system.earl").read_text(encoding="utf-8").splitlines()
+    return 1 + next(number for number, line in enumerate(lines) if line.strip().startswith(text))
+
+
+def test_an_actuator_missing_from_the_model_is_refused_before_the_run_at_the_effector(tmp_path: Path) -> None:
+    copy = pendulum_copy(tmp_path)
+    xml = copy / "pendulum.xml"
+    text = xml.read_text(encoding="utf-8")
+    for gone in ('    <motor name="motor2"', '    <numeric name="earl.encoder.motor2"'):
+        line = next(line for line in text.splitlines(keepends=True) if line.startswith(gone))
+        text = text.replace(line, "")
+    xml.write_text(text, encoding="utf-8")
+    result = earl_cli("run", str(copy), "--duration", "10ms", cwd=copy)
+    assert result.returncode == 1, result.stdout
+    assert "fault" not in result.stdout + result.stderr  # said before the first iteration, not 12 faults later
+    assert result.stderr.splitlines()[0] == (
+        "error[EARL-X021]: the model has no actuator named `motor2`, which `arm/a.motor[2]/re` acts on: each member "
+        "of `arm/a.motor[K]/re` acts on the actuator named after it (`arm/a.motor[1]/re` acts on `motor1`); the "
+        "model's actuators: motor1"
+    )
+    assert f" --> system.earl:{spec_line(copy, 'motor[K in 1..J]/re {')}:5" in result.stderr
+    assert "nothing was executed" in result.stderr
+
+
+def test_a_misspelt_actuator_is_refused_with_the_name_meant(tmp_path: Path) -> None:
+    copy = pendulum_copy(tmp_path)
+    xml = copy / "pendulum.xml"
+    xml.write_text(xml.read_text(encoding="utf-8").replace("motor2", "motr2"), encoding="utf-8")  # and its encoder
+    with pytest.raises(EarlError) as refused:
+        earl.simulate(earl.load(copy))
+    [diagnostic] = refused.value.diagnostics
+    assert diagnostic.code == "EARL-X021" and "the model's actuators: motor1, motr2" in diagnostic.message
+    assert diagnostic.hint == "did you mean `motr2`?"
+    assert diagnostic.location is not None and diagnostic.location.line == spec_line(copy, "motor[K in 1..J]/re {")
+
+
+def test_an_encoder_missing_for_one_member_of_a_family_is_refused(tmp_path: Path) -> None:
+    copy = pendulum_copy(tmp_path, old='    <numeric name="earl.encoder.motor2" data="100 4096"/>\n', new="")
+    result = earl_cli("run", str(copy), "--duration", "10ms")
+    assert result.returncode == 1
+    assert (
+        f"error[EARL-X021]: {copy / 'pendulum.xml'} declares no encoder for `motor2`, which `arm/a.motor[2]/re` "
+        "acts on, but does for `motor1`"
+    ) in result.stderr
+    assert (
+        '= hint: add <numeric name="earl.encoder.motor2" data="GEAR COUNTS"/> to its <custom> section' in result.stderr
+    )
+
+
+def test_effectors_whose_code_names_the_actuators_otherwise_are_not_held_to_their_own_names(tmp_path: Path) -> None:
+    copy = pendulum_copy(tmp_path, "swinging/motor.py", old='f"motor{', new='f"drive{')
+    xml = copy / "pendulum.xml"
+    renamed = xml.read_text(encoding="utf-8").replace('"motor', '"drive').replace("encoder.motor", "encoder.drive")
+    xml.write_text(renamed, encoding="utf-8")
+    result = earl_cli("run", str(copy), "--duration", "200ms")
+    assert result.returncode == 0, result.stderr
+    assert "fault(s)" not in result.stdout
+
+
+def test_an_environment_s_own_bind_may_refuse_the_system(tmp_path: Path) -> None:
+    copy = pendulum_copy(
+        tmp_path,
+        "swinging/environment.py",
+        old='    return MujocoPlant.from_file(MODEL, seed=seed, keyframe="start")',
+        new=(
+            '    plant = MujocoPlant.from_file(MODEL, seed=seed, keyframe="start")\n'
+            "    def bind(system: Any) -> None:\n"
+            '        raise ValueError(f"{system.name} needs a third joint")\n'
+            "    plant.bind = bind  # type: ignore[method-assign]\n"
+            "    return plant"
+        ),
+    )
+    with pytest.raises(EarlError) as refused:
+        earl.simulate(earl.load(copy))
+    [diagnostic] = refused.value.diagnostics
+    assert diagnostic.code == "EARL-X021"
+    assert diagnostic.message == "the environment does not fit the system: ValueError: pendulum needs a third joint"
+    assert diagnostic.location is not None and diagnostic.location.file.endswith("run.toml")

@@ -92,6 +92,10 @@ class PickAndPlaceEnvironment:
 
     # ------------------------------------------------------------ the runtime's side
 
+    def bind(self, system: Any) -> None:
+        """The workcell checks, before the first iteration, that it has every drive the spec's motors act on."""
+        self.plant.bind(system)
+
     def advance(self, time: float) -> None:
         self.plant.advance(time)
 

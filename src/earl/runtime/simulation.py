@@ -12,6 +12,7 @@ state lives in the subsystem engines this object owns.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import numbers
 import os
@@ -128,9 +129,8 @@ class Simulation:
             environment = read_run_settings(Path(system.source_file)).environment if system.source_file else None
         self.environment = _environment(environment, self.expanded, seed, directories, system)
         #: where the environment is named (run.toml's line), for what is said of it before the run
-        self._environment_named = (
-            _setting_location(system, "environment", environment) if isinstance(environment, str) else (None, None)
-        )
+        self._environment_named = _setting_location(system, "environment", environment)
+        _bind(self.environment, self.expanded, *self._environment_named)
         self.statistics = StatisticsRecorder()
         self._faults = _FaultList()
         own: list[Recorder] = [self.statistics, self._faults, *(recorders or [])]
@@ -478,13 +478,36 @@ def _environment(
             ) from None
 
 
-def _setting_location(system: System, key: str, value: str) -> tuple[SourceLocation | None, SourceMap]:
+def _bind(environment: object, expanded: System, location: SourceLocation | None, sources: SourceMap) -> None:
+    """The environment's `bind(system)`, if it has one: its chance to refuse, before the first iteration, a
+    system it cannot serve (a MuJoCo model without an actuator that a real effector is named after)."""
+    bind = getattr(environment, "bind", None)
+    if bind is None:
+        return
+    if not callable(bind):
+        message = f"the environment's `bind` is a {type(bind).__name__}, not a method"
+        raise EarlError([Diagnostic(Severity.ERROR, message, location, code="EARL-X020")], sources)
+    try:
+        bind(expanded)
+    except Exception as error:
+        # the run will not start: what the environment opened (a renderer, a video) is finished now
+        close = getattr(environment, "close", None)
+        if callable(close):
+            with contextlib.suppress(Exception):
+                close()
+        if isinstance(error, EarlError):  # located by the environment, at the spec's lines
+            raise EarlError(error.diagnostics, sources) from None
+        message = f"the environment does not fit the system: {exception_text(error)}"
+        raise EarlError([Diagnostic(Severity.ERROR, message, location, code="EARL-X021")], sources) from None
+
+
+def _setting_location(system: System, key: str, value: object) -> tuple[SourceLocation | None, SourceMap]:
     """Where the run.toml next to the spec sets `key` to `value`, if it does (a message about the environment
     points at the line that names it), and the texts a diagnostic quotes: the spec's, and that run.toml's."""
     sources = SourceMap()
     if isinstance(system.sources, SourceMap):
         sources.texts.update(system.sources.texts)
-    if not system.source_file:
+    if not system.source_file or not isinstance(value, str):
         return None, sources
     path = Path(system.source_file).resolve().parent / "run.toml"  # as read_run_settings finds it
     try:

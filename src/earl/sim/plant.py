@@ -22,12 +22,17 @@ import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
-from earl.diagnostics import did_you_mean
+from earl.diagnostics import Diagnostic, EarlError, Severity, did_you_mean
+from earl.model.location import SourceLocation
+
+if TYPE_CHECKING:
+    from earl.model.elements import System
 
 ENCODER_PREFIX = "earl.encoder."
 
@@ -195,6 +200,59 @@ class MujocoPlant:
     def actuator_names(self) -> list[str]:
         return [self.model.actuator(i).name for i in range(self.model.nu)]
 
+    # ------------------------------------------------------------ the system it serves
+
+    def bind(self, system: System) -> None:
+        """Refuse, before the first iteration, a system whose real effectors and receptors the model cannot
+        serve (the runtime calls it with the system as it runs; docs/simulation.md says what is checked).
+
+        A real effector or receptor acts on the model by names its code gives (`set_input("motor2", …)`), so
+        a missing name would only show as a fault in every iteration. The names are checked where the spec
+        shows them: the members of a family that acts on actuators (sensors, joints) named after them,
+        `motor[1]/re` on `motor1`, must all find theirs."""
+        problems = self._unserved_members(system)
+        if problems:
+            raise EarlError(problems)
+
+    def _unserved_members(self, system: System) -> list[Diagnostic]:
+        from earl.model.kinds import Kind
+        from earl.model.text import subsystem_name
+
+        names = {
+            "actuator": self.actuator_names(),
+            "sensor": [self.model.sensor(i).name for i in range(self.model.nsensor)],
+            "joint": [self.model.joint(i).name for i in range(self.model.njnt)],
+        }
+        families: dict[str, list[_Member]] = {}
+        for agent in system.agents:
+            for subsystem in agent.subsystems:
+                if subsystem.kind not in (Kind.REAL_EFFECTOR, Kind.REAL_RECEPTOR):
+                    continue
+                shown = subsystem_name(agent, subsystem)
+                index = "" if subsystem.index is None else str(subsystem.index)
+                family = shown
+                if index and subsystem.family is not None:  # `arm/a.motor[2]/re` is a member of `arm/a.motor[K]/re`
+                    family = shown.rsplit("[", 1)[0] + f"[{subsystem.family.index}]/{subsystem.kind}"
+                families.setdefault(family, []).append(_Member(shown, subsystem.name + index, subsystem.location))
+        problems = []
+        for family, members in families.items():
+            # the kind of the model's objects most members are named after; none: its code names them otherwise
+            kind, served = max(
+                ((kind, [m for m in members if m.addressed in known]) for kind, known in names.items()),
+                key=lambda found: len(found[1]),
+            )
+            if not served:
+                continue
+            missing = [member for member in members if member not in served]
+            if missing:
+                problems.append(_missing(kind, names[kind], family, served, missing))
+            elif kind == "actuator":
+                with_encoder = [member for member in members if member.addressed in self.encoders]
+                without = [member for member in members if member not in with_encoder]
+                if with_encoder and without:
+                    problems.append(_missing_encoders(self.origin.name, with_encoder, without))
+        return problems
+
     def set_input(self, actuator: str, value: float) -> float:
         """Set an actuator's input (a winding current for a `motor` with gear = kt·G); returns what is applied.
 
@@ -358,6 +416,50 @@ class MujocoPlant:
         closers, self._closers = self._closers, []
         for closer in closers:
             closer()
+
+
+@dataclass(frozen=True)
+class _Member:
+    """A real effector or receptor, and the name of the model's object it is named after (`motor[2]/re`: `motor2`)."""
+
+    shown: str
+    addressed: str
+    location: SourceLocation | None
+
+
+def _listed(members: list[_Member], what: Callable[[_Member], str]) -> str:
+    return ", ".join(f"`{what(member)}`" for member in members)
+
+
+def _missing(kind: str, known: list[str], family: str, served: list[_Member], missing: list[_Member]) -> Diagnostic:
+    """A member of a family whose others find the model's objects named after them, and it not."""
+    some = len(missing) > 1
+    taken = {member.addressed for member in served}
+    suggestions = [did_you_mean(member.addressed, [name for name in known if name not in taken]) for member in missing]
+    examples = "; ".join(f"`{member.shown}` acts on `{member.addressed}`" for member in served[:2])
+    return Diagnostic(
+        Severity.ERROR,
+        f"the model has no {kind} named {_listed(missing, lambda m: m.addressed)}, which "
+        f"{_listed(missing, lambda m: m.shown)} {'act' if some else 'acts'} on: each member of `{family}` acts on "
+        f"the {kind} named after it ({examples}); the model's {kind}s: {', '.join(known) or 'none'}",
+        missing[0].location,
+        code="EARL-X021",
+        hint="; ".join(hint for hint in suggestions if hint)
+        or f"add {'them' if some else 'it'} to the model's <{kind}> section, or correct the name there",
+    )
+
+
+def _missing_encoders(origin: str, served: list[_Member], missing: list[_Member]) -> Diagnostic:
+    some = len(missing) > 1
+    return Diagnostic(
+        Severity.ERROR,
+        f"{origin} declares no encoder for {_listed(missing, lambda m: m.addressed)}, which "
+        f"{_listed(missing, lambda m: m.shown)} {'act' if some else 'acts'} on, but does for "
+        f"{_listed(served, lambda m: m.addressed)}",
+        missing[0].location,
+        code="EARL-X021",
+        hint=f'add <numeric name="{ENCODER_PREFIX}{missing[0].addressed}" data="GEAR COUNTS"/> to its <custom> section',
+    )
 
 
 def _pose(position: FloatArray, quaternion: FloatArray) -> Pose:
