@@ -212,3 +212,31 @@ def test_an_environment_s_own_bind_may_refuse_the_system(tmp_path: Path) -> None
     assert diagnostic.code == "EARL-X021"
     assert diagnostic.message == "the environment does not fit the system: ValueError: pendulum needs a third joint"
     assert diagnostic.location is not None and diagnostic.location.file.endswith("run.toml")
+
+
+def test_a_timestep_that_does_not_divide_the_motors_period_is_refused_before_the_run(tmp_path: Path) -> None:
+    copy = pendulum_copy(tmp_path, old='timestep="0.001"', new='timestep="0.003"')
+    result = earl_cli("run", str(copy), "--duration", "10ms", cwd=copy)
+    assert result.returncode == 1, result.stdout
+    assert result.stderr.splitlines()[0] == (
+        f"error[EARL-X021]: the model's timestep, 3 ms ({copy / 'pendulum.xml'}, line 3), does not divide the period "
+        "of `arm/a.motor[K]/re` (1 ms): the plant is stepped 3 ms at a time, so at their instants it would be up to "
+        "a step behind"
+    )
+    assert f" --> system.earl:{spec_line(copy, 'motor[K in 1..J]/re {')}:5" in result.stderr
+    assert (
+        '= hint: choose a timestep that divides the period of every real effector and receptor, e.g. <option timestep="0.001"/>'
+        in result.stderr
+    )
+
+
+def test_a_timestep_that_divides_the_periods_runs(tmp_path: Path) -> None:
+    copy = pendulum_copy(tmp_path, old='timestep="0.001"', new='timestep="0.0005"')
+    simulation = earl.simulate(earl.load(copy))
+    try:
+        simulation.advance_to(0.0105)
+        # the run advances its environment to the time it reached, 10.5 ms: 21 steps of 0.5 ms
+        assert simulation.environment.time == pytest.approx(0.0105)  # type: ignore[attr-defined]
+        assert simulation.faults == []
+    finally:
+        simulation.close()

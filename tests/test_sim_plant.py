@@ -264,3 +264,16 @@ def test_an_encoder_of_no_actuator_is_said_with_the_actuators_the_model_has() ->
     xml = arm.robot_mjcf(3).replace('"earl.encoder.motor2"', '"earl.encoder.motr2"')
     with pytest.raises(PlantError, match=r"names no actuator of the model: .*did you mean `motor2`\?"):
         MujocoPlant.from_xml(xml)
+
+
+def test_advance_never_steps_beyond_the_time_asked_for() -> None:
+    plant = MujocoPlant.from_xml(arm.robot_mjcf(3, timestep=0.003))
+    assert plant.timestep == 0.003
+    plant.advance(0.002)  # within the first step: the world at 3 ms would be the future
+    assert plant.time == 0.0
+    plant.advance(0.003)
+    assert plant.time == pytest.approx(0.003)
+    plant.advance(0.0059)
+    assert plant.time == pytest.approx(0.003)
+    plant.advance(0.006)  # 0.006 / 0.003 is 1.9999999999999998 in floats: still two steps
+    assert plant.time == pytest.approx(0.006)

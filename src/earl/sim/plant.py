@@ -51,10 +51,11 @@ class XmlOrigin:
     name: str
     text: str | None = None
 
-    def line_of(self, name: str) -> str:
-        """`NAME, line N` for the element whose `name="…"` is `name` (just `NAME` if the text does not show it:
-        an included file, or no text)."""
-        found = re.search(rf"""\bname\s*=\s*["']{re.escape(name)}["']""", self.text or "")
+    def line_of(self, name: str, attribute: str = "name") -> str:
+        """`NAME, line N` for the element whose `name="…"` (or other `attribute`) is `name`, any value if `name`
+        is empty; just `NAME` if the text does not show it (an included file, or no text)."""
+        value = re.escape(name) if name else "[^\"']*"
+        found = re.search(rf"""\b{attribute}\s*=\s*["']{value}["']""", self.text or "")
         if found is None or self.text is None:
             return self.name
         return f"{self.name}, line {1 + self.text.count(chr(10), 0, found.start())}"
@@ -174,12 +175,16 @@ class MujocoPlant:
         return self._timestep
 
     def advance(self, time: float) -> None:
-        """Step the physics until simulated time reaches `time` (to within half a step).
+        """Step the physics until simulated time reaches `time`, never beyond it.
 
-        The number of steps is computed from the step count, not by adding up floats,
-        so that equal calls give equal states however the calls are split.
+        The plant takes every step that ends by `time`: at a time that is not a whole number of
+        steps it stays up to a step behind, never ahead, so that no subsystem sees the world as it
+        will be after its own instant (`bind` refuses a timestep that does not divide a real
+        effector's or receptor's period). The number of steps is computed from the step count, not
+        by adding up floats, so that equal calls give equal states however the calls are split.
         """
-        target = round(time / self.timestep)
+        # a millionth of a step: 0.003 / 0.001 is 2.9999999999999996, and is 3 steps
+        target = math.floor(time / self.timestep + 1e-6)
         if target < self._steps:
             raise PlantError(f"cannot go back in time: the plant is at {self.time:.6f} s, asked for {time:.6f} s")
         while self._steps < target:
@@ -209,31 +214,47 @@ class MujocoPlant:
         A real effector or receptor acts on the model by names its code gives (`set_input("motor2", …)`), so
         a missing name would only show as a fault in every iteration. The names are checked where the spec
         shows them: the members of a family that acts on actuators (sensors, joints) named after them,
-        `motor[1]/re` on `motor1`, must all find theirs."""
-        problems = self._unserved_members(system)
+        `motor[1]/re` on `motor1`, must all find theirs. And the timestep must divide their periods, so that
+        the plant is stepped to each of their instants exactly."""
+        families = _real_families(system)
+        problems = self._unserved_members(families) + self._unmet_periods(families)
         if problems:
             raise EarlError(problems)
 
-    def _unserved_members(self, system: System) -> list[Diagnostic]:
-        from earl.model.kinds import Kind
-        from earl.model.text import subsystem_name
+    def _unmet_periods(self, families: dict[str, list[_Member]]) -> list[Diagnostic]:
+        """The real effectors and receptors whose period is no whole number of the model's steps: the plant
+        would be up to a step behind their instants (it never steps beyond an instant)."""
+        step = round(self.timestep * 1e9)  # nanoseconds, as the run keeps time
+        unmet = {
+            family: members[0].period
+            for family, members in families.items()
+            if members[0].period is not None and (members[0].period % step if step else 1)
+        }
+        if not unmet:
+            return []
+        periods = [member.period for members in families.values() for member in members if member.period]
+        first = families[next(iter(unmet))][0]
+        listed = ", ".join(f"`{family}` ({_shown_time(period)})" for family, period in unmet.items())
+        return [
+            Diagnostic(
+                Severity.ERROR,
+                f"the model's timestep, {_shown_time(step)} ({self.origin.line_of('', 'timestep')}), does not "
+                "divide the period of "
+                f"{listed}: the plant is stepped {_shown_time(step)} at a time, so at their instants it would be up "
+                "to a step behind",
+                first.location,
+                code="EARL-X021",
+                hint="choose a timestep that divides the period of every real effector and receptor, e.g. "
+                f'<option timestep="{_divisor_below(math.gcd(*periods), step) / 1e9:g}"/>',
+            )
+        ]
 
+    def _unserved_members(self, families: dict[str, list[_Member]]) -> list[Diagnostic]:
         names = {
             "actuator": self.actuator_names(),
             "sensor": [self.model.sensor(i).name for i in range(self.model.nsensor)],
             "joint": [self.model.joint(i).name for i in range(self.model.njnt)],
         }
-        families: dict[str, list[_Member]] = {}
-        for agent in system.agents:
-            for subsystem in agent.subsystems:
-                if subsystem.kind not in (Kind.REAL_EFFECTOR, Kind.REAL_RECEPTOR):
-                    continue
-                shown = subsystem_name(agent, subsystem)
-                index = "" if subsystem.index is None else str(subsystem.index)
-                family = shown
-                if index and subsystem.family is not None:  # `arm/a.motor[2]/re` is a member of `arm/a.motor[K]/re`
-                    family = shown.rsplit("[", 1)[0] + f"[{subsystem.family.index}]/{subsystem.kind}"
-                families.setdefault(family, []).append(_Member(shown, subsystem.name + index, subsystem.location))
         problems = []
         for family, members in families.items():
             # the kind of the model's objects most members are named after; none: its code names them otherwise
@@ -425,6 +446,42 @@ class _Member:
     shown: str
     addressed: str
     location: SourceLocation | None
+    #: nanoseconds; None: it runs when a message wakes it
+    period: int | None
+
+
+def _real_families(system: System) -> dict[str, list[_Member]]:
+    """The real effectors and receptors, by family (`arm/a.motor[K]/re`; one that is no family by its own name)."""
+    from earl.model.kinds import Kind
+    from earl.model.text import subsystem_name
+
+    families: dict[str, list[_Member]] = {}
+    for agent in system.agents:
+        for subsystem in agent.subsystems:
+            if subsystem.kind not in (Kind.REAL_EFFECTOR, Kind.REAL_RECEPTOR):
+                continue
+            shown = subsystem_name(agent, subsystem)
+            index = "" if subsystem.index is None else str(subsystem.index)
+            family = shown
+            if index and subsystem.family is not None:  # `arm/a.motor[2]/re` is a member of `arm/a.motor[K]/re`
+                family = shown.rsplit("[", 1)[0] + f"[{subsystem.family.index}]/{subsystem.kind}"
+            period = None if subsystem.period is None else round(subsystem.period.seconds * 1e9)
+            member = _Member(shown, subsystem.name + index, subsystem.location, period)
+            families.setdefault(family, []).append(member)
+    return families
+
+
+def _shown_time(nanoseconds: int) -> str:
+    for unit, size in (("s", 10**9), ("ms", 10**6), ("µs", 10**3)):
+        if nanoseconds >= size:
+            return f"{nanoseconds / size:g} {unit}"
+    return f"{nanoseconds} ns"
+
+
+def _divisor_below(period: int, step: int) -> int:
+    """The longest step, no longer than `step`, that divides `period` (nanoseconds): what to suggest instead."""
+    # a million tries: the periods' common divisor in nanoseconds is a round number unless written to the nanosecond
+    return next((period // n for n in range(1, min(period, 10**6) + 1) if period % n == 0 and period // n <= step), 1)
 
 
 def _listed(members: list[_Member], what: Callable[[_Member], str]) -> str:
