@@ -1244,3 +1244,31 @@ def test_a_wrong_signal_is_said_naming_the_part_that_is_wrong(tmp_path: Path, si
     result = earl_cli("run", str(spec), "--plot", str(tmp_path / "p.png"), "--signal", signal_name)
     assert result.returncode == 2 and fragment in result.stderr, result.stderr
     assert "did you mean" not in result.stderr
+
+
+def test_a_run_of_some_agents_plots_their_signals_of_run_toml_and_refuses_another_agent_s_on_the_command_line(
+    tmp_path: Path,
+) -> None:
+    """run.toml names the signals of the whole system; a process that runs some of its agents (`--agents`,
+    a process of a distributed run) has only theirs in its trace."""
+    spec = tmp_path / "pingpong"
+    shutil.copytree(Path(__file__).parent / "distributed_specs" / "pingpong", spec)
+    (spec / "run.toml").write_text('plot = ["sender/a.cs.count", "receiver/a.cs.received"]\n')
+    png = tmp_path / "p.png"
+    command = ["run", str(spec), "--agents", "sender", "--duration", "200ms", "--plot", str(png)]
+    drawn = earl_cli(*command)
+    assert drawn.returncode == 0, drawn.stdout + drawn.stderr
+    assert png.read_bytes().startswith(b"\x89PNG")
+    said = " ".join(drawn.stderr.split())
+    assert (
+        "earl run: plot: run.toml's `receiver/a.cs.received` left out, of receiver/a, which this process does not "
+        "run (it runs sender/a)" in said
+    ), said
+    named = earl_cli(*command, "--signal", "receiver/a.cs.received")
+    assert named.returncode == 2, named.stdout + named.stderr
+    assert "--signal `receiver/a.cs.received`: of receiver/a, which this process does not run" in named.stderr
+    assert "ran " not in named.stdout  # said before the run
+    (spec / "run.toml").write_text('plot = ["receiver/a.cs.received"]\n')
+    none = earl_cli(*command)
+    assert none.returncode == 1, none.stdout + none.stderr
+    assert "no signal of run.toml's `plot` is of an agent this process runs" in " ".join(none.stderr.split())

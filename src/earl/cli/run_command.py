@@ -245,8 +245,22 @@ def _run(arguments: argparse.Namespace) -> int:
             except ValueError as error:
                 _close(transport)
                 return usage_error(f"{signals_origin} {error}")
-            if agents:
+            if agents:  # this process's trace holds its own agents' subsystems only
                 plotted = [name for name in plotted if name.split(".", 1)[0] in agents]
+                plotted_outputs = [name for name in plotted_outputs if name.split(".", 1)[0] in agents]
+                elsewhere = [signal for signal in signals or [] if signal.split(".", 1)[0] not in agents]
+                if elsewhere:
+                    named = ", ".join(f"`{signal}`" for signal in elsewhere)
+                    owners = ", ".join(dict.fromkeys(signal.split(".", 1)[0] for signal in elsewhere))
+                    runs = f"of {owners}, which this process does not run (it runs {', '.join(agents)})"
+                    if signals_origin == "--signal":  # named on the command line: a mistake
+                        _close(transport)
+                        return usage_error(
+                            f"--signal {named}: {runs}; plot it in the process that runs it, "
+                            "or from that process's trace with earl plot"
+                        )
+                    print(f"earl run: plot: run.toml's {named} left out, {runs}", file=sys.stderr)
+                    arguments.signal = [signal for signal in signals or [] if signal not in elsewhere]
             record_memory = sorted({*(record_memory or []), *plotted})
         with warnings.catch_warnings():
             # a link pattern that matches nothing is said by `_say_what_is_not_recorded`, in the CLI's words
@@ -568,6 +582,9 @@ def _plot(arguments: argparse.Namespace, console: Console) -> bool:
     from earl.runtime.plot import plot_signals
     from earl.runtime.trace_reader import TraceError
 
+    if not arguments.signal:  # every signal of run.toml's `plot` is of another process's agents
+        console.print("earl run: no plot: no signal of run.toml's `plot` is of an agent this process runs")
+        return False
     try:
         left_out = plot_signals(Path(arguments.trace), arguments.signal, Path(arguments.plot))
     except TraceError as error:
