@@ -721,3 +721,34 @@ def test_wait_for_peers_0_starts_at_once_and_a_missing_deployment_file_is_a_usag
         [*command, "--deployment", str(tmp_path / "none.toml")], capture_output=True, text=True, timeout=120
     )
     assert missing.returncode == 2 and "none.toml does not exist" in missing.stderr
+
+
+def test_a_deployment_named_with_a_zenoh_config_is_read_and_checked(tmp_path: Path) -> None:
+    """--zenoh-config replaces the deployment's endpoints, not what it says of the agents and the environment."""
+    (port,) = free_ports(1)
+    config = tmp_path / "zenoh.json5"
+    config.write_text(
+        '{mode: "peer", scouting: {multicast: {enabled: false}}, '
+        f'listen: {{endpoints: ["tcp/127.0.0.1:{port}"]}}, connect: {{endpoints: []}}}}'
+    )
+    command = [sys.executable, "-m", "earl.cli.main", "run", "--transport", "zenoh", "--zenoh-config", str(config)]
+    broken = tmp_path / "broken.toml"
+    broken.write_text('[[process]\nagents = ["sender/a"]\n')
+    result = subprocess.run(
+        [*command, str(PINGPONG), "--agents", "sender", "--deployment", str(broken)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert result.returncode == 1 and f"{broken}: not valid TOML" in result.stderr, result.stderr
+    # the environment with the task agent, apart from the agents acting on it
+    misplaced = deployment(tmp_path, [(["manip/a", "grip/a"], False), (["task/a"], True)])
+    result = subprocess.run(
+        [*command, str(PICK_AND_PLACE), "--agents", "manip,grip", "--deployment", str(misplaced)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert result.returncode == 1, result.stdout + result.stderr
+    assert "but the environment lives in process 2 (task/a)" in result.stderr
+    assert "over Zenoh" not in result.stderr  # refused before Zenoh starts

@@ -17,7 +17,7 @@ from earl.model.elements import System
 from earl.model.expand import expand
 from earl.model.kinds import Kind
 from earl.runtime.names import agent_name
-from earl.transport.deployment import DeploymentError, normalise_agent, read_deployment
+from earl.transport.deployment import normalise_agent, read_deployment
 from earl.transport.zenoh_transport import TransportError, ZenohTransport, config_from_file, default_config
 
 DEPLOYMENT_FILE = "deploy.toml"
@@ -55,6 +55,23 @@ def open_transport(
     known = [agent_name(agent) for agent in expanded.agents]
     environment_here = environment is not None
     names = agents_of(system, parameters, agents)
+    path = Path(arguments.deployment) if arguments.deployment else spec.parent / DEPLOYMENT_FILE
+    group = None
+    if arguments.deployment or not arguments.zenoh_config:
+        # with --zenoh-config, a deployment file named on the command line still says where run.toml's
+        # environment lives, and is checked as without it; only its endpoints are not used
+        if not arguments.deployment and not path.is_file():
+            raise ValueError(
+                f"--transport zenoh needs the processes' endpoints: write {path} (docs/distributed.md), "
+                "name one with --deployment, or give your own --zenoh-config"
+            )
+        deployment = read_deployment(path)  # a DeploymentError: exit 1, as `earl launch` says it
+        deployment.check_agents(known)
+        if environment is not None:
+            deployment = deployment.place_environment(acting_agents(expanded))
+        group = deployment.group_of(names)
+        if environment is not None and not group.names_its_environment:
+            environment_here = bool(group.environment)
     if arguments.zenoh_config:
         config_path = Path(arguments.zenoh_config)
         if not config_path.is_file():
@@ -65,7 +82,7 @@ def open_transport(
         except TransportError as error:
             raise ValueError(str(error)) from None
         where = f"the Zenoh configuration {arguments.zenoh_config}"
-        if environment is not None:
+        if environment is not None and group is None:
             # No deployment file says where run.toml's environment lives: it lives with the agents that act
             # on it, and only where all of them run (each process would simulate a world of its own).
             acting = acting_agents(expanded)
@@ -78,22 +95,7 @@ def open_transport(
                 )
             environment_here = bool(here)
     else:
-        path = Path(arguments.deployment) if arguments.deployment else spec.parent / DEPLOYMENT_FILE
-        if not arguments.deployment and not path.is_file():
-            raise ValueError(
-                f"--transport zenoh needs the processes' endpoints: write {path} (docs/distributed.md), "
-                "name one with --deployment, or give your own --zenoh-config"
-            )
-        try:
-            deployment = read_deployment(path)
-            deployment.check_agents(known)
-            if environment is not None:
-                deployment = deployment.place_environment(acting_agents(expanded))
-            group = deployment.group_of(names)
-            if environment is not None and not group.names_its_environment:
-                environment_here = bool(group.environment)
-        except DeploymentError:
-            raise  # a file that cannot be used: exit 1, as `earl launch` says it
+        assert group is not None
         connect = deployment.connect_for(group)
         config = default_config([group.listen], connect)
         where = f"listening on {group.listen}, connecting to {', '.join(connect) or 'nobody'}"
