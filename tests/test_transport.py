@@ -458,6 +458,18 @@ def test_the_inbox_wakes_its_sleeper_and_hands_over_in_arrival_order() -> None:
         assert [k for m, k in received if m == n] == list(range(200))
 
 
+def test_wait_for_peers_takes_0_written_any_way_the_duration_parser_reads() -> None:
+    from earl.transport.process import peers_wait
+
+    for zero in ("0", "0s", "0 ms", "0.0", "00", "0min", ".0us", "0e3s"):
+        assert peers_wait(zero) == 0.0, zero
+    assert peers_wait("1.5s") == 1.5 and peers_wait(None) == 30.0
+    with pytest.raises(ValueError, match="a duration must be 0 or more"):
+        peers_wait("-1s")
+    with pytest.raises(ValueError, match="is not a duration"):
+        peers_wait("zero")
+
+
 @pytest.mark.parametrize(
     ("arguments", "fragment"),
     [

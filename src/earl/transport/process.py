@@ -134,9 +134,7 @@ def peers_wait(text: str | None) -> float:
 
     if text is None:
         text = DEFAULT_PEERS_WAIT
-    if text.strip() in ("0", "0s", "0 s", "0ms", "0 ms"):
-        return 0.0
-    return parse_duration(text)
+    return parse_duration(text, zero=True)
 
 
 def wait_for_peers(transport: ZenohTransport, arguments: argparse.Namespace) -> None:
