@@ -752,3 +752,35 @@ def test_a_deployment_named_with_a_zenoh_config_is_read_and_checked(tmp_path: Pa
     assert result.returncode == 1, result.stdout + result.stderr
     assert "but the environment lives in process 2 (task/a)" in result.stderr
     assert "over Zenoh" not in result.stderr  # refused before Zenoh starts
+
+
+def test_an_interrupt_while_waiting_for_peers_leaves_no_trace(tmp_path: Path, processes: list[Process]) -> None:
+    """No iteration ran: as for an interrupt one step earlier, the trace this command created is removed."""
+    deploy = deployment(tmp_path, [(["sender/a"], False), (["receiver/a"], False)])
+    trace_file = tmp_path / "w.mcap"
+    sender = run(
+        processes,
+        tmp_path / "sender.log",
+        [
+            str(PINGPONG),
+            "--transport",
+            "zenoh",
+            "--deployment",
+            str(deploy),
+            "--agents",
+            "sender",
+            "--trace",
+            str(trace_file),
+            "--duration",
+            "1s",
+        ],
+    )
+    sender.wait_for("waiting up to 30 s for receiver/a", 60)
+    sender.child.send_signal(signal.SIGINT)
+    assert sender.finish(30) == 130, sender.output
+    said = " ".join(sender.output.split())
+    assert (
+        f"interrupted while waiting for the other processes; nothing was executed; no trace was written to {trace_file}"
+        in said
+    ), said
+    assert not trace_file.exists()

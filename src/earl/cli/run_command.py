@@ -280,13 +280,7 @@ def _run(arguments: argparse.Namespace) -> int:
             )
     except KeyboardInterrupt:  # a stop signal while the spec was read and the run set up
         _close(transport)
-        said = "nothing was executed"
-        trace = Path(arguments.trace) if arguments.trace else None
-        if trace is not None and not trace_was_there and trace.is_file() and not trace.is_symlink():
-            # created by this command a moment ago, holding no run
-            with contextlib.suppress(OSError):
-                trace.unlink()
-                said += f"; no trace was written to {arguments.trace}"
+        said = "nothing was executed" + _remove_unrun_trace(arguments, trace_was_there)
         print(f"earl run: interrupted before the run started; {said}", file=sys.stderr)
         return EXIT_INTERRUPTED
     except EarlError as error:
@@ -320,8 +314,9 @@ def _run(arguments: argparse.Namespace) -> int:
                 with _stopped_like_ctrl_c():
                     wait_for_peers(transport, arguments)
             except KeyboardInterrupt:
-                simulation.close()  # nothing ran; the trace is still closed and readable
-                print("earl run: interrupted while waiting for the other processes", file=sys.stderr)
+                simulation.close()
+                said = "nothing was executed" + _remove_unrun_trace(arguments, trace_was_there)
+                print(f"earl run: interrupted while waiting for the other processes; {said}", file=sys.stderr)
                 return EXIT_INTERRUPTED
         return _execute(simulation, duration, arguments, None if environment is None else settings.report, path)
     finally:
@@ -329,6 +324,17 @@ def _run(arguments: argparse.Namespace) -> int:
         # Zenoh session's threads would keep the process from ever ending.
         with contextlib.suppress(Exception):
             simulation.close()
+
+
+def _remove_unrun_trace(arguments: argparse.Namespace, trace_was_there: bool) -> str:
+    """Remove the trace of a run stopped before its first instant, when this command created it (it
+    holds no run); what to say of it: `; no trace was written to FILE`, or nothing."""
+    trace = Path(arguments.trace) if arguments.trace else None
+    if trace is not None and not trace_was_there and trace.is_file() and not trace.is_symlink():
+        with contextlib.suppress(OSError):
+            trace.unlink()
+            return f"; no trace was written to {arguments.trace}"
+    return ""
 
 
 def _say_what_is_not_recorded(
