@@ -763,6 +763,41 @@ def test_a_zenoh_configuration_zenoh_refuses_is_explained_without_rust_source_li
     assert ".rs:" not in message
 
 
+def test_zenoh_failing_to_start_for_the_network_exits_1_with_a_configuration_file_or_a_deployment_file(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An endpoint another program holds is no usage error, whichever file names it; an endpoint that is no
+    endpoint, in the user's own configuration, is (BAD_PORT above)."""
+    import socket
+
+    from earl.cli.main import main
+    from earl.transport.zenoh_transport import network_failure
+
+    holder = socket.socket()
+    holder.bind(("127.0.0.1", 0))
+    holder.listen()
+    try:
+        port = holder.getsockname()[1]
+        config = tmp_path / "zenoh.json5"
+        config.write_text(
+            f'{{mode: "peer", scouting: {{multicast: {{enabled: false}}}}, listen: {{endpoints: ["tcp/127.0.0.1:{port}"]}}}}'
+        )
+        deploy = tmp_path / "deploy.toml"
+        deploy.write_text(
+            f'[[process]]\nagents = ["sender/a"]\nlisten = "tcp/127.0.0.1:{port}"\n'
+            '[[process]]\nagents = ["receiver/a"]\nlisten = "tcp/127.0.0.1:1"\n'
+        )
+        for option, named in (("--zenoh-config", config), ("--deployment", deploy)):
+            command = ["run", str(PINGPONG), "--transport", "zenoh", "--agents", "sender", option, str(named)]
+            assert main([*command, "--wait-for-peers", "0", "--duration", "0.1s"]) == 1, option
+            error = capsys.readouterr().err
+            assert error.startswith("earl run: Zenoh could not start: ") and "Address already in use" in error, error
+    finally:
+        holder.close()
+    assert network_failure("Unable to connect to any of [Single(tcp/127.0.0.1:17999)]!")
+    assert not network_failure("invalid port value") and not network_failure("Missing TLS private key")
+
+
 def test_this_host_is_known_by_its_name_in_any_case_and_by_its_addresses() -> None:
     import socket
 

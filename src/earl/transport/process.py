@@ -18,7 +18,13 @@ from earl.model.expand import expand
 from earl.model.kinds import Kind
 from earl.runtime.names import agent_name
 from earl.transport.deployment import normalise_agent, read_deployment
-from earl.transport.zenoh_transport import TransportError, ZenohTransport, config_from_file, default_config
+from earl.transport.zenoh_transport import (
+    TransportError,
+    ZenohTransport,
+    config_from_file,
+    default_config,
+    network_failure,
+)
 
 DEPLOYMENT_FILE = "deploy.toml"
 #: seconds; see open_transport
@@ -105,8 +111,10 @@ def open_transport(
     try:
         transport = ZenohTransport(system.name, names, config, log)
     except TransportError as error:
-        if arguments.zenoh_config:  # the user's own file, which Zenoh refuses: a usage error (exit 2)
-            raise ValueError(f"{error} (with {where})") from None
+        if arguments.zenoh_config:
+            if network_failure(str(error)):  # not the file's fault: as from a deployment file (exit 1)
+                raise TransportError(f"{error} (with {where})") from None
+            raise ValueError(f"{error} (with {where})") from None  # the user's own file, refused: exit 2
         raise TransportError(f"{error} ({where}, as {path} says)") from None
     log(f"earl run: {', '.join(names)} over Zenoh ({where})")
     return names, transport, environment_here

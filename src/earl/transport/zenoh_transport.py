@@ -93,6 +93,18 @@ def zenoh_reason(error: BaseException) -> str:
     return text or type(error).__name__
 
 
+#: what Zenoh says when the network, not its configuration, keeps a session from opening: an error of the
+#: system (an endpoint another program holds, an address not of this host), no peer or router to connect
+#: to, a host name that does not resolve
+_NETWORK_FAILURE = re.compile(r"\(os error \d+\)|Unable to connect|failed to lookup address")
+
+
+def network_failure(reason: str) -> bool:
+    """Whether Zenoh's `reason` for not starting is the network's (else its configuration's: an endpoint
+    that is no endpoint, a protocol it does not have, a TLS listener without its key)."""
+    return _NETWORK_FAILURE.search(reason) is not None
+
+
 def config_from_file(path: Path) -> zenoh.Config:
     """A user's own Zenoh configuration (JSON5), passed through unchanged."""
     try:
