@@ -693,6 +693,8 @@ def test_run_help_teaches_with_examples() -> None:
     result = earl_cli("run", "--help")
     assert result.returncode == 0
     assert "examples:" in result.stdout and "exit codes:" in result.stdout and "run.toml" in result.stdout
+    # as docs/runtime.md says them
+    assert "or a --plot could not be drawn (the run and its trace are whole)" in " ".join(result.stdout.split())
 
 
 @pytest.fixture(autouse=True)

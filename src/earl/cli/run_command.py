@@ -47,9 +47,10 @@ The spec is checked first; its errors stop the run. Only `earl run` imports the 
 code a spec names (docs/runtime.md).
 
 exit codes: 0 the run completed (or the spec's code called sys.exit(0)), 1 invalid spec,
-            the run could not start, its trace could not be written (a full disk), or the
-            spec's code called sys.exit with a failure, 2 usage error, 130 interrupted (the
-            trace is closed and readable)
+            the run could not start, its trace could not be written (a full disk), the
+            environment failed, the spec's code called sys.exit with a failure, or a --plot
+            could not be drawn (the run and its trace are whole), 2 usage error, 130
+            interrupted (the trace is closed and readable)
 """
 
 
