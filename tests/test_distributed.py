@@ -27,6 +27,7 @@ from mcap.reader import make_reader
 SPECS = Path(__file__).parent / "distributed_specs"
 PINGPONG = SPECS / "pingpong"
 PICK_AND_PLACE = Path(__file__).parent.parent / "examples" / "pick_and_place"
+MOBILE_ROBOT = Path(__file__).parent.parent / "examples" / "mobile_robot"
 PING = "struct Ping{count:int,stamp:double[2],note:string?}"
 
 
@@ -784,3 +785,37 @@ def test_an_interrupt_while_waiting_for_peers_leaves_no_trace(tmp_path: Path, pr
         in said
     ), said
     assert not trace_file.exists()
+
+
+def test_the_mobile_robot_split_as_its_deploy_toml_says_runs_and_its_base_reports_without_the_coordinator(
+    tmp_path: Path, processes: list[Process]
+) -> None:
+    """examples/mobile_robot/deploy.toml, on free ports: the base with its world in one process, the
+    coordinator in another, for 2 s. The goal and the statuses cross, and the base's process, which runs
+    the world and so the report, says what it can of the patrol without the coordinator's state."""
+    shipped = (MOBILE_ROBOT / "deploy.toml").read_text()
+    first, second = free_ports(2)
+    assert shipped.count('listen = "tcp/127.0.0.1:7461"') == 1 and shipped.count('listen = "tcp/127.0.0.1:7462"') == 1
+    deploy = tmp_path / "deploy.toml"
+    deploy.write_text(shipped.replace(":7461", f":{first}").replace(":7462", f":{second}"))
+    launch = Process(
+        tmp_path / "launch.log", [str(MOBILE_ROBOT), "--deployment", str(deploy), "--duration", "2s"], "launch"
+    )
+    processes.append(launch)
+    assert launch.finish(150) == 0, launch.output
+    output = launch.output
+    assert "Traceback" not in output and "earl run: the report" not in output, output
+    lines = [" ".join(line.split()) for line in output.splitlines()]
+    assert "[base/a ] coordinator/a runs in another process: its summary says whether the patrol is done" in lines
+    assert any(
+        line.startswith("[base/a ] mobile-robot: patrolled=unknown coordinator=elsewhere least_clearance_m=")
+        for line in lines
+    ), output
+    assert not any(line.startswith("[coordinator/a] mobile-robot:") for line in lines)  # no world there
+
+    def count(label: str, link: str) -> int:
+        prefix = f"{label} link {link} ("
+        line = next(line for line in lines if line.startswith(prefix) and " received" in line)
+        return int(line.split("): ", 1)[1].split(" ", 1)[0])
+
+    assert count("[base/a ]", "coordinator,base") >= 1 and count("[coordinator/a]", "base,coordinator") > 10, output

@@ -141,3 +141,21 @@ def test_the_environment_reads_the_wheels_and_geometry_from_the_spec() -> None:
     assert len(floor.wheels) == 4 and floor.wheel_radius == 0.08 and floor.track_width == 0.42
     assert make_environment(expand(system, {}), 5).room.obstacles == floor.room.obstacles
     assert make_environment(expand(system, {}), 6).room.obstacles != floor.room.obstacles
+
+
+def test_a_run_of_the_base_alone_reports_the_world_and_says_the_coordinator_is_elsewhere() -> None:
+    """As the base's process of examples/mobile_robot/deploy.toml does: the report had failed for want of
+    the coordinator's subsystem."""
+    result = subprocess.run(
+        [sys.executable, "-m", "earl.cli.main", "run", str(EXAMPLE), "--agents", "base", "--duration", "1s"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
+    )
+    assert result.returncode == 0, result.stderr
+    assert "the report" not in result.stdout + result.stderr
+    lines = result.stdout.splitlines()
+    assert lines[-2] == "coordinator/a runs in another process: its summary says whether the patrol is done"
+    assert lines[-1].startswith("mobile-robot: patrolled=unknown coordinator=elsewhere least_clearance_m="), lines
+    assert lines[-1].endswith("sim_time_s=1.000")
