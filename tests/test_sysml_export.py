@@ -209,7 +209,7 @@ def test_the_element_walk_can_fail() -> None:
 def test_families_are_expanded_with_the_given_parameters() -> None:
     text = export_sysml(earl.load(FLAGSHIP, {"N": 3}), {"N": 3})
     assert "motorController3_ve" in text and "motorController4_ve" not in text
-    assert "attribute N : EARL::int = 3;" in text
+    assert "attribute N : EARL::int = 3 {" in text
     assert "<'motorController[3]/ve'>" in text
 
 
@@ -232,7 +232,7 @@ def test_transitions_keep_priorities_and_guards() -> None:
     assert guard.group(1) == "newJointPos_pp and not emergencyStop_pp"
     assert "@EARL::TransitionPriority { priority = 2; }" in guard.group(2)
     # `* -> emergencyStop` is one transition per other state
-    assert text.count("then emergencyStop {") == 3
+    assert text.count("Declared as `* -> emergencyStop`") == 3
 
 
 def test_a_two_stage_transition_function_is_a_fork_and_a_join_per_stage() -> None:
@@ -466,7 +466,7 @@ def test_a_name_renamed_for_a_library_feature_gets_no_short_name_that_would_hide
     spec = tmp_path / "names.earl"
     spec.write_text(text.replace(system_line, "system EARL\n\nparam agents: int = 1", 1), encoding="utf-8")
     exported = export_sysml(earl.load(spec))
-    assert "attribute agents_2 : EARL::int = 1;" in exported
+    assert "attribute agents_2 : EARL::int = 1 {" in exported
     assert "<'agents'>" not in exported
     assert "package EARL_system {" in exported
     spec.write_text(text.replace(system_line, "system ScalarValues", 1), encoding="utf-8")
@@ -655,4 +655,164 @@ def test_states_named_start_or_done_do_not_hide_what_every_state_body_inherits()
     exported = export_sysml(earl.load(spec))
     assert "entry; then start_2;" in exported and "state start_2 : EARL::FSMState" in exported
     assert not re.search(r"\bstate start\b", exported)
+    assert not syntax_errors(exported)
+
+
+#: a comment on every kind of element the export writes (`K01` … `K39`)
+_EVERY_KIND = """// K01 system
+system every
+
+// K02 system param
+param N: int = 2
+
+// K03 alias
+type Metres = double
+
+// K04 struct
+struct Reading {
+    // K05 field
+    value: double
+}
+
+// K06 robot
+r/r {
+    // K07 robot member
+    a/a
+    b/a
+    // K39 robot link member
+    link b,a
+}
+
+// K08 agent
+a/a {
+    // K09 agent param
+    param G: double = 1.0
+    // K10 cs
+    cs {
+        // K11 period
+        period 1 ms
+        // K12 subsystem param
+        param KP: double = 2.0
+        // K13 ib
+        x/ib: Reading
+        // K14 ob
+        y/ob: double
+        z/ib: double  // K37 trailing comment
+        // K15 memory
+        m/m: double = 0.0
+        // K16 pp
+        p/pp = x/ib.value > 1.0
+        // K17 pf
+        f/pf(x/ib -> m/mo)
+        // K18 stage
+        stage pf = {f/pf}
+        // K19 bb
+        b/bb {
+            // K20 tf
+            tf = {f/pf}
+            // K21 tc
+            tc = p/pp
+            // K22 ec
+            ec = not p/pp
+        }
+        // K23 fsm
+        fsm {
+            // K24 initial
+            initial s
+            // K25 state
+            state s: b/bb {
+                // K26 obligatory
+                obligatory x/ib
+                // K27 timeout
+                timeout 4 ms
+            }
+            state t: b/bb
+            // K28 transition without priority
+            s -> t when p/pp
+            // K29 transition with priority
+            t -> s when p/pp priority 1
+            // K30 from any state
+            * -> s when not p/pp priority 2
+            // K31 assume
+            assume x/ib.value > -1.0
+        }
+    }
+    // K32 ve
+    v/ve {
+        period 1 ms
+        c/ib: double
+        o/ob: double
+    }
+    // K33 re
+    e/re {
+        period 1 ms
+        c/ib: double
+    }
+    // K34 vr
+    w/vr {
+        period 1 ms
+        c/ib: double
+        c/ob: double
+    }
+    // K35 rr
+    q/rr {
+        period 1 ms
+        c/ob: double
+    }
+    // K36 link in an agent
+    link cs,v: cs.y -> v/ve.c
+    link v,e: v/ve.o -> e/re.c
+    link q,w: q/rr.c -> w/vr.c
+    link w,cs: w/vr.c -> cs.z
+}
+
+b/a {
+    cs {
+        period 1 ms
+        o/ob: Reading
+    }
+}
+
+// K38 link between agents
+link b,a: b/a.cs.o -> a/a.cs.x
+"""
+
+#: a comment at a clause, or at a robot's member, is in the doc of the element that owns it
+_OWNER = {"K07": "K06", "K39": "K06", "K11": "K10", "K20": "K19", "K21": "K19", "K22": "K19", "K24": "K23"}
+_OWNER |= {"K26": "K25", "K27": "K25"}
+
+
+def _docs(exported: str) -> list[str]:
+    """Every doc comment of the export, its lines joined as one text."""
+    return [
+        " ".join(line.strip().removeprefix("*").strip() for line in body.splitlines())
+        for body in re.findall(r"\bdoc\s*/\*(.*?)\*/", exported, re.DOTALL)
+    ]
+
+
+def _declared_at(marker: str) -> int:
+    """The line of the element a `// K… ` comment is about: the next line, or its own for an end-of-line comment."""
+    lines = _EVERY_KIND.splitlines()
+    number = next(n for n, line in enumerate(lines, start=1) if f"// {marker} " in line)
+    return number + 1 if lines[number - 1].lstrip().startswith("//") else number
+
+
+def test_every_kind_of_element_keeps_its_comment_and_where_it_was_written() -> None:
+    """A transition without a priority, a `param` and a `stage` set lost their comments (and the transition its
+    line), though docs/sysml.md promises every `// comment` as its element's doc with the file and line. The spec
+    comments every kind of element the export writes, and the clauses whose comments the model keeps."""
+    exported = export_sysml(earl.loads(_EVERY_KIND, "every.earl"))
+    docs = _docs(exported)
+    markers = sorted(set(re.findall(r"// (K\d\d) ", _EVERY_KIND)))
+    assert len(markers) == 39
+    assert "K01 system" in docs[0]  # the system's comment is the package's doc
+    for marker in markers[1:]:
+        holding = [doc for doc in docs if f"{marker} " in doc]
+        assert holding, f"{marker}'s comment is in no doc"
+        line = _declared_at(_OWNER.get(marker, marker))
+        assert all(f"From every.earl:{line}." in doc for doc in holding), (marker, holding)
+    assert "At `tc`: K21 tc" in exported and "At `timeout`: K27 timeout" in exported
+    # a transition without a priority has a doc too, and no priority
+    without = re.search(r"transition <'s,t/t'> s_t_t\s+first s\s+if p_pp\s+then t \{(.*?)\n\s*\}", exported, re.DOTALL)
+    assert without is not None and "From every.earl:" in without.group(1) and "Priority" not in without.group(1)
     assert not syntax_errors(exported)

@@ -29,6 +29,7 @@ from earl.export.sysml_expressions import ExpressionWriter, literal
 from earl.export.sysml_names import Namespace, name_text, quoted, readable
 from earl.lang.resolver import resolve
 from earl.model.elements import (
+    FSM,
     Agent,
     BasicBehaviour,
     Duration,
@@ -162,6 +163,7 @@ class _Writer:
         self.lines: list[str] = []
         self.depth = 0
         self.comments = _comments_by_location(declared)
+        self.clause_comments = _clause_comments_by_location(declared)
         #: SysML names of the spec's data types and of the helper definitions made for array types.
         self.type_names: dict[str, str] = {}
         self.helper_types: dict[str, tuple[str, DataType]] = {}
@@ -199,13 +201,28 @@ class _Writer:
         self.emit(" */")
 
     def element_doc(self, location: SourceLocation | None, *extra: str) -> None:
-        """The person's comments on an element, what the export adds, and where it was written."""
+        """The person's comments on an element and at its clauses, what the export adds, and where it was written."""
         where = _where(location)
         self.doc(
             *_comment_lines(self.comments.get(location) if location else None),
+            *self.clause_notes(location),
             *extra,
             *([f"From {where}."] if where else []),
         )
+
+    def clause_notes(self, location: SourceLocation | None) -> list[str]:
+        """The comments written at an element's clauses (`period`, `tf`, `tc`, `ec`, `initial`, a state's
+        `obligatory`, `optional` and `timeout` lines), each after the clause it is about: the clauses are
+        features of the element in SysML too, and its doc is where a SysML tool shows what was said of them."""
+        said = self.clause_comments.get(location) if location is not None else None
+        notes = []
+        for key, comments in (said or {}).items():
+            # a state's clause spreads over several lines, keyed `obligatory 0`, `obligatory 1`, …
+            clause = key.split()[0]
+            lines = _comment_lines(comments)
+            if lines:
+                notes.append(f"At `{clause}`: {' '.join(lines)}")
+        return notes
 
     def named(self, namespace: Namespace, earl_name: str, preferred: str | None = None) -> _Named:
         """A readable, unique name, with the EARL name as short name when the two differ, unless that
@@ -345,9 +362,9 @@ class _Writer:
         for parameter in parameters:
             name = self.named(namespace, parameter.name, parameter.name)
             value = literal(_parameter_value(parameter))
-            where = _where(parameter.location)
-            note = f" // parameter, {where}" if where else " // parameter"
-            self.emit(f"attribute {name.declaration} : {self.typed(parameter.data_type)} = {value};{note}")
+            # a doc, not a `//` note: a SysML tool keeps the doc, so the comment and the line stay with the attribute
+            with self.block(f"attribute {name.declaration} : {self.typed(parameter.data_type)} = {value}"):
+                self.element_doc(parameter.location)
 
     def robot(self, robot: Robot, namespace: Namespace) -> None:
         name = self.named(namespace, f"{robot.name}/r")
@@ -527,7 +544,8 @@ class _Writer:
     def stage_set(self, stage_set: StageSet, namespace: Namespace, names: _SubsystemNames) -> None:
         named = self.named(namespace, f"stage {stage_set.name}", f"{stage_set.name}Stage")
         targets = [names.resolve(reference) for reference in stage_set.functions]
-        self.emit(f"ref action {named.declaration} : EARL::PartialTransitionFunction[*] = {_sequence(targets)};")
+        with self.block(f"ref action {named.declaration} : EARL::PartialTransitionFunction[*] = {_sequence(targets)}"):
+            self.element_doc(stage_set.location)
 
     def basic_behaviour(self, behaviour: BasicBehaviour, names: _SubsystemNames, expressions: ExpressionWriter) -> None:
         own = names.name(behaviour.name, None, Kind.BASIC_BEHAVIOUR)
@@ -643,14 +661,11 @@ class _Writer:
         self.depth += 1
         self.emit(f"first {name_text(source)}")
         self.emit(f"if {expressions.text(transition.condition.expression)}")
-        declared = self.declared_transition(transition)
-        if transition.priority is None and not declared:
-            self.emit(f"then {name_text(destination)};")
-        else:
-            with self.block(f"then {name_text(destination)}"):
-                self.element_doc(transition.location, *declared)
-                if transition.priority is not None:
-                    self.emit(f"@EARL::TransitionPriority {{ priority = {transition.priority}; }}")
+        # always a body: the doc carries the comment and the line, with or without a priority
+        with self.block(f"then {name_text(destination)}"):
+            self.element_doc(transition.location, *self.declared_transition(transition))
+            if transition.priority is not None:
+                self.emit(f"@EARL::TransitionPriority {{ priority = {transition.priority}; }}")
         self.depth -= 1
 
     def declared_transition(self, transition: Transition) -> tuple[str, ...]:
@@ -768,6 +783,27 @@ class _SubsystemNames:
 
     def resolve(self, reference: ElementReference) -> str:
         return self.name(reference.name, _index_of(reference), reference.kind)
+
+
+def _clause_comments_by_location(system: System) -> dict[SourceLocation, dict[str, Comments]]:
+    """The comments at the clauses of every declared subsystem, basic behaviour, FSM and state, by where the
+    element was written: as `_comments_by_location`, because expansion keeps locations, not comments."""
+    table: dict[SourceLocation, dict[str, Comments]] = {}
+
+    def keep(element: Subsystem | BasicBehaviour | FSM | State) -> None:
+        if element.location is not None and element.clause_comments:
+            table[element.location] = element.clause_comments
+
+    for agent in system.agents:
+        for subsystem in agent.subsystems:
+            keep(subsystem)
+            for behaviour in subsystem.basic_behaviours:
+                keep(behaviour)
+            if subsystem.fsm is not None:
+                keep(subsystem.fsm)
+                for state in subsystem.fsm.states:
+                    keep(state)
+    return table
 
 
 def _comments_by_location(system: System) -> dict[SourceLocation, Comments]:
