@@ -200,11 +200,12 @@ def test_mermaid_system_and_fsm(system: System) -> None:
     states = mermaid_of(Subject(system), "fsm", "manip/a.cs")
     lines = states.splitlines()
     assert "stateDiagram-v2" in lines
-    assert "    [*] --> s_idle" in lines
+    # inside the composite state that stands for the state machine, which its assumption is a note on
+    assert "        [*] --> s_idle" in lines
     transitions = [line for line in lines if " --> " in line and "[*]" not in line]
     # Table 5: six transitions between named states and `i,emergencyStop/t` from each of the three others
     assert len(transitions) == 9
-    assert "    s_jointMove --> s_idle : [not emergencyStop/pp] priority 3" in lines
+    assert "        s_jointMove --> s_idle : [not emergencyStop/pp] priority 3" in lines
     with pytest.raises(TargetError, match="system and fsm views only"):
         mermaid_of(Subject(system), "types", None)
 
@@ -539,3 +540,59 @@ def test_an_expanded_member_is_named_by_its_number_or_a_parameter_that_is_it(tmp
         out = tmp_path / "m.mmd"
         arguments = ["diagram", str(pick_and_place), "--view", "fsm", "--expand", "--target", target]
         assert main([*arguments, "--format", "mermaid", "-o", str(out)]) == code, target
+
+
+_ASSUMES_NOTHING = """system plain
+
+a/a {
+    cs {
+        period 1 ms
+        x/ib: double
+        p/pp = x/ib > 1.0
+        b/bb {
+            tf = {}
+            tc = p/pp
+        }
+        fsm {
+            initial s
+            state s: b/bb
+            s -> s when p/pp
+        }
+    }
+}
+"""
+
+
+def test_the_fsm_view_shows_the_fsm_s_assumptions_as_a_note(system: System) -> None:
+    """`assume not (newJointPos/pp and newOperationalPos/pp)` was drawn nowhere, though the manual states it in
+    Table 5's caption and the FSM's conditions are read under it: it is a SysML note of the state machine, with
+    its comment, in the Graphviz drawing (SVG, PNG, DOT) and in Mermaid, where a note must be on a state and the
+    state machine becomes a composite state."""
+    diagram = build_diagram(system, "fsm", "manip/a.cs")
+    assert 'shape="note"' in diagram.dot
+    shown = svg_text(diagram.svg())
+    assert "assume not (newJointPos/pp and" in shown and "newOperationalPos/pp)" in shown
+    assert "Table 5: task/a never sets a new joint" in shown  # its comment, under it
+    # expanded, the assumption is the same
+    assert 'shape="note"' in build_diagram(system, "fsm", "manip/a.cs", expand=True).dot
+    assert "assume" not in svg_text(build_diagram(system, "fsm", "manip/a.motorController/ve").svg())
+
+    states = mermaid_of(Subject(system), "fsm", "manip/a.cs").splitlines()
+    assert '    state "manip/a.cs.fsm" as fsm {' in states
+    note = states[states.index("    note right of fsm") :]
+    assert note[1:4] == [
+        "        assume not (newJointPos/pp and newOperationalPos/pp)",
+        "        Table 5: task/a never sets a new joint position and an operational pose at once.",
+        "    end note",
+    ]
+    # an FSM that assumes nothing is drawn as before: its states at the top, no note
+    plain = mermaid_of(Subject(earl.loads(_ASSUMES_NOTHING, "plain.earl")), "fsm", None).splitlines()
+    assert "    [*] --> s_s" in plain and not any("note" in line or "{" in line for line in plain)
+    assert 'shape="note"' not in build_diagram(earl.loads(_ASSUMES_NOTHING, "plain.earl"), "fsm").dot
+
+
+def test_a_mermaid_label_keeps_a_backslash() -> None:
+    """Mermaid dropped the `\\` of a string `"a\\"b"` in an assumption's note; it is an entity code now."""
+    from earl.render.mermaid import text
+
+    assert text('"a\\"b"') == "#quot;a#92;#quot;b#quot;"

@@ -22,7 +22,14 @@ from earl.cli.main import main
 from earl.render.build import Subject
 from earl.render.document import write_site
 from earl.render.mermaid import mermaid_of
-from earl.render.tables import composition_table, condition_table, memory_table, predicate_table, transition_table
+from earl.render.tables import (
+    assumption_table,
+    composition_table,
+    condition_table,
+    memory_table,
+    predicate_table,
+    transition_table,
+)
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLE = ROOT / "examples" / "pick_and_place" / "system.earl"
@@ -121,6 +128,35 @@ def test_tables_3_4_and_5_follow_the_manual(manip_cs: earl.Subsystem) -> None:
         "operationalMove": "motionFinished/pp or emergencyStop/pp",
         "emergencyStop": "false/pp",
     }
+    # Table 5's caption: "It is assumed that task/a can not set simultaneously a new joint position and an
+    # operational space pose"
+    (assumed,) = assumption_table(manip_cs.fsm)
+    assert assumed.formula == "not (newJointPos/pp and newOperationalPos/pp)"
+    assert assumed.comment == "Table 5: task/a never sets a new joint position and an operational pose at once."
+
+
+def test_table_5_states_what_the_fsm_assumes(site: Path) -> None:
+    """The FSM's `assume` formulas were in no table and no diagram: they are a line of Table 5's caption,
+    as the manual states its assumption, with the formula's names linked and its comment after it."""
+    from markdown_it import MarkdownIt
+
+    html = (site / "index.html").read_text(encoding="utf-8")
+    caption = re.search(r"<caption>Table 5: initial conditions labelling manip/a\.cs\.fsm.*?</caption>", html)
+    assert caption is not None
+    assert '<div class="note">Assumed: <code>not (<a href="#pp-manip-a-cs-newJointPos">newJointPos/pp</a>' in (
+        caption.group()
+    )
+    assert "— Table 5: task/a never sets a new joint position and an operational pose at once." in caption.group()
+    # a subsystem whose FSM assumes nothing says nothing
+    other = re.search(r"<caption>Table 5: initial conditions labelling manip/a\.motorController.*?</caption>", html)
+    assert other is not None and "Assumed" not in other.group()
+    # the Markdown copy: a paragraph under the caption's title, read back as GitHub reads it
+    read = MarkdownIt("commonmark").enable("table").render((site / "index.md").read_text(encoding="utf-8"))
+    assert re.search(
+        r"<p><strong>Table 5: initial conditions labelling manip/a\.cs\.fsm[^<]*</strong></p>\s*"
+        r"<p>Assumed: <code>not \(</code><a href=\"#pp-manip-a-cs-newJointPos\"><code>newJointPos/pp</code></a>",
+        read,
+    )
 
 
 # ---------------------------------------------------------------- the written document
@@ -357,6 +393,12 @@ def test_document_opens_in_headless_chromium_without_errors(site: Path, tmp_path
             table_6_bullets = page.evaluate(
                 "document.getElementById('table6-manip-a-cs').querySelectorAll('td.bullet').length"
             )
+            # Table 5's caption as a reader sees it: the assumption on a line of its own, not bold
+            assumed = page.evaluate(
+                "Array.from(document.querySelectorAll('caption .note')).map(n => [n.innerText, "
+                "getComputedStyle(n).fontWeight, n.getBoundingClientRect().top > "
+                "n.parentElement.getBoundingClientRect().top + 5])"
+            )
             page.goto((site / "index.html").as_uri() + "#ss-manip-a-cs", wait_until="load")
             page.screenshot(path=str(screenshot))
         finally:
@@ -366,6 +408,14 @@ def test_document_opens_in_headless_chromium_without_errors(site: Path, tmp_path
     assert count == len(list((site / "diagrams").glob("*.svg")))
     assert title == "pickAndPlace: an EARL specification"
     assert table_6_bullets == 16 * 7
+    assert assumed == [
+        [
+            "Assumed: not (newJointPos/pp and newOperationalPos/pp) — Table 5: task/a never sets a new joint "
+            "position and an operational pose at once.",
+            "400",
+            True,
+        ]
+    ]
     assert screenshot.read_bytes()[:4] == b"\x89PNG"
     print(f"screenshot: {screenshot}")
 

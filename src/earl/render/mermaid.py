@@ -11,16 +11,20 @@ from earl.model.elements import FSM, Agent, Subsystem
 from earl.model.text import expression_text
 from earl.render.build import Subject
 from earl.render.names import agent_name, link_label, qualified_subsystem_name
+from earl.render.tables import assumption_table
 from earl.render.targets import TargetError, find_subsystem, only_fsm
 from earl.render.views.system import inter_agent_links, member_names, member_placement_lines
+
+#: The identifier of the composite state that stands for the state machine; the states' are `s_…`, never this.
+FSM_STATE = "fsm"
 
 
 def text(value: str) -> str:
     """A Mermaid quoted label: quotes and characters Mermaid reads as markup become entity codes.
 
     `&` is one of them: Mermaid draws labels as HTML, where a spec's string `"&lt;"` would be shown as
-    `"<"`; written `#38;lt;` it is shown as written."""
-    replacements = {'"': "#quot;", "<": "#lt;", ">": "#gt;", "#": "#35;", "|": "#124;", "&": "#38;"}
+    `"<"`; written `#38;lt;` it is shown as written. So is `\\`, which Mermaid drops before a quote (`"a\\"b"`)."""
+    replacements = {'"': "#quot;", "<": "#lt;", ">": "#gt;", "#": "#35;", "|": "#124;", "&": "#38;", "\\": "#92;"}
     return "".join(replacements.get(c, c) for c in value)
 
 
@@ -74,12 +78,18 @@ def system_mermaid(subject: Subject) -> str:
 
 def fsm_mermaid(fsm: FSM, owner: str, subsystem: Subsystem | None = None) -> str:
     lines = ["---", f"title: stm [FSM] {owner}.fsm", "---", "stateDiagram-v2"]
+    assumptions = assumption_table(fsm)
+    # Mermaid attaches a note to a state only: an FSM that assumes something is drawn as a composite state,
+    # the state machine, and its assumptions are a note on it, as the Graphviz drawing's note in the frame
+    indent = "        " if assumptions else "    "
+    if assumptions:
+        lines.append(f'    state "{text(owner)}.fsm" as {FSM_STATE} {{')
     for state in fsm.states:
         identifier = _identifier("s", state.name)
-        lines.append(f'    state "{text(state.name)}" as {identifier}')
-        lines.append(f"    {identifier} : do / {text(state.behaviour)}/bb")
+        lines.append(f'{indent}state "{text(state.name)}" as {identifier}')
+        lines.append(f"{indent}{identifier} : do / {text(state.behaviour)}/bb")
     if fsm.state_named(fsm.initial) is not None:
-        lines.append(f"    [*] --> {_identifier('s', fsm.initial)}")
+        lines.append(f"{indent}[*] --> {_identifier('s', fsm.initial)}")
     for transition in fsm.concrete_transitions():
         if transition.source is None:
             continue
@@ -88,7 +98,15 @@ def fsm_mermaid(fsm: FSM, owner: str, subsystem: Subsystem | None = None) -> str
             label += f" priority {transition.priority}"
         source = _identifier("s", transition.source)
         destination = _identifier("s", transition.destination)
-        lines.append(f"    {source} --> {destination} : {text(label).replace(':', '#58;')}")
+        lines.append(f"{indent}{source} --> {destination} : {text(label).replace(':', '#58;')}")
+    if assumptions:
+        lines.append("    }")
+        lines.append(f"    note right of {FSM_STATE}")
+        for assumption in assumptions:
+            lines.append(f"        assume {text(assumption.formula)}")
+            if assumption.comment:
+                lines.append(f"        {text(assumption.comment)}")
+        lines.append("    end note")
     return "\n".join(lines) + "\n"
 
 

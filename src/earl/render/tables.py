@@ -2,7 +2,8 @@
 
 - Table 3: Internal Memory and its dataTypes;
 - Table 4: the `fun` of each Primitive Predicate;
-- Table 5: initial conditions of FSM Transitions, terminal (and error) conditions of Basic Behaviours;
+- Table 5: initial conditions of FSM Transitions, terminal (and error) conditions of Basic Behaviours,
+  and the FSM's assumptions, which the manual states in the table's caption;
 - Table 6: Transition Function compositions, with a bullet where a Partial
   Transition Function writes an Internal Memory (`/mo`) or an Output Buffer (`/ob`).
 
@@ -15,8 +16,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from earl.model.elements import PrimitivePredicate, Subsystem
+from earl.model.elements import FSM, PrimitivePredicate, Subsystem
 from earl.model.kinds import Kind
+from earl.model.location import Comments
 from earl.model.text import expression_text
 from earl.model.types import type_text
 from earl.render.names import Key, element_key, family_note, indexed_name, lookup
@@ -50,6 +52,12 @@ class ConditionRow:  # Table 5, lower part
     behaviour: str
     terminal_condition: str
     error_condition: str | None
+
+
+@dataclass(frozen=True)
+class AssumptionRow:  # Table 5's caption: "It is assumed that task/a can not set simultaneously …"
+    formula: str  # in EARL text, `not (newJointPos/pp and newOperationalPos/pp)`
+    comment: str | None  # what the person wrote above or after it, in words
 
 
 @dataclass(frozen=True)
@@ -118,6 +126,27 @@ def transition_table(subsystem: Subsystem) -> list[TransitionRow]:
         TransitionRow(t.name, t.source, t.destination, expression_text(t.condition.expression), t.priority)
         for t in subsystem.fsm.transitions
     ]
+
+
+def assumption_table(fsm: FSM | None) -> list[AssumptionRow]:
+    """The FSM's `assume` formulas with their comments: facts the FSM relies on, which the document and the
+    FSM diagram state beside the conditions, as the manual's Table 5 caption does."""
+    if fsm is None:
+        return []
+    return [AssumptionRow(expression_text(a.expression), comment_words(a.comments)) for a in fsm.assumptions]
+
+
+def comment_words(comments: Comments | None) -> str | None:
+    """A person's `//` comments as one sentence: markers dropped, a ruler (`// ---- …`, which heads a section of
+    the file, not the element under it) left out; None when nothing was said."""
+    if comments is None:
+        return None
+    said = []
+    for line in [*comments.leading, *([comments.trailing] if comments.trailing else [])]:
+        words = line.strip().removeprefix("//").strip()
+        if words and not words.startswith("----"):
+            said.append(words)
+    return " ".join(said) or None
 
 
 def condition_table(subsystem: Subsystem) -> list[ConditionRow]:

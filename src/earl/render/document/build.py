@@ -56,6 +56,7 @@ from earl.render.names import (
     subsystem_name,
 )
 from earl.render.tables import (
+    assumption_table,
     composition_table,
     condition_table,
     memory_table,
@@ -518,7 +519,13 @@ class DocumentBuilder:
         caption = text(
             f"Table 5: initial conditions labelling {qualified}.fsm transitions and terminal conditions of {qualified}.bb"
         )
-        return Table(caption, header, rows)
+        # the manual's caption states what the FSM assumes ("It is assumed that task/a can not set simultaneously
+        # …"): the conditions above are read under those facts, so they are said where the conditions are
+        notes: list[Content] = []
+        for assumption in assumption_table(subsystem.fsm):
+            said = with_code(f" — {assumption.comment}") if assumption.comment else ()
+            notes.append((Text("Assumed: "), *self.expression_content(assumption.formula, scope), *said))
+        return Table(caption, header, rows, notes=notes)
 
     def functions_table(self, subsystem: Subsystem, qualified: str, scope: Scope) -> Table:
         header = [

@@ -44,6 +44,7 @@ a code { color: var(--accent); }
 code code { background: none; padding: 0; }
 table { border-collapse: collapse; margin: 14px 0 22px; font-size: 13.5px; }
 caption { caption-side: top; text-align: left; font-weight: 600; padding: 0 0 6px; }
+caption .note { font-weight: 400; margin-top: 2px; }
 th, td { border: 1px solid var(--rule); padding: 4px 8px; vertical-align: top; text-align: left; }
 th { background: var(--shade); }
 table.matrix td.bullet, table.matrix th { text-align: center; }
@@ -97,8 +98,9 @@ def table(item: Table) -> str:
     attributes = (f' id="{escape(item.anchor)}"' if item.anchor else "") + (f' class="{item.css}"' if item.css else "")
     head = "".join("<tr>" + "".join(_cell("th", c) for c in row) + "</tr>" for row in item.header)
     body = "".join("<tr>" + "".join(_cell("td", c) for c in row) + "</tr>" for row in item.rows)
+    notes = "".join(f'<div class="note">{content(note)}</div>' for note in item.notes)
     return (
-        f'<div class="wide"><table{attributes}><caption>{content(item.caption)}</caption>'
+        f'<div class="wide"><table{attributes}><caption>{content(item.caption)}{notes}</caption>'
         f"<thead>{head}</thead><tbody>{body}</tbody></table></div>"
     )
 

@@ -124,6 +124,8 @@ def _header(item: Table) -> list[str]:
 def table(item: Table) -> str:
     header = _header(item)
     lines = [f"**{content(item.caption)}**", ""]
+    for note in item.notes:  # a paragraph each, under the caption's title, not bold
+        lines += [content(note), ""]
     if item.anchor:
         lines.insert(0, f'<a id="{item.anchor}"></a>')
     lines.append("| " + " | ".join(header) + " |")

@@ -67,6 +67,8 @@ class Table:
     rows: list[list[Cell]]
     anchor: str | None = None
     css: str = ""  # "matrix" for Table 6
+    #: lines under the caption's title that belong to it: Table 5's "Assumed: …", as the manual's caption says it
+    notes: list[Content] = field(default_factory=list)
 
 
 @dataclass

@@ -1,6 +1,9 @@
 """The FSM view (the manual's Figure 12): states with their Basic Behaviours, transitions with
 their initial conditions and priorities, and the initial state.
 
+The FSM's assumptions (`assume …`, which the manual states in Table 5's caption) are a SysML
+note inside the frame, the state machine's own comment.
+
 A transition declared from every other state (`* -> emergencyStop`, Table 5's
 `i,emergencyStop/t where i ≠ emergencyStop`) is drawn once from a dashed
 "every state i ≠ …" node, as families are drawn once; with `expand` it is drawn
@@ -14,6 +17,7 @@ from earl.model.text import expression_text, literal_text, reference_text
 from earl.render.diagram import Diagram
 from earl.render.dot import Graph, html, wrapped
 from earl.render.names import slug
+from earl.render.tables import assumption_table
 from earl.render.views.common import node_id
 
 
@@ -85,4 +89,27 @@ def fsm_view(fsm: FSM, owner: str, subsystem: Subsystem | None = None, expand: b
         tooltip = html(f"{transition.name}/t")
         names.append(f"{transition.name}/t")
         graph.add(f'{source} -> {destination} [label={transition_label(transition)}, tooltip="{tooltip}"];')
+    assumed = assumptions_label(fsm)
+    if assumed is not None:
+        # inside the frame and tied to no state: a comment of the state machine itself, as a SysML note
+        graph.add(
+            f'assumptions [shape="note", style="filled", fillcolor="#fffbe6", color="#8a7a3d", margin="0.12,0.06", '
+            f'label={assumed}, tooltip="{html(owner + "." if owner else "")}fsm assumes"];'
+        )
     return Diagram("fsm", graph.header, graph.source(), slug("fsm", owner), tuple(names))
+
+
+def assumptions_label(fsm: FSM) -> str | None:
+    """`assume not (newJointPos/pp and newOperationalPos/pp)` over its comment, for each assumption: an
+    HTML-like label, or None for an FSM that assumes nothing."""
+    rows = []
+    for assumption in assumption_table(fsm):
+        lines = wrapped(f"assume {assumption.formula}")
+        rows += [f'<tr><td align="left">{html(line)}</td></tr>' for line in lines]
+        for line in wrapped(assumption.comment, 48) if assumption.comment else []:
+            rows.append(
+                f'<tr><td align="left"><font point-size="9" color="#555555"><i>{html(line)}</i></font></td></tr>'
+            )
+    if not rows:
+        return None
+    return '<<table border="0" cellborder="0" cellspacing="0" cellpadding="1">' + "".join(rows) + "</table>>"
