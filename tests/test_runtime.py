@@ -194,6 +194,29 @@ def test_when_no_transition_holds_the_subsystem_stays_and_the_fault_is_recorded_
     assert sim.state_of("probe/a.cs").iteration == 6  # the behaviour went on, its number not reset
 
 
+def test_a_function_that_returns_a_value_is_told_once_that_it_is_ignored(tmp_path: Path) -> None:
+    """`return {"x": 1}` writes nothing: a fault says so at the function's first return, naming its spec line
+    and how outputs are written; its writes through `outputs` still count and the FSM goes on as before."""
+    spec = copy_spec("probe", tmp_path)
+    stages = spec.parent / "probing" / "stages.py"
+    stages.write_text(
+        stages.read_text().replace(
+            "def swap_b(inputs, outputs, context):\n    outputs.y = inputs.x\n",
+            'def swap_b(inputs, outputs, context):\n    outputs.y = inputs.x\n    return {"y": 0}\n',
+        )
+    )
+    sim, _ = simulate(spec)
+    sim.advance_to(0.005)
+    [fault] = sim.faults
+    assert fault.kind == "return-value" and fault.function == "swapB" and fault.time == 0
+    assert fault.message.startswith("`swapB/pf` (system.earl:21) returned a dict ({'y': 0}), which is ignored")
+    assert "`outputs.y = …`" in fault.message and "returns None" in fault.message
+    assert fault.traceback == ""
+    assert sim.state_of("probe/a.cs").memory["y"] != 0  # what it wrote through `outputs` was kept
+    assert [f.kind for f in sim.faults] == ["return-value"]  # never the error condition's `recover`
+    sim.close()
+
+
 # ---------------------------------------------------------------------- FIFOs
 @pytest.mark.parametrize(
     ("policy", "seen", "faults"),

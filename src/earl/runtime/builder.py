@@ -299,6 +299,7 @@ def _behaviour(
                 engine.memory,
                 lambda reference, s=subsystem: _data_type(s, reference),  # type: ignore[misc]
             ),
+            declared.location,
         )
     behaviours: dict[str, BehaviourRuntime] = {}
     for behaviour in subsystem.basic_behaviours:

@@ -47,7 +47,9 @@ def compile_iteration(engine: SubsystemEngine, state: StateRuntime) -> Iterate:
     """The iteration of `engine` while it is in `state`."""
     behaviour = state.behaviour
     if behaviour.execute is None:
-        behaviour.execute = compile_execute(behaviour.stages, engine.memory, engine.context, engine._function_fault)
+        behaviour.execute = compile_execute(
+            behaviour.stages, engine.memory, engine.context, engine._function_fault, engine._function_returned
+        )
     namespace = {**_steps_4_and_5(engine, state), "execute": behaviour.execute}
     lines = [
         "def iterate(time):",

@@ -26,11 +26,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Protocol
 
+from earl.model.location import SourceLocation
 from earl.runtime.binding import UserFunction
 from earl.runtime.channels import Channel
 from earl.runtime.compiled_iteration import Completion, Iterate, compile_completion, compile_iteration
 from earl.runtime.events import Fault, Recorder
-from earl.runtime.iteration import Execute
+from earl.runtime.iteration import Call, Execute
 from earl.runtime.predicates import CompiledPredicate
 from earl.runtime.values import ValueTypeError
 from earl.runtime.views import Context, Inputs, Outputs, UndeclaredAccess, explain
@@ -44,6 +45,8 @@ class FunctionRuntime:
     function: UserFunction
     inputs: Inputs
     outputs: Outputs
+    #: the spec line declaring it, named when it misbehaves in a way the spec line explains (a result returned)
+    location: SourceLocation | None = None
 
 
 @dataclass
@@ -139,6 +142,8 @@ class SubsystemEngine:
         self.iteration = 0
         self.total_iterations = 0
         self.faults = 0
+        #: partial transition functions already told that what they return is ignored (once each)
+        self._returned: set[str] = set()
         self._error_in_iteration = False
         self._stuck = False
         self._timeouts_set = False
@@ -210,6 +215,27 @@ class SubsystemEngine:
         self.report_fault(time, kind, said, function, trace)
         # Faults section of docs/semantics.md: the behaviour's error condition becomes true
         self._error_in_iteration = True
+
+    def _function_returned(self, time: int, call: Call, value: object) -> None:
+        """A partial transition function returned something other than None: what it returns is ignored (docs/
+        runtime.md), so a function written as `return {"x": 1}` writes nothing. Said once per function: the same
+        code returns the same kind of thing at every call, and its writes through `outputs` still count."""
+        name = call.name
+        if name in self._returned:
+            return
+        self._returned.add(name)
+        location = call.location
+        # the file's name: a whole path would bury what the message says
+        where = f" ({Path(location.file).name}:{location.line})" if location is not None else ""
+        written = call.outputs.__dir__()
+        example = f"outputs.{written[0]} = …" if written else "outputs.NAME = …"
+        self.report_fault(
+            time,
+            "return-value",
+            f"`{name}/pf`{where} returned {_shown(value)}, which is ignored: a partial transition function "
+            f"writes its outputs through its second parameter (`{example}`) and returns None",
+            name,
+        )
 
     def report_fault(self, time: int, kind: str, message: str, function: str = "", trace: str = "") -> None:
         self.faults += 1
@@ -389,6 +415,17 @@ def _predicate_raising(error: BaseException) -> str | None:
             found = filename[:-1].rsplit(" ", 1)[-1]
         trace = trace.tb_next
     return found
+
+
+def _shown(value: object) -> str:
+    """`a dict ({'position': [0.3, 0.3]})`: what a function returned, kept short, whatever its `__repr__` does."""
+    try:
+        text = repr(value)
+    except BaseException:  # the spec's own class, misbehaving: its type is enough
+        return f"a {type(value).__name__}"
+    if len(text) > 60:
+        text = text[:57] + "..."
+    return f"a {type(value).__name__} ({text})"
 
 
 def exception_text(error: BaseException) -> str:

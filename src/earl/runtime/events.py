@@ -20,7 +20,9 @@ class Fault:
 
     time: int
     subsystem: str
-    kind: str  # "exception" | "undeclared-write" | "type" | "predicate" | "no-transition" | "overflow" | "deadline"
+    #: "exception" | "undeclared-write" | "type" | "return-value" | "predicate" | "no-transition" | "overflow" |
+    #: "deadline"
+    kind: str
     message: str
     state: str = ""
     behaviour: str = ""

@@ -5,7 +5,8 @@ stage run as if in parallel, on one snapshot of buffers and memory (Eq. 4–8 of
 docs/semantics.md). What that means for one call:
 
 1. copy the declared reads into the function's `inputs`;
-2. call `function(inputs, outputs, context)`;
+2. call `function(inputs, outputs, context)`; what it returns is ignored (anything but None is a
+   `return-value` fault, said once per function: its writes go through `outputs`);
 3. check what it set on `outputs` against its declared writes and their types;
 4. a stage of one function writes memory at once; a stage of several collects the writes and
    applies them when the stage ends, so that no function sees another's;
@@ -24,6 +25,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import Any, Protocol
 
+from earl.model.location import SourceLocation
 from earl.runtime.binding import UserFunction
 from earl.runtime.codegen import generated_function
 from earl.runtime.values import QUICK_TEST_NAMES, QuickTest
@@ -44,6 +46,8 @@ class Call(Protocol):
     def inputs(self) -> Inputs: ...
     @property
     def outputs(self) -> Outputs: ...
+    @property
+    def location(self) -> SourceLocation | None: ...
 
 
 def compile_execute(
@@ -51,12 +55,15 @@ def compile_execute(
     memory: dict[str, Any],
     context: Context,
     fault: Callable[[int, str, Exception], None],
+    returned: Callable[[int, Call, object], None],
 ) -> Execute:
-    """The behaviour's `tf.execute()`; `fault(time, function, error)` is told of a call that raised."""
+    """The behaviour's `tf.execute()`; `fault(time, function, error)` is told of a call that raised, and
+    `returned(time, call, value)` of one that returned something other than None (which is ignored)."""
     namespace: dict[str, Any] = {
         "memory": memory,
         "context": context,
         "fault": fault,
+        "returned": returned,
         "Exception": Exception,
         "MISSING": _MISSING,
         # what the quick tests use, and the builtins, as closure variables (see below)
@@ -105,6 +112,7 @@ def _call(n: int, call: Call, target: str, namespace: dict[str, Any]) -> list[st
             f"written_{n}": outputs._earl_memory_written,
             f"sends_{n}": outputs._earl_sent,
             f"name_{n}": call.name,
+            f"call_{n}": call,
         }
     )
     values = [f"value_{n}_{position}" for position in range(len(writes))]
@@ -115,7 +123,7 @@ def _call(n: int, call: Call, target: str, namespace: dict[str, Any]) -> list[st
     namespace[f"reads_{n}"] = call.inputs.__dict__
     lines += [
         "    try:",
-        f"        function_{n}(inputs_{n}, outputs_{n}, context)",
+        f"        result_{n} = function_{n}(inputs_{n}, outputs_{n}, context)",
     ]
     if writes:
         lines.append(f"        if set_{n}:")
@@ -140,6 +148,9 @@ def _call(n: int, call: Call, target: str, namespace: dict[str, Any]) -> list[st
         f"        clear_{n}()",
         f"        fault(time, name_{n}, error)",
         "    else:",
+        # a function that returns its outputs (`return {"x": 1}`) expects them written: it is told, once
+        f"        if result_{n} is not None:",
+        f"            returned(time, call_{n}, result_{n})",
         # writes by family member or by `outputs["x/mo"]` first, so that a later attribute write wins
         f"        if written_{n}:",
         f"            {target}.update(written_{n})",
