@@ -192,3 +192,45 @@ def test_the_document_and_the_sysml_export_name_its_code(tmp_path: Path) -> None
     assert "EARL::python(" in constraint
     assert "calc def python {" in (tmp_path / "EARL.sysml").read_text(encoding="utf-8")
     assert "limits" not in sys.modules
+
+
+@pytest.mark.parametrize(
+    ("result", "said"),
+    [
+        ('"no"', "returned a str ('no')"),
+        ('float("nan")', "returned a float (nan)"),
+        ("None", "returned None"),
+        ("1", "returned an int (1)"),
+    ],
+)
+def test_a_predicate_that_returns_no_boolean_is_a_fault_and_the_condition_counts_as_false(
+    tmp_path: Path, result: str, said: str
+) -> None:
+    """`return "no"` or NaN would be true and None false if taken by truthiness, silently."""
+    code = CODE.replace('return inputs.x >= context.parameters["LIMIT"]', f"return {result}")
+    sim = earl.simulate(earl.load(write(tmp_path, code)))
+    try:
+        sim.advance_to(0.0025)  # three iterations, three decisions
+        assert sim.state_of("counter/a.cs").state == "count"
+        assert [f.kind for f in sim.faults] == ["predicate"] * 3  # once per decision, not per condition
+        assert sim.faults[0].message == (
+            f"evaluating the terminal condition of `count/bb`: `big/pp` {said}, not a Boolean, so the condition "
+            "counts as false (a predicate computed by Python returns True or False)"
+        )
+    finally:
+        sim.close()
+        sys.modules.pop("limits", None)
+
+
+def test_a_predicate_may_return_a_numpy_boolean(tmp_path: Path) -> None:
+    code = "import numpy\n\n" + CODE.replace(
+        'return inputs.x >= context.parameters["LIMIT"]', 'return numpy.bool_(inputs.x >= context.parameters["LIMIT"])'
+    )
+    sim = earl.simulate(earl.load(write(tmp_path, code)))
+    try:
+        sim.advance_to(0.0025)
+        assert sim.state_of("counter/a.cs").state == "done"
+        assert sim.faults == []
+    finally:
+        sim.close()
+        sys.modules.pop("limits", None)

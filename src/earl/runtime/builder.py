@@ -31,10 +31,12 @@ from earl.runtime.engine import (
     BehaviourRuntime,
     Destination,
     FunctionRuntime,
+    PredicateFault,
     Sink,
     StateRuntime,
     SubsystemEngine,
     TransitionRuntime,
+    shown,
 )
 from earl.runtime.events import Recorder
 from earl.runtime.names import agent_name, indexed, reference_key
@@ -400,7 +402,12 @@ def _keep_repeated_predicates(engine: SubsystemEngine, subsystem: Subsystem) -> 
 
 
 def _python_predicate(engine: SubsystemEngine, predicate: PrimitivePredicate) -> CompiledPredicate:
-    """`ready/pp(x/ib, y/mi) = python "m:f"`: `f(inputs, context)`, its result taken as a Boolean."""
+    """`ready/pp(x/ib, y/mi) = python "m:f"`: `f(inputs, context)`, which returns True or False.
+
+    Anything else (None, "no", NaN, a number) is a fault rather than its truth value: `return "no"` or a
+    NaN would hold, and a function that forgot its `return` would never hold, without a word."""
+    from numpy import bool_
+
     assert predicate.implementation is not None
     function = resolve_callable(
         predicate.implementation.path,
@@ -422,12 +429,22 @@ def _python_predicate(engine: SubsystemEngine, predicate: PrimitivePredicate) ->
         if known is None:
             refresh()
             try:
-                known = values[name] = bool(function(inputs, context))
+                result = function(inputs, context)
             except (KeyboardInterrupt, SystemExit):
                 raise
             except BaseException as raised:
                 values[name] = raised
                 raise
+            if result is True or result is False:
+                known = values[name] = result
+            elif isinstance(result, bool_):
+                known = values[name] = bool(result)
+            else:
+                known = values[name] = PredicateFault(
+                    name,
+                    f": `{name}/pp` returned {shown(result)}, not a Boolean, so the condition counts as false "
+                    "(a predicate computed by Python returns True or False)",
+                )
         if isinstance(known, BaseException):
             raise known  # the engine records it once, then leaves a PredicateFailedBefore in its place
         return known

@@ -232,7 +232,7 @@ class SubsystemEngine:
         self.report_fault(
             time,
             "return-value",
-            f"`{name}/pf`{where} returned {_shown(value)}, which is ignored: a partial transition function "
+            f"`{name}/pf`{where} returned {shown(value)}, which is ignored: a partial transition function "
             f"writes its outputs through its second parameter (`{example}`) and returns None",
             name,
         )
@@ -321,11 +321,19 @@ class SubsystemEngine:
         except PredicateFailedBefore:
             return False
         except BaseException as raised:  # a Python predicate's own exception class may derive from BaseException
+            self._condition_failed(time, what, raised)
+            return False
+
+    def _condition_failed(self, time: int, what: str, raised: BaseException) -> None:
+        """A condition could not be evaluated: a `predicate` fault, and the condition counts as false."""
+        if isinstance(raised, PredicateFault):  # a Python predicate's own failure, which names it
+            said = f"evaluating {what}{raised.said}"
+        else:
             inside = _predicate_raising(raised)
             where = f" in `{inside}`" if inside and inside not in what else ""
-            self.report_fault(time, "predicate", f"evaluating {what} raised {exception_text(explain(raised))}{where}")
-            self._failure_recorded(raised)
-            return False
+            said = f"evaluating {what} raised {exception_text(explain(raised))}{where}"
+        self.report_fault(time, "predicate", said)
+        self._failure_recorded(raised)
 
     def _failure_recorded(self, raised: BaseException) -> None:
         """A Python predicate that raised is asked again in the same decision (a `tc` and a transition naming
@@ -358,13 +366,7 @@ class SubsystemEngine:
             except PredicateFailedBefore:
                 terminal = False
             except BaseException as raised:
-                what = f"the terminal condition of `{behaviour.name}/bb`"
-                inside = _predicate_raising(raised)
-                where = f" in `{inside}`" if inside else ""
-                self.report_fault(
-                    time, "predicate", f"evaluating {what} raised {exception_text(explain(raised))}{where}"
-                )
-                self._failure_recorded(raised)
+                self._condition_failed(time, f"the terminal condition of `{behaviour.name}/bb`", raised)
                 terminal = False
             if not terminal:
                 return
@@ -398,6 +400,17 @@ class SubsystemEngine:
         return dict(self.memory)
 
 
+class PredicateFault(Exception):
+    """What a primitive predicate computed by Python raises when it gave no Boolean: it names the predicate,
+    which the condition's fault then reports (the predicate's own frames are no compiled predicate's)."""
+
+    def __init__(self, predicate: str, said: str) -> None:
+        super().__init__(f"`{predicate}/pp`{said}")
+        self.predicate = predicate
+        #: the fault's message after `evaluating the terminal condition of `b/bb``
+        self.said = said
+
+
 class PredicateFailedBefore(Exception):
     """What a Python primitive predicate raises when asked again in the decision where it raised and its
     fault was recorded: the condition is false again, without a second fault for one failure (an `ec`
@@ -417,15 +430,19 @@ def _predicate_raising(error: BaseException) -> str | None:
     return found
 
 
-def _shown(value: object) -> str:
+def shown(value: object) -> str:
     """`a dict ({'position': [0.3, 0.3]})`: what a function returned, kept short, whatever its `__repr__` does."""
+    if value is None:
+        return "None"
     try:
         text = repr(value)
     except BaseException:  # the spec's own class, misbehaving: its type is enough
-        return f"a {type(value).__name__}"
+        text = ""
     if len(text) > 60:
         text = text[:57] + "..."
-    return f"a {type(value).__name__} ({text})"
+    kind = type(value).__name__
+    article = "an" if kind[:1].lower() in "aeiou" else "a"
+    return f"{article} {kind} ({text})" if text else f"{article} {kind}"
 
 
 def exception_text(error: BaseException) -> str:
