@@ -234,3 +234,27 @@ def test_a_predicate_may_return_a_numpy_boolean(tmp_path: Path) -> None:
     finally:
         sim.close()
         sys.modules.pop("limits", None)
+
+
+def test_a_predicate_that_raises_inside_another_is_named_and_its_traceback_kept(tmp_path: Path) -> None:
+    """`either/pp = false/pp or big/pp`: the exception of big's code is big's, not the compiled predicate's
+    that asked for it, and the fault keeps the traceback of the code, as a partial transition function's does."""
+    spec = write(tmp_path, CODE.replace('return inputs.x >= context.parameters["LIMIT"]', "return 1 / 0"))
+    text = spec.read_text().replace(
+        "        false/pp = false\n", "        false/pp = false\n        either/pp = false/pp or big/pp\n"
+    )
+    spec.write_text(text.replace("tc = big/pp", "tc = either/pp"))
+    sim = earl.simulate(earl.load(spec))
+    try:
+        sim.advance_to(0.0005)  # one iteration
+        [fault] = sim.faults
+        assert fault.message == (
+            "evaluating the terminal condition of `count/bb` raised ZeroDivisionError: division by zero in `big/pp`"
+        )
+        assert fault.traceback.startswith("Traceback (most recent call last):\n")
+        assert "limits.py" in fault.traceback and "return 1 / 0" in fault.traceback
+        assert fault.traceback.endswith("ZeroDivisionError: division by zero\n")
+        assert "earl/runtime" not in fault.traceback
+    finally:
+        sim.close()
+        sys.modules.pop("limits", None)

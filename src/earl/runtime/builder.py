@@ -433,8 +433,9 @@ def _python_predicate(engine: SubsystemEngine, predicate: PrimitivePredicate) ->
             except (KeyboardInterrupt, SystemExit):
                 raise
             except BaseException as raised:
-                values[name] = raised
-                raise
+                # named here: the compiled predicate that asked for it would be blamed otherwise
+                known = values[name] = PredicateFault.raised(name, raised)
+                raise known from None
             if result is True or result is False:
                 known = values[name] = result
             elif isinstance(result, bool_):

@@ -326,13 +326,15 @@ class SubsystemEngine:
 
     def _condition_failed(self, time: int, what: str, raised: BaseException) -> None:
         """A condition could not be evaluated: a `predicate` fault, and the condition counts as false."""
+        trace = ""
         if isinstance(raised, PredicateFault):  # a Python predicate's own failure, which names it
             said = f"evaluating {what}{raised.said}"
+            trace = raised.trace
         else:
             inside = _predicate_raising(raised)
             where = f" in `{inside}`" if inside and inside not in what else ""
             said = f"evaluating {what} raised {exception_text(explain(raised))}{where}"
-        self.report_fault(time, "predicate", said)
+        self.report_fault(time, "predicate", said, trace=trace)
         self._failure_recorded(raised)
 
     def _failure_recorded(self, raised: BaseException) -> None:
@@ -401,14 +403,23 @@ class SubsystemEngine:
 
 
 class PredicateFault(Exception):
-    """What a primitive predicate computed by Python raises when it gave no Boolean: it names the predicate,
-    which the condition's fault then reports (the predicate's own frames are no compiled predicate's)."""
+    """What a primitive predicate computed by Python raises when it raised or gave no Boolean: it names the
+    predicate, which the condition's fault then reports. `_predicate_raising` cannot find it: the frames
+    of a Python predicate are no compiled predicate's, so an exception of its code would be blamed on the
+    compiled predicate that asked for it (`sensorLost/pp = … or tooFar/pp`)."""
 
-    def __init__(self, predicate: str, said: str) -> None:
+    def __init__(self, predicate: str, said: str, trace: str = "") -> None:
         super().__init__(f"`{predicate}/pp`{said}")
         self.predicate = predicate
         #: the fault's message after `evaluating the terminal condition of `b/bb``
         self.said = said
+        #: the traceback of the predicate's code, from its own frames down, when it raised
+        self.trace = trace
+
+    @classmethod
+    def raised(cls, predicate: str, error: BaseException) -> PredicateFault:
+        """The fault of a predicate whose code raised `error`."""
+        return cls(predicate, f" raised {exception_text(explain(error))} in `{predicate}/pp`", _user_traceback(error))
 
 
 class PredicateFailedBefore(Exception):
