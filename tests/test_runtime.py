@@ -749,6 +749,48 @@ a/a {
     assert [d.code for d in refused.value.diagnostics if d.code != "EARL-X011"] == ["EARL-X004"]  # (cs: no fsm)
 
 
+def test_a_module_that_cannot_be_imported_is_said_once_at_the_first_line_naming_it(tmp_path: Path) -> None:
+    """Five functions of one broken file are one error, at the first line naming it (a predicate, bound before
+    the functions, names it further down), and the file is imported once: its failing code runs once."""
+    spec = tmp_path / "system.earl"
+    spec.write_text(
+        """\
+system broken
+
+a/a {
+    cs {
+        period 1 ms
+        x/m: int = 0
+        f/pf(x/mi -> x/mo) = python "helpers:f"
+        g/pf(x/mi -> x/mo) = python "helpers:g"
+        done/pp(x/mi) = python "helpers:done"
+        run/bb {
+            tf = {f/pf} then {g/pf}
+            tc = done/pp
+        }
+        fsm {
+            initial run
+            state run: run/bb
+        }
+    }
+}
+"""
+    )
+    (tmp_path / "helpers.py").write_text(
+        "from pathlib import Path\n\n"
+        "with open(Path(__file__).with_name('imports.txt'), 'a') as log:\n    log.write('imported\\n')\n"
+        "raise RuntimeError('half-written')\n"
+    )
+    with pytest.raises(earl.EarlError) as refused:
+        earl.simulate(earl.load(spec), check=False)
+    [diagnostic] = refused.value.diagnostics
+    assert diagnostic.code == "EARL-X003"
+    assert diagnostic.message.startswith("importing `helpers` for `f/pf` of a/a.cs failed: RuntimeError: half-written")
+    assert diagnostic.location is not None and diagnostic.location.line == 7
+    assert diagnostic.hint == "`helpers` is named at lines 8, 9 too: this error stands for those"
+    assert (tmp_path / "imports.txt").read_text() == "imported\n"
+
+
 def test_a_run_time_beyond_any_float_is_refused_as_out_of_range_not_overflowed() -> None:
     """`10**400` is an int Python cannot make a float: compared, not converted, it is refused like infinity,
     and the message quotes it short."""

@@ -31,9 +31,11 @@ PREDICATE_SIGNATURE = "def NAME(inputs, context) -> bool"
 
 
 class BindingProblem(Exception):
-    def __init__(self, diagnostic: Diagnostic) -> None:
+    def __init__(self, diagnostic: Diagnostic, module: str | None = None) -> None:
         super().__init__(diagnostic.message)
         self.diagnostic = diagnostic
+        #: the module that cannot be imported, when that is the problem: said once for all that name it
+        self.module = module
 
 
 @contextlib.contextmanager
@@ -46,6 +48,7 @@ def user_code_path(directories: list[Path]) -> Iterator[None]:
     """
     resolved = [d.resolve() for d in directories]
     _SHADOWING.clear()
+    _UNIMPORTABLE.clear()  # a module fixed since an earlier run (in a notebook) is imported again
     for directory in resolved:
         _forget_shadowed(directory)
     added = [str(d) for d in resolved if str(d) not in sys.path]
@@ -160,48 +163,68 @@ def resolve_callable(
 _ABSENT = object()
 
 
+#: what each module that could not be imported in this binding says, by module name: a module is imported
+#: once however many functions name it (importing it again would run its failing code again), and each
+#: function naming it is told the same at its own line
+_UNIMPORTABLE: dict[str, Callable[[str, SourceLocation | None], Diagnostic]] = {}
+
+
 def _import(module_name: str, what: str, location: SourceLocation | None) -> Any:
-    """The module, or a BindingProblem that says why it cannot be imported."""
+    """The module, or a BindingProblem that says why it cannot be imported (its `module` names it)."""
+    say = _UNIMPORTABLE.get(module_name)
+    if say is None:
+        found = _importing(module_name)
+        if isinstance(found, _Imported):
+            return found.module
+        say = _UNIMPORTABLE[module_name] = found
+    raise BindingProblem(say(what, location), module=module_name)
+
+
+class _Imported:
+    """A module imported (a module object is no value to tell apart from what `_importing` says otherwise)."""
+
+    def __init__(self, module: Any) -> None:
+        self.module = module
+
+
+def _importing(module_name: str) -> _Imported | Callable[[str, SourceLocation | None], Diagnostic]:
+    """The module imported, or what to say, for a function at a spec line, about why it cannot be."""
     top = module_name.partition(".")[0]
     if top in _SHADOWING:
-        raise BindingProblem(
-            Diagnostic(
-                Severity.ERROR,
-                f"{what} names the module `{module_name}`, but `{top}` is also the name of a module that earl or "
-                "Python itself uses, which is imported instead",
-                location,
-                code="EARL-X002",
-                hint=f'rename `{top}` in {_SHADOWING[top]} (and the spec\'s `python "{top}…"` with it)',
-            )
+        directory = _SHADOWING[top]
+        return lambda what, location: Diagnostic(
+            Severity.ERROR,
+            f"{what} names the module `{module_name}`, but `{top}` is also the name of a module that earl or "
+            "Python itself uses, which is imported instead",
+            location,
+            code="EARL-X002",
+            hint=f'rename `{top}` in {directory} (and the spec\'s `python "{top}…"` with it)',
         )
     try:
-        return importlib.import_module(module_name)
+        return _Imported(importlib.import_module(module_name))
     except ModuleNotFoundError as error:
         missing = error.name or module_name
         if missing == module_name or module_name.startswith(missing + "."):
-            raise BindingProblem(
-                Diagnostic(
-                    Severity.ERROR,
-                    f"{what} names the module `{module_name}`, which cannot be found (no module `{missing}`)",
-                    location,
-                    code="EARL-X002",
-                    hint="modules are looked up next to the spec file first, then on the Python path; "
-                    f"create `{module_name.replace('.', '/')}.py` there",
-                )
-            ) from None
+            return lambda what, location: Diagnostic(
+                Severity.ERROR,
+                f"{what} names the module `{module_name}`, which cannot be found (no module `{missing}`)",
+                location,
+                code="EARL-X002",
+                hint="modules are looked up next to the spec file first, then on the Python path; "
+                f"create `{module_name.replace('.', '/')}.py` there",
+            )
         failure: BaseException = error  # the module is there, but something it imports is not
     except KeyboardInterrupt:
         raise
     except BaseException as error:  # the user's module failed while importing, sys.exit() included
         failure = error
-    raise BindingProblem(
-        Diagnostic(
-            Severity.ERROR,
-            f"importing `{module_name}` for {what} failed: {_import_failure(failure)}{_where(failure)}",
-            location,
-            code="EARL-X003",
-        )
-    ) from None
+    said = f"{_import_failure(failure)}{_where(failure)}"
+    return lambda what, location: Diagnostic(
+        Severity.ERROR,
+        f"importing `{module_name}` for {what} failed: {said}",
+        location,
+        code="EARL-X003",
+    )
 
 
 def _import_failure(error: BaseException) -> str:

@@ -109,6 +109,8 @@ def build_network(
     problems: list[Diagnostic] = []
     system_parameters = {p.name: _value(p.value) for p in system.parameters}
     bound: dict[str, UserFunction] = {}
+    #: modules that cannot be imported: what was said of each, at the first line naming it, and the lines naming it
+    unimportable: dict[str, _Unimportable] = {}
     directories = code_directories or []
     keys: dict[tuple[str, int | None, Kind, str, int | None], SubsystemEngine] = {}
     with user_code_path(directories):
@@ -136,7 +138,7 @@ def build_network(
                     engine = _engine(
                         agent, subsystem, len(network.engines), agent_parameters, types, recorder, environment, seed
                     )
-                    _behaviour(engine, subsystem, types, bound, problems)
+                    _behaviour(engine, subsystem, types, bound, _Problems(problems, unimportable))
                 except (ValueTypeError, PredicateCompileError) as error:
                     problems.append(
                         Diagnostic(
@@ -164,9 +166,72 @@ def build_network(
             _connect(link, agent, keys, network, problems, remote)
     for link in system.links:
         _connect(link, None, keys, network, problems, remote)
+    for module in unimportable.values():
+        module.say_where_else()
     if problems:
         raise EarlError(_once_per_binding(problems), system.sources)  # type: ignore[arg-type]
     return network
+
+
+class _Unimportable:
+    """A module that cannot be imported, said once at the first spec line that names it: one broken file
+    of five functions is one error to fix, not five."""
+
+    def __init__(self, diagnostic: Diagnostic, module: str) -> None:
+        self.diagnostic = diagnostic
+        self.module = module
+        self.lines: set[tuple[str, int]] = set()
+
+    def named_at(self, diagnostic: Diagnostic, problems: list[Diagnostic]) -> None:
+        """Another function or predicate names the module: the error moves to its line if that comes first."""
+        location, first = diagnostic.location, self.diagnostic.location
+        if location is None:
+            return
+        if first is not None and location.file == first.file and location.line < first.line:
+            problems[problems.index(self.diagnostic)] = diagnostic
+            self.lines.add((first.file, first.line))
+            self.diagnostic = diagnostic
+        elif first is None or (location.file, location.line) != (first.file, first.line):
+            self.lines.add((location.file, location.line))
+
+    def say_where_else(self) -> None:
+        if not self.lines:
+            return
+        first = self.diagnostic.location
+        files: dict[str, list[int]] = {}
+        for file, line in sorted(self.lines):
+            files.setdefault(file, []).append(line)
+        places = "; ".join(
+            ("lines " if len(lines) > 1 else "line ")
+            + ", ".join(map(str, lines))
+            + ("" if first is not None and file == first.file else f" of {Path(file).name}")
+            for file, lines in files.items()
+        )
+        also = f"`{self.module}` is named at {places} too: this error stands for those"
+        self.diagnostic.hint = f"{self.diagnostic.hint}; {also}" if self.diagnostic.hint else also
+
+
+class _Problems:
+    """Where `_behaviour` puts what it finds: the run's problems, a module that cannot be imported once."""
+
+    def __init__(self, problems: list[Diagnostic], unimportable: dict[str, _Unimportable]) -> None:
+        self.problems = problems
+        self.unimportable = unimportable
+
+    def append(self, diagnostic: Diagnostic) -> None:
+        self.problems.append(diagnostic)
+
+    def binding(self, problem: BindingProblem) -> None:
+        module = problem.module
+        if module is None:
+            self.problems.append(problem.diagnostic)
+            return
+        known = self.unimportable.get(module)
+        if known is None:
+            self.unimportable[module] = _Unimportable(problem.diagnostic, module)
+            self.problems.append(problem.diagnostic)
+        else:
+            known.named_at(problem.diagnostic, self.problems)
 
 
 #: the codes of code that cannot be bound: the same spec line fails alike for every member of a family
@@ -268,7 +333,7 @@ def _behaviour(
     subsystem: Subsystem,
     types: TypeSystem,
     bound: dict[str, UserFunction],
-    problems: list[Diagnostic],
+    problems: _Problems,
 ) -> None:
     for predicate in subsystem.primitive_predicates:
         if predicate.implementation is not None:
@@ -276,7 +341,7 @@ def _behaviour(
                 engine.predicates[predicate.name] = _python_predicate(engine, predicate)
                 engine.keeps_predicate_values = True
             except BindingProblem as problem:
-                problems.append(problem.diagnostic)
+                problems.binding(problem)
     _keep_repeated_predicates(engine, subsystem)
     functions: dict[str, FunctionRuntime] = {}
     for declared in subsystem.partial_transition_functions:
@@ -288,7 +353,7 @@ def _behaviour(
                 function = bind_function(declared, engine.name)
                 bound[cache_key] = function
         except BindingProblem as problem:
-            problems.append(problem.diagnostic)
+            problems.binding(problem)
             continue
         functions[declared.name] = FunctionRuntime(
             declared.name,
