@@ -1031,15 +1031,61 @@ def test_trace_and_plot_on_one_file_is_a_usage_error(tmp_path: Path) -> None:
     assert "--trace and --plot both name" in result.stderr and not same.exists()
 
 
-def test_a_report_that_calls_sys_exit_does_not_choose_the_exit_code(tmp_path: Path) -> None:
+def example_reporting_with(tmp_path: Path, report: str, code: str) -> Path:
+    """The pick-and-place example, its run.toml's `report` naming `report`, with closing.py holding `code`."""
     example = tmp_path / "pick_and_place"
     shutil.copytree(EXAMPLE, example)
     settings = example / "run.toml"
-    settings.write_text(re.sub(r'report = "[^"]*"', 'report = "closing:summary"', settings.read_text()))
-    (example / "closing.py").write_text("import sys\n\n\ndef summary(simulation):\n    sys.exit(5)\n")
-    result = earl_cli("run", str(example), "--duration", "20ms", "--no-progress")
-    assert result.returncode == 0, result.stderr
-    assert "the report `closing:summary` called sys.exit(5)" in result.stdout + result.stderr
+    settings.write_text(re.sub(r'report = "[^"]*"', f'report = "{report}"', settings.read_text()))
+    (example / "closing.py").write_text(code)
+    return example
+
+
+@pytest.mark.parametrize(
+    ("code", "said"),
+    [
+        ("import sys\n\n\ndef summary(simulation):\n    sys.exit(5)\n", "called sys.exit(5); its text is lost"),
+        ("def summary(simulation):\n    return 1 / 0\n", "failed: ZeroDivisionError: division by zero"),
+    ],
+)
+def test_a_report_that_fails_at_the_end_exits_1_not_what_it_chose(tmp_path: Path, code: str, said: str) -> None:
+    """The run and its trace are whole, but what run.toml asked for is missing: exit 1, as for a plot not drawn
+    (and never the 5 the report's sys.exit chose)."""
+    result = earl_cli("run", str(example_reporting_with(tmp_path, "closing:summary", code)), "--duration", "20ms")
+    assert result.returncode == 1, result.stderr
+    assert "ran 0.020 s of virtual time" in result.stdout
+    assert f"the report `closing:summary` {said}" in result.stdout + result.stderr
+
+
+@pytest.mark.parametrize(
+    ("report", "code", "said", "hint"),
+    [
+        (
+            "closing:sumary",
+            "def summary(simulation):\n    return 'done'\n",
+            "error[EARL-X004]: the run report names `sumary`, but the module `closing` has no such function",
+            "did you mean `summary`?",
+        ),
+        (
+            "closing:summary",
+            "def summary():\n    return 'done'\n",
+            "error[EARL-X005]: the run report calls `closing:summary` with 1 argument, but it is defined as "
+            "`summary()`",
+            "write it as `def summary(simulation) -> str`",
+        ),
+    ],
+)
+def test_a_report_that_cannot_be_bound_is_said_at_its_run_toml_line_before_the_run(
+    tmp_path: Path, report: str, code: str, said: str, hint: str
+) -> None:
+    example = example_reporting_with(tmp_path, report, code)
+    line = 1 + (example / "run.toml").read_text().split("\n").index(f'report = "{report}"')
+    result = earl_cli("run", "pick_and_place", "--duration", "20ms", cwd=tmp_path)
+    assert result.returncode == 1
+    assert said in result.stderr and hint in result.stderr
+    assert f"--> pick_and_place/run.toml:{line}:1" in result.stderr
+    assert f'report = "{report}"' in result.stderr  # the line, quoted
+    assert "virtual time" not in result.stdout  # nothing ran
 
 
 def test_a_stop_before_the_run_never_removes_a_file_this_command_did_not_create(

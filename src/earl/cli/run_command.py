@@ -48,9 +48,9 @@ code a spec names (docs/runtime.md).
 
 exit codes: 0 the run completed (or the spec's code called sys.exit(0)), 1 invalid spec,
             the run could not start, its trace could not be written (a full disk), the
-            environment failed, the spec's code called sys.exit with a failure, or a --plot
-            could not be drawn (the run and its trace are whole), 2 usage error, 130
-            interrupted (the trace is closed and readable)
+            environment failed, the spec's code called sys.exit with a failure, or the --plot
+            or run.toml's report asked for failed at the end (the run and its trace are
+            whole), 2 usage error, 130 interrupted (the trace is closed and readable)
 """
 
 
@@ -157,7 +157,7 @@ def _run(arguments: argparse.Namespace) -> int:
 
     watch_supervisor()
     from earl.runtime.durations import parse_duration
-    from earl.runtime.simulation import RecordingWarning, Simulation, read_run_settings
+    from earl.runtime.simulation import RecordingWarning, Simulation, bind_report, read_run_settings
 
     try:
         path = spec_path(arguments.spec)
@@ -235,6 +235,8 @@ def _run(arguments: argparse.Namespace) -> int:
             from earl.transport.process import agents_of
 
             agents = agents_of(system, parameters, agents)
+        # bound now, as the spec's functions are: not found to be misspelt after the whole run
+        report = bind_report(settings.report, path, settings) if settings.report and environment is not None else None
         if arguments.plot:
             # what the plot draws is recorded, and a signal the system does not have is said now
             from earl.model.expand import expand
@@ -319,7 +321,7 @@ def _run(arguments: argparse.Namespace) -> int:
                 said = "nothing was executed" + _remove_unrun_trace(arguments, trace_was_there)
                 print(f"earl run: interrupted while waiting for the other processes; {said}", file=sys.stderr)
                 return EXIT_INTERRUPTED
-        return _execute(simulation, duration, arguments, None if environment is None else settings.report, path)
+        return _execute(simulation, duration, arguments, report, settings.report or "", path)
     finally:
         # Closed already, unless printing failed (a reader that went away: `earl run … | head`); an open
         # Zenoh session's threads would keep the process from ever ending.
@@ -437,7 +439,14 @@ def _seed(text: str) -> int:
     return value
 
 
-def _execute(simulation: Any, duration: float, arguments: argparse.Namespace, report: str | None, path: Path) -> int:
+def _execute(
+    simulation: Any,
+    duration: float,
+    arguments: argparse.Namespace,
+    report: Callable[[Any], object] | None,
+    report_name: str,
+    path: Path,
+) -> int:
     from earl.runtime.simulation import EnvironmentFailed
     from earl.runtime.trace import TraceWriteError
 
@@ -483,8 +492,9 @@ def _execute(simulation: Any, duration: float, arguments: argparse.Namespace, re
 
         print_link_statistics(simulation.transport)
     plotted = _plot(arguments, console) if arguments.plot else True
-    if report:
-        _report(simulation, report, path, console)
+    # a report that fails is a run that did not give what it was asked for, as a plot not drawn is
+    reported = _report(simulation, report, report_name, path, console) if report is not None else True
+    delivered = plotted and reported
     if broken is not None:
         console.print(f"earl run: {brief(str(broken))} at {simulation.time:.3f} s; the run stopped there")
         return EXIT_FAILED
@@ -498,8 +508,9 @@ def _execute(simulation: Any, duration: float, arguments: argparse.Namespace, re
             f"earl run: the spec's code called sys.exit({'' if status is None else repr(status)}) at "
             f"{simulation.time:.3f} s; the run stopped there" + (" and the trace is closed" if arguments.trace else "")
         )
-        return EXIT_OK if status in (None, 0) and plotted else EXIT_FAILED
-    return EXIT_OK if plotted else EXIT_FAILED  # a plot asked for and not drawn, as `earl plot` says it
+        return EXIT_OK if status in (None, 0) and delivered else EXIT_FAILED
+    # a plot asked for and not drawn (as `earl plot` says it), or a report that failed
+    return EXIT_OK if delivered else EXIT_FAILED
 
 
 def _advance(
@@ -606,24 +617,20 @@ def _plot(arguments: argparse.Namespace, console: Console) -> bool:
     return True
 
 
-def _report(simulation: Any, report: str, path: Path, console: Console) -> None:
-    """The example's own closing lines (`report = "module:function"` in run.toml)."""
-    from earl.runtime.binding import BindingProblem, resolve_callable, user_code_path
+def _report(simulation: Any, function: Callable[[Any], object], report: str, path: Path, console: Console) -> bool:
+    """The example's own closing lines (`report = "module:function"` in run.toml, bound before the run);
+    whether it gave them."""
+    from earl.runtime.binding import user_code_path
 
-    with user_code_path([path.resolve().parent]):
+    with user_code_path([path.resolve().parent]):  # for what the report imports as it runs
         try:
-            function = resolve_callable(
-                report, "the run report", None, arity=1, signature="def NAME(simulation) -> str"
-            )
             text = function(simulation)
-        except BindingProblem as problem:
-            console.print(f"earl run: {problem.diagnostic.message}")
-            return
-        except Exception as error:  # the report is the example's code: say what failed, keep the exit code
+        except Exception as error:  # the report is the example's code: say what failed
             console.print(f"earl run: the report `{report}` failed: {type(error).__name__}: {error}")
-            return
+            return False
         except SystemExit as leaving:  # sys.exit in the report must not choose earl's exit code
             console.print(f"earl run: the report `{report}` called sys.exit({leaving.code!r}); its text is lost")
-            return
+            return False
     if text:
         print(text)
+    return True

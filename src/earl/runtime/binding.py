@@ -285,7 +285,7 @@ def _check_arity(
         raise BindingProblem(
             Diagnostic(
                 Severity.ERROR,
-                f"{what} calls `{name}` with {arity} arguments, but it is defined as "
+                f"{what} calls `{name}` with {arity} argument{'s' if arity != 1 else ''}, but it is defined as "
                 f"`{name.rpartition(':')[2]}{actual}`",
                 location,
                 code="EARL-X005",

@@ -19,7 +19,7 @@ import os
 import re
 import tomllib
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -525,6 +525,23 @@ def _setting_location(system: System, key: str, value: object) -> tuple[SourceLo
     return None, sources
 
 
+def bind_report(report: str, spec: Path, settings: RunSettings) -> Callable[[Simulation], object]:
+    """run.toml's `report = "module:function"`, bound before the run as the spec's functions are: a
+    misspelt name or a wrong signature is said at once (EARL-X001…X005 at its run.toml line), not
+    after a run of minutes."""
+    with user_code_path([spec.resolve().parent]):
+        try:
+            return resolve_callable(
+                report,
+                "the run report",
+                settings.location("report"),
+                arity=1,
+                signature="def NAME(simulation) -> str",
+            )
+        except BindingProblem as problem:
+            raise EarlError([problem.diagnostic], settings.sources()) from None
+
+
 @dataclass
 class RunSettings:
     """Defaults for `earl run` read from a `run.toml` next to the spec (command-line options win)."""
@@ -536,14 +553,52 @@ class RunSettings:
     report: str | None = None
     plot: list[str] | None = None
     record_links: list[str] | None = None
+    #: the file as a diagnostic names it, its text and the line of each key: a wrong `report` or
+    #: `environment` is said at its line, as a wrong function is at the spec's
+    file: str = ""
+    text: str = ""
+    lines: dict[str, int] = field(default_factory=dict)
+
+    def location(self, key: str) -> SourceLocation | None:
+        """Where `key = …` is written in run.toml (None without a run.toml, or for a key it does not set)."""
+        line = self.lines.get(key)
+        if line is None:
+            return None
+        written = self.text.split("\n")[line - 1].rstrip("\r")
+        return SourceLocation(self.file, line, 1, line, max(1, len(written.rstrip())))
+
+    def sources(self) -> SourceMap:
+        """run.toml's text, for a diagnostic to quote its line."""
+        sources = SourceMap()
+        if self.file:
+            sources.add(self.file, self.text)
+        return sources
+
+
+def _key_lines(text: str) -> dict[str, int]:
+    """The line each top-level key of a run.toml is set on (`report = "…"`, `"report" = "…"`)."""
+    import re
+
+    lines: dict[str, int] = {}
+    for number, line in enumerate(text.split("\n"), start=1):
+        if line.lstrip().startswith("["):
+            break  # a table: no setting of earl's is in one
+        found = re.match(r"""\s*(?:"([^"]*)"|'([^']*)'|([A-Za-z0-9_-]+))\s*=""", line)
+        if found:
+            lines.setdefault(next(group for group in found.groups() if group is not None), number)
+    return lines
 
 
 def read_run_settings(spec: Path) -> RunSettings:
     path = spec.resolve().parent / "run.toml"  # next to the file itself, as its modules and imports
     if not path.is_file():
         return RunSettings()
+    # named as the spec is (`run.toml` beside `system.earl`), unless the spec is a link to another directory
+    beside = spec.parent / "run.toml"
+    shown = str(beside) if beside.resolve() == path else str(path)
     try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
+        text = path.read_text(encoding="utf-8")
+        data = tomllib.loads(text)
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as error:
         raise ValueError(f"{path}: not valid TOML: {error}") from None
     known = {"environment", "duration", "seed", "record_memory", "record_links", "report", "plot"}
@@ -584,4 +639,7 @@ def read_run_settings(spec: Path) -> RunSettings:
         report=data.get("report"),
         plot=data.get("plot"),
         record_links=data.get("record_links"),
+        file=shown,
+        text=text,
+        lines=_key_lines(text),
     )
