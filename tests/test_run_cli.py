@@ -694,7 +694,10 @@ def test_run_help_teaches_with_examples() -> None:
     assert result.returncode == 0
     assert "examples:" in result.stdout and "exit codes:" in result.stdout and "run.toml" in result.stdout
     # as docs/runtime.md says them
-    assert "or a --plot could not be drawn (the run and its trace are whole)" in " ".join(result.stdout.split())
+    assert (
+        "or the --plot or run.toml's report asked for failed at the end (the run and its trace are whole)"
+        in " ".join(result.stdout.split())
+    )
 
 
 @pytest.fixture(autouse=True)
@@ -1039,6 +1042,19 @@ def example_reporting_with(tmp_path: Path, report: str, code: str) -> Path:
     settings.write_text(re.sub(r'report = "[^"]*"', f'report = "{report}"', settings.read_text()))
     (example / "closing.py").write_text(code)
     return example
+
+
+def test_run_toml_s_environment_without_its_factory_is_said_at_its_line(tmp_path: Path) -> None:
+    spec = counter_copy(tmp_path)
+    (spec.parent / "run.toml").write_text('duration = "10ms"\nenvironment = "counting.relay"\n')
+    result = earl_cli("run", "counter", cwd=tmp_path)
+    assert result.returncode == 1
+    assert "error[EARL-X001]: `counting.relay` does not name a function: write `module:function`" in result.stderr
+    assert "--> counter/run.toml:2:1" in result.stderr and 'environment = "counting.relay"' in result.stderr
+    assert '`counting.relay` is a module: name its function after a colon, `"counting.relay:' in result.stderr
+    # given on the command line, it is the command line's: no run.toml line
+    result = earl_cli("run", "counter", "--environment", "counting.relay", cwd=tmp_path)
+    assert result.returncode == 1 and "EARL-X001" in result.stderr and "run.toml" not in result.stderr
 
 
 @pytest.mark.parametrize(

@@ -791,6 +791,43 @@ a/a {
     assert (tmp_path / "imports.txt").read_text() == "imported\n"
 
 
+def test_a_module_named_without_its_function_is_said_so_not_read_as_module_dot_function() -> None:
+    """`environment = "counting.cs"` (the `:FACTORY` forgotten) was read as the function `cs` of `counting`,
+    and refused as `counting` having no function `cs`: only the colon separates module and function."""
+    with pytest.raises(earl.EarlError) as refused:
+        earl.simulate(earl.load(SPECS / "counter"), environment="counting.cs")
+    [diagnostic] = refused.value.diagnostics
+    assert diagnostic.code == "EARL-X001"
+    assert diagnostic.message == "`counting.cs` does not name a function: write `module:function`"
+    assert diagnostic.hint is not None
+    assert diagnostic.hint.startswith(
+        '`counting.cs` is a module: name its function after a colon, `"counting.cs:FACTORY"`'
+    )
+    assert "(it defines `" in diagnostic.hint
+
+
+@pytest.mark.parametrize("check", [True, False])
+def test_a_dot_for_the_colon_of_an_implementation_is_refused_with_the_colon_suggested(
+    tmp_path: Path, check: bool
+) -> None:
+    spec = copy_spec("counter", tmp_path)
+    text = spec.read_text()
+    dotted = re.sub(r'python "counting\.cs:(\w+)"', r'python "counting.cs.\1"', text, count=1)
+    assert dotted != text
+    spec.write_text(dotted)
+    line = 1 + dotted.split("\n").index(next(row for row in dotted.split("\n") if 'python "counting.cs.' in row))
+    function = re.search(r'python "counting\.cs\.(\w+)"', dotted).group(1)  # type: ignore[union-attr]
+    with pytest.raises(earl.EarlError) as refused:
+        earl.simulate(earl.load(spec), check=check)
+    [diagnostic] = [d for d in refused.value.diagnostics if d.severity == earl.Severity.ERROR]
+    # the checker finds it first (without importing anything); unchecked, the binding refuses it alike
+    assert diagnostic.code == ("EARL-E044" if check else "EARL-X001")
+    assert diagnostic.location is not None and diagnostic.location.line == line
+    assert f'did you mean `python "counting.cs:{function}"`?' in (diagnostic.hint or "") or (
+        f'did you mean `"counting.cs:{function}"`?' in (diagnostic.hint or "")
+    )
+
+
 def test_a_run_time_beyond_any_float_is_refused_as_out_of_range_not_overflowed() -> None:
     """`10**400` is an int Python cannot make a float: compared, not converted, it is refused like infinity,
     and the message quotes it short."""

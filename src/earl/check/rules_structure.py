@@ -195,7 +195,8 @@ def buffer_groups(context: CheckContext) -> Iterator[Finding]:
 def implementations_name_a_function(context: CheckContext) -> Iterator[Finding]:
     """`= python "module:function"` tells `earl run` which function computes a Partial Transition
     Function or a Primitive Predicate; without both parts there is nothing to import (`earl run`
-    refuses it, EARL-X001). Nothing is imported to check this."""
+    refuses it, EARL-X001). A dot does not stand for the colon: `robot.arm.move` could be the module
+    `robot.arm.move` as well as the function `move` of `robot.arm`. Nothing is imported to check this."""
     for _, subsystem in context.distinct_subsystems():
         named = [(f"`{f.name}/pf`", f.implementation, f.location) for f in subsystem.partial_transition_functions]
         named += [(f"`{p.name}/pp`", p.implementation, p.location) for p in subsystem.primitive_predicates]
@@ -203,10 +204,15 @@ def implementations_name_a_function(context: CheckContext) -> Iterator[Finding]:
             if implementation is None:
                 continue
             if not implementation.module.strip() or not implementation.function.strip():
+                path = implementation.path.strip()
+                module, dot, function = path.rpartition(".")
+                dotted = dot and ":" not in path and module and function.isidentifier()
                 yield Finding(
                     f'the implementation of {what}, `python "{implementation.path}"`, does not name a function',
                     location,
-                    'write `python "module:function"`, e.g. `python "robot.arm:move"`',
+                    f'did you mean `python "{module}:{function}"`? A colon separates the module from the function'
+                    if dotted
+                    else 'write `python "module:function"`, e.g. `python "robot.arm:move"`',
                 )
 
 

@@ -272,7 +272,10 @@ def _run(arguments: argparse.Namespace) -> int:
                 system,
                 parameters=parameters,
                 seed=seed,
-                environment=environment,
+                # run.toml's own, read there again, is said at its line when it cannot be bound
+                environment="run.toml"
+                if environment is not None and arguments.environment is None and environment == settings.environment
+                else environment,
                 trace=arguments.trace,
                 record_memory=record_memory,
                 record_links=arguments.record_links if arguments.record_links is not None else settings.record_links,

@@ -176,17 +176,20 @@ class Predicate:
 @quick_init
 @dataclass(frozen=True, slots=True)
 class PythonImplementation:
-    """`python "pick_and_place.manip:joint_move"`: where the runtime finds the code."""
+    """`python "pick_and_place.manip:joint_move"`: where the runtime finds the code.
+
+    The colon is the only separator: `robot.arm.move` could be the module `robot.arm.move` as well as
+    the function `move` of `robot.arm`, so it names no function (EARL-E044, EARL-X001)."""
 
     path: str
 
     @property
     def module(self) -> str:
-        return self.path.partition(":")[0] if ":" in self.path else self.path.rpartition(".")[0]
+        return self.path.partition(":")[0]
 
     @property
     def function(self) -> str:
-        return self.path.partition(":")[2] if ":" in self.path else self.path.rpartition(".")[2]
+        return self.path.partition(":")[2]
 
 
 @dataclass

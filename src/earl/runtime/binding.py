@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import importlib
+import importlib.util
 import inspect
 import sys
 import traceback
@@ -111,11 +112,17 @@ def _installed(locations: list[str]) -> bool:
 
 
 def resolve_callable(
-    path: str, what: str, location: SourceLocation | None, arity: int = 3, signature: str = SIGNATURE
+    path: str,
+    what: str,
+    location: SourceLocation | None,
+    arity: int = 3,
+    signature: str = SIGNATURE,
+    placeholder: str = "FUNCTION",
 ) -> Callable[..., Any]:
-    """Import `module:function` (or `module.function`) and check that it can be called with `arity` arguments.
+    """Import `module:function` and check that it can be called with `arity` arguments.
 
-    `signature` shows how such a function is written, in hints (`def NAME(inputs, outputs, context)`).
+    `signature` shows how such a function is written, in hints (`def NAME(inputs, outputs, context)`);
+    `placeholder` stands for its name in a hint that cannot know it (`pendulum.env:FACTORY`).
     """
     module_name, function_name = _split(path)
     if not module_name or not function_name:
@@ -125,7 +132,7 @@ def resolve_callable(
                 f"`{path}` does not name a function: write `module:function`",
                 location,
                 code="EARL-X001",
-                hint='e.g. `= python "pick_and_place.manip:joint_move"`',
+                hint=_colon_hint(path.strip(), placeholder),
             )
         )
     module = _import(module_name, what, location)
@@ -265,11 +272,49 @@ def _not_a_plain_function(function: object) -> str | None:
 
 
 def _split(path: str) -> tuple[str, str]:
-    if ":" in path:
-        module, _, function = path.partition(":")
-    else:
-        module, _, function = path.rpartition(".")
+    """`module:function`: the colon is the only separator (a dot could end a module's name as well as
+    stand before a function's: `pendulum.env` is a module whose factory was left out)."""
+    module, _, function = path.partition(":")
     return module.strip(), function.strip()
+
+
+def _colon_hint(path: str, placeholder: str) -> str:
+    """What `path`, which has no `module:function` colon, was likely meant to be."""
+    module_name, dot, last = path.rpartition(".")
+    if ":" in path or not dot or not last.isidentifier():
+        return f'write the module, a colon and the function, e.g. `"pick_and_place.manip:{placeholder.lower()}"`'
+    whole = _importable(path)
+    if whole is not None:  # `pendulum.env`: the module alone, its function left out
+        functions = _functions_defined_in(whole)
+        name = functions[0] if len(functions) == 1 else placeholder
+        listed = f" (it defines {', '.join(f'`{f}`' for f in functions[:6])})" if len(functions) > 1 else ""
+        return f'`{path}` is a module: name its function after a colon, `"{path}:{name}"`{listed}'
+    return f'did you mean `"{module_name}:{last}"`? A colon separates the module from the function'
+
+
+def _importable(module_name: str) -> Any:
+    """The module `module_name` if it exists and imports, else None (a hint never fails the binding)."""
+    try:
+        if importlib.util.find_spec(module_name) is None:
+            return None
+    except (ImportError, ValueError):
+        return None
+    except KeyboardInterrupt:
+        raise
+    except BaseException:  # a package whose `__init__` fails: the binding says so when it imports it
+        return None
+    found = _importing(module_name)
+    return found.module if isinstance(found, _Imported) else None
+
+
+def _functions_defined_in(module: Any) -> list[str]:
+    """The public functions and classes a module defines itself (not those it imports)."""
+    name = getattr(module, "__name__", "")
+    return sorted(
+        key
+        for key, value in vars(module).items()
+        if callable(value) and not key.startswith("_") and getattr(value, "__module__", None) == name
+    )
 
 
 def _check_arity(

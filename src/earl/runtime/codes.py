@@ -9,7 +9,7 @@ from __future__ import annotations
 
 RUNNING_CODES: dict[str, str] = {
     "EARL-X000": 'a partial transition function has no `= python "…"` implementation',
-    "EARL-X001": "the implementation is not `module:function`",
+    "EARL-X001": "the implementation is not `module:function` (a dot is no colon)",
     "EARL-X002": "the module cannot be found (modules are looked up next to the spec first)",
     "EARL-X003": "importing the module raised an error, called `sys.exit()`, or imports a module that cannot be found",
     "EARL-X004": "the module has no such function, or it is not callable",

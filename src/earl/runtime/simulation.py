@@ -15,8 +15,6 @@ from __future__ import annotations
 import contextlib
 import math
 import numbers
-import os
-import re
 import tomllib
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -124,12 +122,14 @@ class Simulation:
         self.expanded = expand(system, parameters)
         self.seed = seed
         directories = _code_directories(system)
+        settings = RunSettings()
         if environment == "run.toml":
-            # like `earl run`: the environment a run.toml next to the spec names, if any
-            environment = read_run_settings(Path(system.source_file)).environment if system.source_file else None
-        self.environment = _environment(environment, self.expanded, seed, directories, system)
+            # like `earl run`: the environment a run.toml next to the spec names, if any (said at its line)
+            settings = read_run_settings(Path(system.source_file)) if system.source_file else RunSettings()
+            environment = settings.environment
         #: where the environment is named (run.toml's line), for what is said of it before the run
-        self._environment_named = _setting_location(system, "environment", environment)
+        self._environment_named = _environment_named(system, settings, environment)
+        self.environment = _environment(environment, self.expanded, seed, directories, *self._environment_named)
         _bind(self.environment, self.expanded, *self._environment_named)
         self.statistics = StatisticsRecorder()
         self._faults = _FaultList()
@@ -450,15 +450,25 @@ class _Guarded:
 
 
 def _environment(
-    environment: object | str | None, expanded: System, seed: int, directories: list[Path], system: System
+    environment: object | str | None,
+    expanded: System,
+    seed: int,
+    directories: list[Path],
+    location: SourceLocation | None,
+    sources: SourceMap,
 ) -> object:
+    """The environment object; `location` is where it is named (run.toml's line), if it is."""
     if not isinstance(environment, str):
         return environment
-    location, sources = _setting_location(system, "environment", environment)
     with user_code_path(directories):
         try:
             factory = resolve_callable(
-                environment, "the environment", location, arity=2, signature="def NAME(system, seed) -> object"
+                environment,
+                "the environment",
+                location,
+                arity=2,
+                signature="def NAME(system, seed) -> object",
+                placeholder="FACTORY",
             )
         except BindingProblem as problem:
             raise EarlError([problem.diagnostic], sources) from None
@@ -501,28 +511,21 @@ def _bind(environment: object, expanded: System, location: SourceLocation | None
         raise EarlError([Diagnostic(Severity.ERROR, message, location, code="EARL-X021")], sources) from None
 
 
-def _setting_location(system: System, key: str, value: object) -> tuple[SourceLocation | None, SourceMap]:
-    """Where the run.toml next to the spec sets `key` to `value`, if it does (a message about the environment
-    points at the line that names it), and the texts a diagnostic quotes: the spec's, and that run.toml's."""
+def _environment_named(
+    system: System, settings: RunSettings, environment: object
+) -> tuple[SourceLocation | None, SourceMap]:
+    """Where the run.toml next to the spec names the environment, if it does (a message about the
+    environment points at that line), and the texts a diagnostic quotes: the spec's, and that run.toml's
+    (an environment that refuses the system in `bind` says so at the spec's lines)."""
     sources = SourceMap()
     if isinstance(system.sources, SourceMap):
         sources.texts.update(system.sources.texts)
-    if not system.source_file or not isinstance(value, str):
+    if not isinstance(environment, str) or environment != settings.environment:
         return None, sources
-    path = Path(system.source_file).resolve().parent / "run.toml"  # as read_run_settings finds it
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError):
-        return None, sources
-    shown = os.path.relpath(path)
-    if shown.startswith(".."):
-        shown = str(path)
-    for number, line in enumerate(text.split("\n"), start=1):
-        setting = re.match(rf"\s*{re.escape(key)}\s*=\s*([\"'])(.*?)\1", line)
-        if setting is not None and setting[2] == value:
-            sources.add(shown, text)
-            return SourceLocation(shown, number, setting.start(1) + 1, number, setting.end(0)), sources
-    return None, sources
+    location = settings.location("environment")
+    if location is not None:
+        sources.texts.update(settings.sources().texts)
+    return location, sources
 
 
 def bind_report(report: str, spec: Path, settings: RunSettings) -> Callable[[Simulation], object]:
@@ -564,8 +567,13 @@ class RunSettings:
         line = self.lines.get(key)
         if line is None:
             return None
-        written = self.text.split("\n")[line - 1].rstrip("\r")
-        return SourceLocation(self.file, line, 1, line, max(1, len(written.rstrip())))
+        written = self.text.split("\n")[line - 1].rstrip("\r").rstrip()
+        # the value, after the `=` (the caret under what is wrong: a misspelt `module:function`)
+        equals = written.find("=")
+        start = equals + 1 + (len(written) - equals - 1 - len(written[equals + 1 :].lstrip())) if equals >= 0 else 0
+        if start >= len(written):
+            start = 0
+        return SourceLocation(self.file, line, start + 1, line, max(start + 1, len(written)))
 
     def sources(self) -> SourceMap:
         """run.toml's text, for a diagnostic to quote its line."""
