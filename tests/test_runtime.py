@@ -828,6 +828,89 @@ def test_a_dot_for_the_colon_of_an_implementation_is_refused_with_the_colon_sugg
     )
 
 
+PLANT = """\
+class Plant:
+    def __init__(self, system, seed):
+        self.seed = seed
+        self.times = []
+
+    def advance(self, time):
+        self.times.append(time)
+
+
+class Fixed:
+    def __init__(self, xml):
+        pass
+
+
+async def later(system, seed):
+    return Plant(system, seed)
+"""
+
+
+def test_a_class_taking_system_and_seed_is_an_environment_factory(tmp_path: Path) -> None:
+    """`FACTORY(system, seed) -> object` is what a class is, called: its instance is the environment."""
+    spec = copy_spec("counter", tmp_path)
+    (spec.parent / "plant.py").write_text(PLANT)
+    sim = earl.simulate(earl.load(spec), environment="plant:Plant", seed=4)
+    try:
+        sim.advance_to(0.002)
+        plant = sim.environment
+        assert type(plant).__name__ == "Plant" and plant.seed == 4  # type: ignore[attr-defined]
+        assert plant.times  # type: ignore[attr-defined]
+    finally:
+        sim.close()
+        sys.modules.pop("plant", None)
+
+
+@pytest.mark.parametrize(
+    ("factory", "message", "hint"),
+    [
+        (
+            "plant:Fixed",
+            "the environment calls `plant:Fixed` with 2 arguments, but it is defined as `Fixed(xml)`",
+            "give `Fixed` an `__init__(self, system, seed)` (see docs/runtime.md)",
+        ),
+        (
+            "plant:later",
+            "the environment names `plant:later`, which is a coroutine function (`async def`), not a function",
+            "write it as `def later(system, seed) -> object` (or as a class whose `__init__` takes them): earl "
+            "calls it once, before the run, and the object it returns is the environment",
+        ),
+    ],
+)
+def test_an_environment_factory_that_cannot_make_the_environment_is_told_how_to_be_written(
+    tmp_path: Path, factory: str, message: str, hint: str
+) -> None:
+    spec = copy_spec("counter", tmp_path)
+    (spec.parent / "plant.py").write_text(PLANT)
+    try:
+        with pytest.raises(earl.EarlError) as refused:
+            earl.simulate(earl.load(spec), environment=factory)
+    finally:
+        sys.modules.pop("plant", None)
+    [diagnostic] = refused.value.diagnostics
+    assert (diagnostic.code, diagnostic.message, diagnostic.hint) == ("EARL-X005", message, hint)
+
+
+def test_a_class_named_as_a_partial_transition_function_is_refused_with_a_hint_about_functions(
+    tmp_path: Path,
+) -> None:
+    spec = copy_spec("counter", tmp_path)
+    code = spec.parent / "counting" / "cs.py"
+    code.write_text(code.read_text() + "\n\nclass Counter:\n    def __init__(self, a, b, c):\n        pass\n")
+    text = spec.read_text()
+    spec.write_text(re.sub(r'python "counting\.cs:increment"', 'python "counting.cs:Counter"', text))
+    with pytest.raises(earl.EarlError) as refused:
+        earl.simulate(earl.load(spec))
+    [diagnostic] = refused.value.diagnostics
+    assert diagnostic.code == "EARL-X005" and "which is a class, not a function" in diagnostic.message
+    assert diagnostic.hint == (
+        "write it as `def Counter(inputs, outputs, context) -> None`: the runtime calls it and uses what it wrote "
+        "through `outputs` at once"
+    )
+
+
 def test_a_run_time_beyond_any_float_is_refused_as_out_of_range_not_overflowed() -> None:
     """`10**400` is an int Python cannot make a float: compared, not converted, it is refused like infinity,
     and the message quotes it short."""

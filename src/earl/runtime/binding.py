@@ -29,6 +29,9 @@ UserFunction = Callable[[Any, Any, Any], object]
 SIGNATURE = "def NAME(inputs, outputs, context) -> None"
 #: how a primitive predicate computed by Python is written
 PREDICATE_SIGNATURE = "def NAME(inputs, context) -> bool"
+#: how the runtime uses a partial transition function, and a predicate, as hints say it
+FUNCTION_USE = "the runtime calls it and uses what it wrote through `outputs` at once"
+PREDICATE_USE = "the runtime calls it and uses the Boolean it returns at once"
 
 
 class BindingProblem(Exception):
@@ -118,11 +121,15 @@ def resolve_callable(
     arity: int = 3,
     signature: str = SIGNATURE,
     placeholder: str = "FUNCTION",
+    use: str = FUNCTION_USE,
+    classes: bool = False,
 ) -> Callable[..., Any]:
     """Import `module:function` and check that it can be called with `arity` arguments.
 
     `signature` shows how such a function is written, in hints (`def NAME(inputs, outputs, context)`);
-    `placeholder` stands for its name in a hint that cannot know it (`pendulum.env:FACTORY`).
+    `placeholder` stands for its name in a hint that cannot know it (`pendulum.env:FACTORY`), and `use`
+    says what is done with it, for a hint about something that cannot be used so. With `classes`, a
+    class is taken too: what calling it makes is what is wanted (an environment object), not writes.
     """
     module_name, function_name = _split(path)
     if not module_name or not function_name:
@@ -151,16 +158,18 @@ def resolve_callable(
                 hint=suggestion or f"define `{signature.replace('NAME', function_name)}` in `{module.__file__}`",
             )
         )
-    kind = _not_a_plain_function(function)
+    kind = None if classes and inspect.isclass(function) else _not_a_plain_function(function)
     if kind is not None:
+        written = f"write it as `{signature.replace('NAME', function_name)}`"
+        if classes:
+            written += " (or as a class whose `__init__` takes them)"
         raise BindingProblem(
             Diagnostic(
                 Severity.ERROR,
                 f"{what} names `{module_name}:{function_name}`, which is {kind}, not a function",
                 location,
                 code="EARL-X004" if not callable(function) else "EARL-X005",
-                hint=f"write it as `{signature.replace('NAME', function_name)}`: the runtime calls it and uses what "
-                "it wrote (and a predicate, what it returned) at once",
+                hint=f"{written}: {use}",
             )
         )
     _check_arity(function, arity, f"{module_name}:{function_name}", what, location, signature)
@@ -327,14 +336,20 @@ def _check_arity(
     try:
         actual.bind(*range(arity))
     except TypeError:
+        short = name.rpartition(":")[2]
+        if inspect.isclass(function):  # a class is called through its `__init__`, which takes `self` first
+            parameters = signature[signature.index("(") + 1 : signature.index(")")]
+            hint = f"give `{short}` an `__init__(self, {parameters})` (see docs/runtime.md)"
+        else:
+            hint = f"write it as `{signature.replace('NAME', short)}` (see docs/runtime.md)"
         raise BindingProblem(
             Diagnostic(
                 Severity.ERROR,
                 f"{what} calls `{name}` with {arity} argument{'s' if arity != 1 else ''}, but it is defined as "
-                f"`{name.rpartition(':')[2]}{actual}`",
+                f"`{short}{actual}`",
                 location,
                 code="EARL-X005",
-                hint=f"write it as `{signature.replace('NAME', name.rpartition(':')[2])}` (see docs/runtime.md)",
+                hint=hint,
             )
         ) from None
 

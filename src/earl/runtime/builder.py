@@ -20,6 +20,7 @@ from earl.model.text import subsystem_name
 from earl.model.types import DataType
 from earl.runtime.binding import (
     PREDICATE_SIGNATURE,
+    PREDICATE_USE,
     BindingProblem,
     UserFunction,
     bind_function,
@@ -480,6 +481,7 @@ def _python_predicate(engine: SubsystemEngine, predicate: PrimitivePredicate) ->
         predicate.location,
         arity=2,
         signature=PREDICATE_SIGNATURE,
+        use=PREDICATE_USE,
     )
     inputs = build_inputs(f"{predicate.name}/pp", predicate.reads, engine.inputs, engine.memory)
     refresh = inputs._earl_refresh

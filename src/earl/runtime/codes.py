@@ -13,7 +13,8 @@ RUNNING_CODES: dict[str, str] = {
     "EARL-X002": "the module cannot be found (modules are looked up next to the spec first)",
     "EARL-X003": "importing the module raised an error, called `sys.exit()`, or imports a module that cannot be found",
     "EARL-X004": "the module has no such function, or it is not callable",
-    "EARL-X005": "the function cannot be called with `(inputs, outputs, context)`, or is no plain function",
+    "EARL-X005": "the function cannot be called with `(inputs, outputs, context)` (or what else it is given), "
+    "or is no plain function (a class is only an environment factory)",
     "EARL-X010": "a subsystem's data cannot be set up (e.g. an initial value that does not fit its type)",
     "EARL-X011": "a subsystem has no `fsm`",
     "EARL-X012": "a subsystem has no `period` and a state that waits for nothing",

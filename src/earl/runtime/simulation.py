@@ -469,6 +469,8 @@ def _environment(
                 arity=2,
                 signature="def NAME(system, seed) -> object",
                 placeholder="FACTORY",
+                use="earl calls it once, before the run, and the object it returns is the environment",
+                classes=True,  # `environment = "plant:Plant"`: the class makes the object, as a factory would
             )
         except BindingProblem as problem:
             raise EarlError([problem.diagnostic], sources) from None
@@ -540,6 +542,7 @@ def bind_report(report: str, spec: Path, settings: RunSettings) -> Callable[[Sim
                 settings.location("report"),
                 arity=1,
                 signature="def NAME(simulation) -> str",
+                use="earl calls it once the run ends and prints the text it returns",
             )
         except BindingProblem as problem:
             raise EarlError([problem.diagnostic], settings.sources()) from None
