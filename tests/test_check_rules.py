@@ -1505,6 +1505,40 @@ def test_a_constant_index_outside_a_fixed_array_is_refused() -> None:
     assert negative.message == "`v/mi[1 - 2]` reads element -1 of a `double[3]`, whose elements are 0 to 2"
 
 
+@pytest.mark.parametrize(
+    ("index", "wrong", "hint"),
+    [
+        ("d/mi", "`d/mi` is a `double`", "an `int` parameter or quantifier index"),
+        ("b/mi", "`b/mi` is a `boolean`", "an `int` parameter or quantifier index"),
+        ("true", "`true` is a Boolean", "an `int` parameter or quantifier index"),
+        ('"x"', '`"x"` is a string', "an `int` parameter or quantifier index"),
+        ("1.5", "`1.5` is a real number", "an `int` parameter or quantifier index"),
+        ("1.0", "`1.0` is a real number", "write `1`: elements are counted in whole numbers"),
+        ("i/mi + d/mi", "`d/mi` is a `double`", "an `int` parameter or quantifier index"),
+    ],
+)
+def test_an_index_that_is_not_a_whole_number_is_refused(index: str, wrong: str, hint: str) -> None:
+    """`v/mi[true]` read element 1 at run time, `v/mi[1.5]` failed every time: both passed the check."""
+    memories = (
+        "        v/m: double[3] = [0.0, 0.0, 0.0]\n        d/m: double = 0.0\n"
+        "        b/m: boolean = false\n        i/m: int32 = 0\n"
+    )
+    text = edit(
+        ("        x/m: double = 0.0\n", "        x/m: double = 0.0\n" + memories),
+        ("        go/pp = x/mi > 1.0\n", f"        go/pp = x/mi > 1.0 or v/mi[{index}] > 1.0\n"),
+    )
+    [finding] = findings(text, "EARL-E030")
+    assert finding.message == f"the index of `v/mi[{index}]` must be a whole number, but {wrong}"
+    assert finding.location is not None
+    assert (finding.location.line, finding.location.column) == position_of(text, "go/pp =", f"[{index}]")
+    assert finding.hint is not None and hint in finding.hint
+    # whole numbers: a literal, an integer memory, arithmetic of them, a quantifier's index
+    for whole in ("1", "i/mi", "i/mi + 1", "0 - i/mi", "2 * i/mi"):
+        assert findings(text.replace(f"v/mi[{index}]", f"v/mi[{whole}]"), "EARL-E030") == [], whole
+    quantified = text.replace(f"v/mi[{index}] > 1.0", "any(K in 0..2: v/mi[K] > 1.0)")
+    assert findings(quantified, "EARL-E030") == []
+
+
 def test_a_constant_index_a_quantifier_puts_in_is_checked_for_every_value() -> None:
     """`all(J in 1..N: v/mi[J] > 0.0)` of a `double[N]`: J = N is one past the last element (they count
     from 0). The check looked only at the first body of the unrolled quantifier (J = 1)."""

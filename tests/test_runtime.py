@@ -664,6 +664,27 @@ def test_a_negative_element_index_is_a_fault_not_an_element_from_the_end(tmp_pat
         sim.close()
 
 
+@pytest.mark.parametrize("index", ["true", "1.5", "0.5 + 0.5"])
+def test_an_index_that_is_not_a_whole_number_is_a_fault_not_an_element(tmp_path: Path, index: str) -> None:
+    """`v/mi[true]` read element 1 (Python takes True for 1), silently; `earl check` refuses it (EARL-E030),
+    a run that skips the check reports it."""
+    spec = copy_spec(
+        "counter",
+        tmp_path,
+        {
+            "        count/m: int = 0\n": "        count/m: int = 0\n        v/m: double[3] = [0.0, 9.0, 0.0]\n",
+            "done/pp = count/mi >= LIMIT": f"done/pp = count/mi >= LIMIT or v/mi[{index}] > 1.0",
+        },
+    )
+    sim = earl.simulate(earl.load(spec), check=False)
+    try:
+        sim.advance_to(0.005)
+        assert sim.state_of("counter/a.cs").state == "counting"  # `v/mi[1]` (9.0) was not read
+        assert "an index must be a whole number, not" in sim.faults[0].message
+    finally:
+        sim.close()
+
+
 def test_advance_by_takes_a_duration_and_should_stop_a_function() -> None:
     sim = earl.simulate(earl.load(SPECS / "counter"), seed=1)
     try:

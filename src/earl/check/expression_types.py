@@ -15,6 +15,7 @@ from earl.model.expressions import (
     ConstantError,
     Expression,
     FieldAccess,
+    IndexAccess,
     ListLiteral,
     Literal,
     Name,
@@ -56,6 +57,7 @@ _NUMERIC = {
 class TypeProblem:
     message: str
     location: SourceLocation | None
+    hint: str | None = None
 
 
 class ExpressionTyper:
@@ -67,6 +69,8 @@ class ExpressionTyper:
         self.problems: list[TypeProblem] = []
         # an index said out of range once: the unrolled bodies of a quantifier repeat each index's place
         self._indices_said: set[SourceLocation | None] = set()
+        # an index of the wrong type said once, likewise
+        self._index_types_said: set[SourceLocation | None] = set()
         # above 0 while typing operands that are never evaluated: `J == 2 or v/ib[J + 1]` with J = 2 reads no
         # element 3, since `or` stops at its constant true operand (their types are still checked)
         self._unreachable = 0
@@ -84,6 +88,9 @@ class ExpressionTyper:
         if isinstance(expression, Read):
             return self._read(expression)
         if isinstance(expression, Call):
+            for argument in expression.arguments:  # `newData(x/ib.samples[i])`: its indices are indices too
+                if isinstance(argument, Read):
+                    self._check_index_types(argument)
             return BOOLEAN
         if isinstance(expression, Quantifier):
             self._expect(expression.body, BOOLEAN, f"the body of `{expression.quantifier}(…)`")
@@ -238,6 +245,7 @@ class ExpressionTyper:
     def _read(self, read: Read) -> str:
         if read.target.kind is Kind.PRIMITIVE_PREDICATE:
             return BOOLEAN
+        self._check_index_types(read)
         current = self._structure(read, check_indices=not self._unreachable)
         if current is None:
             return UNKNOWN
@@ -249,6 +257,58 @@ class ExpressionTyper:
             if current.name == "string":
                 return STRING
         return OTHER
+
+    def _check_index_types(self, read: Read) -> None:
+        """Every index of `read` is a whole number: `v/ib[1.5]`, `v/ib[true]` or `v/ib[d/ib]` of a `double`
+        names no element (a Boolean would even read element 1 in Python, silently)."""
+        for accessor in read.path:
+            if not isinstance(accessor, IndexAccess):
+                continue
+            location = accessor.location or accessor.index.location or read.location
+            if location in self._index_types_said:
+                continue  # the unrolled bodies of a quantifier repeat each index's place
+            wrong = self._not_whole(accessor.index)
+            if wrong is None:
+                continue
+            self._index_types_said.add(location)
+            value = constant_value(accessor.index)
+            self.problems.append(
+                TypeProblem(
+                    f"the index of `{expression_text(read)}` must be a whole number, but {wrong}",
+                    location,
+                    f"write `{int(value)}`: elements are counted in whole numbers"
+                    if isinstance(value, float) and value.is_integer()
+                    else "index with a whole number (`v/ib[2]`), an `int` parameter or quantifier index, "
+                    "or a buffer or memory of an integer type (`int32`, `uint8`, …)",
+                )
+            )
+
+    def _not_whole(self, index: Expression) -> str | None:
+        """Why `index` is not a whole number (`` `1.5` is a real number ``), or None when it is one or its
+        type is not known here. EARL's arithmetic is `+ - *`: whole numbers give whole numbers."""
+        shown = f"`{expression_text(index)}`"
+        value = constant_value(index)
+        if value is not None:
+            if isinstance(value, bool):
+                return f"{shown} is a Boolean"
+            if isinstance(value, str):
+                return f"{shown} is a string"
+            return None if isinstance(value, int) else f"{shown} is a real number"
+        if isinstance(index, Negate):
+            return self._not_whole(index.operand)
+        if isinstance(index, Arithmetic):
+            return self._not_whole(index.left) or self._not_whole(index.right)
+        category = self.type_of(index)
+        structure = self._structure(index) if isinstance(index, Read) else None
+        if isinstance(structure, PrimitiveType) and structure.name not in INTEGER_RANGES:
+            return f"{shown} is a `{structure.name}`"
+        if category == BOOLEAN:
+            return f"{shown} is a Boolean"
+        if category == STRING:
+            return f"{shown} is a string"
+        if category == OTHER:
+            return f"{shown} is {self._what(index, category)}"
+        return None
 
     def _check_index(self, read: Read, accessor: object, array: ArrayType, within: str = "") -> None:
         """A constant index outside a fixed-size array: `ranges/ib[8]` of a `double[8]` (elements 0 to 7)

@@ -56,7 +56,9 @@ def _once(findings: Iterable[Finding]) -> Iterator[Finding]:
 @rule("EARL-E030", Severity.ERROR, "predicates are Boolean", "§2.2, Table 4, Table 5")
 def predicates_are_boolean(context: CheckContext) -> Iterator[Finding]:
     """Primitive predicates, terminal, error and initial conditions, and assumptions produce a Boolean
-    (`fun` returns true or false), and their operators are applied to operands of the right type."""
+    (`fun` returns true or false), and their operators are applied to operands of the right type. An
+    array's index is a whole number within the array (`v/ib[1.5]`, `v/ib[true]` or `v/ib[d/ib]` of a
+    `double` name no element)."""
 
     def findings() -> Iterator[Finding]:
         for _agent, subsystem in context.distinct_subsystems():
@@ -70,7 +72,7 @@ def predicates_are_boolean(context: CheckContext) -> Iterator[Finding]:
                         "compare it, e.g. `x > 0.5`, or test it with `newData(…)`",
                     )
             for problem in typer.problems:
-                yield Finding(problem.message, problem.location)
+                yield Finding(problem.message, problem.location, problem.hint)
 
     yield from _once(findings())
 

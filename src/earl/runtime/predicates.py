@@ -140,7 +140,11 @@ def kept_for_the_decision(predicate: CompiledPredicate, name: str, values: dict[
 
 
 def _element(index: int) -> int:
-    """An array index of a condition computed at run time: elements count from 0, and none is negative."""
+    """An array index of a condition computed at run time: elements count from 0, and none is negative.
+    A Boolean or a real number is no index (`earl check` refuses them, EARL-E030; a model built in Python
+    may skip the check): Python would read `True` as element 1."""
+    if isinstance(index, bool) or not isinstance(index, int):
+        raise TypeError(f"an index must be a whole number, not {index!r}")
     if index < 0:
         raise IndexError(f"element {index} does not exist (elements count from 0)")
     return index
@@ -221,7 +225,7 @@ def _path(read: Read) -> str:
             parts.append(f"[{accessor.name!r}]")
         elif isinstance(accessor, IndexAccess):
             index = accessor.index
-            if isinstance(index, Literal) and isinstance(index.value, int) and index.value >= 0:
+            if isinstance(index, Literal) and type(index.value) is int and index.value >= 0:  # not a bool
                 parts.append(f"[{_source(index)}]")
             else:  # Python would read a negative index from the end: an element the spec has not
                 parts.append(f"[_element({_source(index)})]")
