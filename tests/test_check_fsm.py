@@ -350,6 +350,77 @@ def test_an_assumption_that_contradicts_itself_is_named_alone() -> None:
     assert contradiction.hint is not None and contradiction.hint.endswith("correct it")
 
 
+IN_ONE_STATE = """\
+system a3
+
+r/r { a/a }
+
+a/a {
+    cs {
+        period 10 ms
+        y/ib: double
+        g/m: double = 0.0
+        f/pf(y/ib -> g/mo)
+        run/bb {
+            tf = {f/pf}
+            tc = true
+        }
+        fsm {
+            initial s1
+            state s1: run/bb { obligatory y/ib timeout 1 ms }
+            state s2: run/bb
+            s1 -> s2 when true
+            s2 -> s1 when y/ib > 0.0
+            s2 -> s2 when y/ib > 1.0
+            assume timeout(y/ib)
+        }
+    }
+}
+"""
+
+
+def test_an_assumption_that_cannot_hold_in_one_state_is_said_there_and_hides_nothing() -> None:
+    """`assume timeout(y/ib)` holds where `y/ib` is waited for, never in `s2`, which does not wait for it: the
+    check passed, said that `run/bb` (`tc = true`) never ends in `s2`, and hid the overlap of its transitions."""
+    diagnostics = check(earl.loads(IN_ONE_STATE, "a3.earl"))
+    codes = [d.code for d in diagnostics if d.code.startswith(("EARL-E06", "EARL-W06", "EARL-I06"))]
+    assert codes == ["EARL-E064", "EARL-W061", "EARL-E060"]
+    [contradiction] = [d for d in diagnostics if d.code == "EARL-E064"]
+    assert contradiction.message == (
+        "the `assume` formulas of a/a.cs cannot hold in state `s2`: `timeout(y/ib)` (line 22) holds in no "
+        "situation there, as `y/ib`, which `s2` does not wait for, never times out; `s2` is checked without it"
+    )
+    assert contradiction.location is not None
+    assert (contradiction.location.line, contradiction.location.column) == (18, 13)
+    assert (
+        contradiction.hint is not None
+        and "let `s2` wait for `y/ib` (`obligatory y/ib timeout …`)" in contradiction.hint
+    )
+    # waited for in every state, the assumption can hold everywhere: nothing said
+    waited = IN_ONE_STATE.replace("state s2: run/bb\n", "state s2: run/bb { obligatory y/ib timeout 1 ms }\n")
+    assert [d.code for d in check(earl.loads(waited, "a3.earl")) if d.code == "EARL-E064"] == []
+
+
+def test_a_behaviour_the_assumptions_keep_from_stopping_is_not_said_to_never_end() -> None:
+    """`tc = go/pp` with `assume not go/pp`: its terminal condition can hold, the assumption is the reason it
+    does not; EARL-I063 said the condition could never hold. The transitions out are what it makes dead."""
+    text = IN_ONE_STATE.replace("tc = true", "tc = go/pp").replace(
+        "        run/bb {", "        go/pp = y/ib > 5.0\n        run/bb {"
+    )
+    text = text.replace("assume timeout(y/ib)", "assume not go/pp")
+    diagnostics = check(earl.loads(text, "a3.earl"))
+    assert [d.code for d in diagnostics if d.code == "EARL-I063"] == []
+    dead = [d.message for d in diagnostics if d.code == "EARL-W062"]
+    assert dead[0] == (
+        "transition `s1,s2/t` of a/a.cs can never be taken: the `assume` formulas rule out that `run/bb` stops "
+        "in `s1` (`not go/pp` (line 23))"
+    )
+    # a terminal condition that cannot hold of itself still is the note
+    never = text.replace("tc = go/pp", "tc = go/pp and y/ib < 1.0")
+    notes = [d.message for d in check(earl.loads(never, "a3.earl")) if d.code == "EARL-I063"]
+    assert notes[0].startswith("`run/bb` never ends: its terminal and error conditions can never hold")
+
+
 FAMILY = """\
 system fam
 

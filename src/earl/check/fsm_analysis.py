@@ -27,8 +27,11 @@ of docs/semantics.md), in priority order.  With these, for every state of every 
 - a behaviour that can stop while no leaving transition holds is stuck (warning, with one assignment);
 - a transition that can never be taken — its condition never holds when the behaviour stops, or
   a transition of higher priority always holds then too — is dead (warning);
-- a behaviour whose `tc` and `ec` can never hold never ends (note: fine for a sink state);
-- `assume` formulas that can never hold together would switch every check off (error).
+- a behaviour whose `tc` and `ec` can never hold never ends (note: fine for a sink state); one that
+  the assumptions alone keep from stopping makes the transitions leaving its state dead;
+- `assume` formulas that can never hold together would switch every check off (error); those that
+  cannot hold in one state (with what receiving there makes true) are an error there, and the state
+  is checked without them.
 
 The BDDs come from `dd` (a maintained BDD package; its pure-Python backend needs no
 compiler), not from a hand-made solver.
@@ -429,17 +432,18 @@ def _contradicting(bdd: Any, formulas: list[Function], meaning: Function) -> lis
 _QUOTED_ASSUMPTION = 60
 
 
+def _quoted(assumption: Assumption) -> str:
+    """`` `v/ib > 3.0` (line 40) ``: an assumption as a message names it."""
+    text = expression_text(assumption.expression)
+    if len(text) > _QUOTED_ASSUMPTION:
+        text = text[: _QUOTED_ASSUMPTION - 1] + "…"
+    line = assumption.location.line if assumption.location is not None else None
+    return f"`{text}`" + (f" (line {line})" if line is not None else "")
+
+
 def _contradiction(owner: str, culprits: list[Assumption]) -> Finding:
     """EARL-E064 at the first of the assumptions that cannot hold together, naming each of them."""
-
-    def quoted(assumption: Assumption) -> str:
-        text = expression_text(assumption.expression)
-        if len(text) > _QUOTED_ASSUMPTION:
-            text = text[: _QUOTED_ASSUMPTION - 1] + "…"
-        line = assumption.location.line if assumption.location is not None else None
-        return f"`{text}`" + (f" (line {line})" if line is not None else "")
-
-    said = [quoted(assumption) for assumption in culprits]
+    said = [_quoted(assumption) for assumption in culprits]
     if len(said) == 1:
         why = f"{said[0]} holds in no situation"
         hint = "an assumption states what always holds of the inputs; correct it"
@@ -452,6 +456,65 @@ def _contradiction(owner: str, culprits: list[Assumption]) -> Finding:
         culprits[0].location,
         hint,
     )
+
+
+def _contradiction_in_state(
+    owner: str, state: State, culprits: list[Assumption], reasons: list[_BufferFact]
+) -> Finding:
+    """EARL-E064 at `state`, whose buffer facts (`reasons`) leave the assumptions `culprits` no situation,
+    although they can hold in other states: the state is checked without them."""
+    said = [_quoted(assumption) for assumption in culprits]
+    if len(said) == 1:
+        why = f"{said[0]} holds in no situation there"
+        without = "it"
+    else:
+        why = ", ".join(said[:-1]) + " and " + said[-1] + " cannot hold at once there"
+        without = "them"
+    because = f", as {' and '.join(reason.said for reason in reasons)}" if reasons else ""
+    hint = "an assumption states what holds of the inputs in every state of the FSM; correct it"
+    unwaited = [reason.not_waited_for for reason in reasons if reason.not_waited_for is not None]
+    if unwaited:
+        hint += f", or let `{state.name}` wait for `{unwaited[0]}` (`obligatory {unwaited[0]} timeout …`)"
+    return Finding(
+        f"the `assume` formulas of {owner} cannot hold in state `{state.name}`: {why}{because}; "
+        f"`{state.name}` is checked without {without}",
+        state.location,
+        hint,
+    )
+
+
+def _state_assumptions(
+    bdd: Any,
+    each_assumed: list[Function],
+    meaning: Function,
+    explained_facts: list[_BufferFact],
+) -> tuple[Function, list[int], list[_BufferFact]]:
+    """The assumptions a state is checked under: all of them, unless the state's buffer facts contradict
+    some (`assume timeout(x/ib)` in a state that does not wait for `x/ib`). Those are left out, a minimal
+    contradicting set at a time. Returned: the kept assumptions conjoined with `meaning`, their indices,
+    and the facts that contradict the others."""
+    facts = bdd.true
+    for fact in explained_facts:
+        facts &= fact.formula
+    kept = list(range(len(each_assumed)))
+    reasons: list[_BufferFact] = []
+    while True:
+        assumed = meaning
+        for index in kept:
+            assumed &= each_assumed[index]
+        if (assumed & facts) == bdd.false:
+            # the facts first, so that each is left out of the contradiction where it can be: what stays
+            # is the assumptions that cannot hold and the facts they cannot hold with
+            formulas = [fact.formula for fact in explained_facts] + [each_assumed[index] for index in kept]
+            culprits = _contradicting(bdd, formulas, meaning)
+            blamed = [
+                kept[position - len(explained_facts)] for position in culprits if position >= len(explained_facts)
+            ]
+            if blamed:  # (receiving alone never contradicts itself: no endless loop, whatever happens)
+                reasons += [explained_facts[position] for position in culprits if position < len(explained_facts)]
+                kept = [index for index in kept if index not in blamed]
+                continue
+        return assumed, kept, list(dict.fromkeys(reasons))
 
 
 def _when(example: str) -> str:
@@ -511,7 +574,19 @@ def analyse(context: CheckContext, subsystem: Subsystem, fsm: FSM, owner: str) -
         behaviour = subsystem.basic_behaviour(state.behaviour)
         if behaviour is None:
             continue
-        stop = stops[state.name] & assumed & _buffer_facts(encoder, state, fed_by_other_agents)
+        explained_facts = _explained_buffer_facts(encoder, state, fed_by_other_agents)
+        facts = bdd.true
+        for fact in explained_facts:
+            facts &= fact.formula
+        # the assumptions hold in the FSM, but perhaps not in this state (`assume timeout(x/ib)` where
+        # `x/ib` is not waited for): said, and the state checked without those, not left unexamined
+        in_state = assumed
+        kept = list(range(len(each_assumed)))
+        if fsm.assumptions and (assumed & facts) == bdd.false:
+            in_state, kept, reasons = _state_assumptions(bdd, each_assumed, meaning, explained_facts)
+            blamed = [fsm.assumptions[index] for index in range(len(each_assumed)) if index not in kept]
+            findings["EARL-E064"].append(_contradiction_in_state(owner, state, blamed, reasons))
+        stop = stops[state.name] & in_state & facts
         # what also holds when no sender is stale: in one process, or while every peer is alive
         alive = _buffer_facts(encoder, state, frozenset()) if fed_by_other_agents else bdd.true
 
@@ -525,7 +600,7 @@ def analyse(context: CheckContext, subsystem: Subsystem, fsm: FSM, owner: str) -
             return said
 
         leaving = [t for t in fsm.transitions if t.source == state.name]
-        if stop == bdd.false:
+        if stop == bdd.false and (stops[state.name] & meaning & facts) == bdd.false:
             findings["EARL-I063"].append(
                 Finding(
                     f"`{behaviour.name}/bb` never ends: its terminal and error conditions can never hold, so state `{state.name}` of {owner} is never left",
@@ -533,6 +608,23 @@ def analyse(context: CheckContext, subsystem: Subsystem, fsm: FSM, owner: str) -
                     "fine for a deliberate sink state such as an emergency stop",
                 )
             )
+            continue
+        if stop == bdd.false:
+            # the behaviour could stop, but the assumptions say it never does here: not the note above,
+            # whose reason would be untrue; what it makes dead is every transition leaving the state
+            ruling_out = [
+                fsm.assumptions[kept[position]]
+                for position in _contradicting(
+                    bdd, [each_assumed[index] for index in kept], stops[state.name] & meaning & facts
+                )
+            ]
+            for transition in leaving:
+                dead[id(transition)] = Finding(
+                    f"transition {named(transition)} of {owner} can never be taken: the `assume` formulas rule out "
+                    f"that `{behaviour.name}/bb` stops in `{state.name}` ({', '.join(map(_quoted, ruling_out))})",
+                    transition.location,
+                    "check the `assume` formulas and the behaviour's terminal condition",
+                )
             continue
         if not leaving:
             findings["EARL-W021"].append(
@@ -562,7 +654,7 @@ def analyse(context: CheckContext, subsystem: Subsystem, fsm: FSM, owner: str) -
             if holds == bdd.false:
                 never = (
                     "its condition never holds"
-                    if (conditions[id(transition)] & assumed) == bdd.false
+                    if (conditions[id(transition)] & in_state) == bdd.false
                     else f"its condition never holds when `{behaviour.name}/bb` stops"
                 )
                 dead[id(transition)] = Finding(
@@ -689,11 +781,31 @@ def _buffer_key(read: Read) -> tuple[str, int | None] | None:
 
 
 def _buffer_facts(encoder: _Encoder, state: State, fed_by_other_agents: frozenset[tuple[str, int | None]]) -> Function:
-    """What receiving in `state` makes true (docs/semantics.md, step 4): a buffer the state waits for
-    took a message or timed out (and, with no timeout, took one); a buffer it does not wait for never
-    times out. A buffer an inter-agent link feeds is exempt from the last two: its sender may go
-    stale, and a stale buffer reads as timed out in every state (docs/distributed.md)."""
+    """What receiving in `state` makes true (docs/semantics.md, step 4), one formula: see `_explained_buffer_facts`."""
     facts = encoder.bdd.true
+    for fact in _explained_buffer_facts(encoder, state, fed_by_other_agents):
+        facts &= fact.formula
+    return facts
+
+
+@dataclass(frozen=True)
+class _BufferFact:
+    """One thing receiving in a state makes true, as a formula and as a message says it."""
+
+    said: str
+    formula: Function
+    #: the buffer (`x/ib`) the fact is about when it holds because the state does not wait for it
+    not_waited_for: str | None = None
+
+
+def _explained_buffer_facts(
+    encoder: _Encoder, state: State, fed_by_other_agents: frozenset[tuple[str, int | None]]
+) -> list[_BufferFact]:
+    """What receiving in `state` makes true (docs/semantics.md, step 4), each fact with what a message says
+    of it: a buffer the state waits for took a message or timed out (and, with no timeout, took one); a
+    buffer it does not wait for never times out. A buffer an inter-agent link feeds is exempt from the last
+    two: its sender may go stale, and a stale buffer reads as timed out in every state (docs/distributed.md)."""
+    facts: list[_BufferFact] = []
     for (function, text), variable in list(encoder.calls.items()):
         read = encoder.call_arguments[text]
         if read.path:
@@ -704,11 +816,15 @@ def _buffer_facts(encoder: _Encoder, state: State, fed_by_other_agents: frozense
         if function == "timeout":
             arrived = encoder.calls.get(("newData", text))
             if waited_for and arrived is not None:
-                facts &= arrived | variable
+                said = f"`{text}`, which `{state.name}` waits for, took a message or timed out"
+                facts.append(_BufferFact(said, arrived | variable))
             elif not waited_for and not may_go_stale:
-                facts &= ~variable
+                said = f"`{text}`, which `{state.name}` does not wait for, never times out"
+                facts.append(_BufferFact(said, ~variable, text))
         elif function == "newData" and waited_for and state.timeout is None and not may_go_stale:
-            facts &= variable  # waited for with no timeout: the iteration ends only once it has come
+            # waited for with no timeout: the iteration ends only once it has come
+            said = f"`{text}`, which `{state.name}` waits for with no `timeout`, always took a message"
+            facts.append(_BufferFact(said, variable))
     return facts
 
 
@@ -807,7 +923,9 @@ _register(
     "only situations in which every assumption holds. Assumptions that contradict each other leave no "
     "situation at all: every overlap and every missing transition would pass unseen. The error points at "
     "the assumptions that cannot hold at once, none of which can be left out of the contradiction (the "
-    "others, innocent, are not named).",
+    "others, innocent, are not named). An assumption holds in every state: one that cannot hold with what "
+    "receiving in a state makes true (`assume timeout(x/ib)` in a state that does not wait for `x/ib`, "
+    "where it never times out) is an error at that state, which is then checked without it.",
 )
 _register(
     "EARL-W061",
@@ -832,7 +950,9 @@ _register(
     "behaviours that never end",
     "§2.2, Table 5",
     "A behaviour whose terminal and error conditions can never hold runs forever, like the manual's "
-    "`emergencyStop/bb` with `false/pp`: fine for a deliberate sink state, a mistake elsewhere.",
+    "`emergencyStop/bb` with `false/pp`: fine for a deliberate sink state, a mistake elsewhere. When they "
+    "can hold but the `assume` formulas rule it out, the transitions leaving the state are dead instead "
+    "(EARL-W062).",
 )
 _register(
     "EARL-W020",
