@@ -1493,6 +1493,26 @@ def test_the_hint_for_outputs_in_an_early_stage_says_what_fits_the_function() ->
     assert said[0].hint == "`outputMotorCon/pf` reads only memory: move it into the last stage (stage 2)"
 
 
+def test_a_predicate_only_unused_predicates_use_is_unused_too() -> None:
+    """`p2/pp = p1/pp and …` with `p2/pp` unused: `p1/pp` is dead too, and W030 said only `p2/pp`."""
+    text = edit(
+        (
+            "        go/pp = x/mi > 1.0\n",
+            "        go/pp = x/mi > 1.0\n        p1/pp = x/mi > 2.0\n        p2/pp = p1/pp and x/mi < 5.0\n"
+            "        p3/pp = p1/pp or p2/pp\n",
+        )
+    )
+    said = findings(text, "EARL-W030")
+    assert [(d.message, d.location.line if d.location else None) for d in said] == [
+        ("primitive predicate `p1/pp` is used only by `p2/pp` and `p3/pp`, which are never used in a condition", 8),
+        ("primitive predicate `p2/pp` is used only by `p3/pp`, which is never used in a condition", 9),
+        ("primitive predicate `p3/pp` is never used", 10),
+    ]
+    assert said[0].hint == "use one of them in a terminal, error or initial condition, or remove them together"
+    # one of them used by a condition: every predicate it is defined through is used
+    assert findings(text.replace("tc = go/pp", "tc = p3/pp"), "EARL-W030") == []
+
+
 def test_a_constant_index_outside_a_fixed_array_is_refused() -> None:
     text = edit(
         ("        x/m: double = 0.0\n", "        x/m: double = 0.0\n        v/m: double[3] = [0.0, 0.0, 0.0]\n"),

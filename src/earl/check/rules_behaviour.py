@@ -17,9 +17,12 @@ from earl.model.location import SourceLocation
 from earl.model.text import expression_text, instance_name, reference_text, subsystem_name
 
 
-def _conditions(subsystem: Subsystem) -> Iterator[tuple[str, Expression, SourceLocation | None]]:
-    """Every Boolean formula of a subsystem, with what it is called in messages."""
-    for predicate in subsystem.primitive_predicates:
+def _conditions(
+    subsystem: Subsystem, with_predicates: bool = True
+) -> Iterator[tuple[str, Expression, SourceLocation | None]]:
+    """Every Boolean formula of a subsystem, with what it is called in messages; without `with_predicates`,
+    only those the FSM evaluates itself (terminal, error and initial conditions, assumptions)."""
+    for predicate in subsystem.primitive_predicates if with_predicates else ():
         yield f"primitive predicate `{predicate.name}/pp`", predicate.expression, predicate.location
     for behaviour in subsystem.basic_behaviours:
         yield (
@@ -79,19 +82,49 @@ def predicates_are_boolean(context: CheckContext) -> Iterator[Finding]:
 
 @rule("EARL-W030", Severity.WARNING, "every primitive predicate is used", "§2.2, Table 4")
 def unused_primitive_predicates(context: CheckContext) -> Iterator[Finding]:
-    """A primitive predicate no condition uses is dead specification: remove it, or use it."""
+    """A primitive predicate no condition uses is dead specification: remove it, or use it. So is one that
+    only such predicates use (`p1/pp` in `p2/pp = p1/pp and …`, with `p2/pp` unused): the message says
+    which."""
     for agent in context.declared.agents:
         for subsystem in agent.subsystems:
-            used: set[str] = set()
-            for _role, expression, _location in _conditions(subsystem):
-                used.update(r.target.name for r in reads(expression) if r.target.kind is Kind.PRIMITIVE_PREDICATE)
+            named_in_definition: dict[str, set[str]] = {}  # predicate → the predicates its definition names
+            live: set[str] = set()  # the predicates a terminal, error or initial condition or an assumption reaches
+            for _role, expression, _location in _conditions(subsystem, with_predicates=False):
+                live.update(r.target.name for r in reads(expression) if r.target.kind is Kind.PRIMITIVE_PREDICATE)
             for predicate in subsystem.primitive_predicates:
-                if predicate.name not in used:
+                named_in_definition[predicate.name] = {
+                    r.target.name for r in reads(predicate.expression) if r.target.kind is Kind.PRIMITIVE_PREDICATE
+                }
+            frontier = list(live)
+            while frontier:  # through definitions: what a live predicate names is live too
+                for name in named_in_definition.get(frontier.pop(), ()):
+                    if name not in live:
+                        live.add(name)
+                        frontier.append(name)
+            for predicate in subsystem.primitive_predicates:
+                if predicate.name in live:
+                    continue
+                users = [
+                    user.name
+                    for user in subsystem.primitive_predicates
+                    if user.name != predicate.name and predicate.name in named_in_definition.get(user.name, set())
+                ]
+                if not users:
                     yield Finding(
                         f"primitive predicate `{predicate.name}/pp` is never used",
                         predicate.location,
                         "use it in a terminal, error or initial condition, or remove it",
                     )
+                    continue
+                listed = ", ".join(f"`{user}/pp`" for user in users[:-1])
+                listed = f"{listed} and `{users[-1]}/pp`" if listed else f"`{users[-1]}/pp`"
+                which = "which is" if len(users) == 1 else "which are"
+                yield Finding(
+                    f"primitive predicate `{predicate.name}/pp` is used only by {listed}, {which} never used "
+                    "in a condition",
+                    predicate.location,
+                    "use one of them in a terminal, error or initial condition, or remove them together",
+                )
 
 
 def _writes(
