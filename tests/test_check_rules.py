@@ -571,6 +571,15 @@ CASES: list[Case] = [
         edit(("        x/m: double = 0.0\n", "        x/m: double = 0.0\n        k/m: int = -1\n")),
     ),
     Case(
+        "EARL-E043",
+        edit(("        x/m: double = 0.0\n", "        x/m: double = 0.0\n        k/m: int = 1.0\n")),
+        7,
+        20,
+        # a parameter refuses it (`param K: int = 1.0`, EARL-R005): the memory took it as 1, silently
+        "the initial value of `k/m` must be a whole number (int), not the real number 1.0",
+        edit(("        x/m: double = 0.0\n", "        x/m: double = 1\n        k/m: int = 1\n")),
+    ),
+    Case(
         "EARL-E045",
         edit(("        go/pp = x/mi > 1.0\n", "        go/pp = x/mi > 1.0 and not late/pp\n        late/pp = go/pp\n")),
         7,
@@ -1511,6 +1520,14 @@ def test_a_predicate_only_unused_predicates_use_is_unused_too() -> None:
     assert said[0].hint == "use one of them in a terminal, error or initial condition, or remove them together"
     # one of them used by a condition: every predicate it is defined through is used
     assert findings(text.replace("tc = go/pp", "tc = p3/pp"), "EARL-W030") == []
+
+
+def test_a_real_number_for_an_integer_memory_is_refused_with_the_whole_number_to_write() -> None:
+    text = edit(("        x/m: double = 0.0\n", "        x/m: double = 0.0\n        k/m: int32[2] = [1, 2.0]\n"))
+    [finding] = findings(text, "EARL-E043")
+    assert finding.message == "the initial value of `k/m`[1] must be a whole number (int32), not the real number 2.0"
+    [whole] = findings(edit(("x/m: double = 0.0", "x/m: double = 0.0\n        k/m: uint8 = 3.0")), "EARL-E043")
+    assert whole.hint == "write `3`: an integer type holds whole numbers, written without a decimal point"
 
 
 def test_a_constant_index_outside_a_fixed_array_is_refused() -> None:

@@ -616,10 +616,12 @@ def test_advance_to_a_time_reached_does_nothing_and_a_negative_one_is_refused() 
         sim.close()
 
 
-def test_a_memory_whose_initial_value_does_not_fit_is_said_at_its_line(tmp_path: Path) -> None:
-    """`earl check` refuses it (EARL-E043); unchecked, the run names the memory's line, not the subsystem's."""
-    spec = copy_spec("counter", tmp_path, {"count/m: int = 0": "count/m: int = true"})
-    line = 1 + spec.read_text()[: spec.read_text().index("count/m: int = true")].count("\n")
+@pytest.mark.parametrize("value", ["true", "1.0"])
+def test_a_memory_whose_initial_value_does_not_fit_is_said_at_its_line(tmp_path: Path, value: str) -> None:
+    """`earl check` refuses it (EARL-E043); unchecked, the run names the memory's line, not the subsystem's.
+    A real number for an `int` is refused as for a parameter: `1.0` became 1, silently."""
+    spec = copy_spec("counter", tmp_path, {"count/m: int = 0": f"count/m: int = {value}"})
+    line = 1 + spec.read_text()[: spec.read_text().index(f"count/m: int = {value}")].count("\n")
     with pytest.raises(earl.EarlError) as refused:
         earl.simulate(earl.load(spec), check=False)
     [diagnostic] = refused.value.diagnostics

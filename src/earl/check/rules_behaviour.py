@@ -5,6 +5,7 @@ from __future__ import annotations
 import re
 from collections.abc import Iterable, Iterator
 
+from earl.check.constants import constant_value
 from earl.check.context import CheckContext, reference_key
 from earl.check.expression_types import BOOLEAN, ExpressionTyper
 from earl.check.registry import Finding, rule
@@ -15,6 +16,7 @@ from earl.model.graphs import cycles
 from earl.model.kinds import Kind
 from earl.model.location import SourceLocation
 from earl.model.text import expression_text, instance_name, reference_text, subsystem_name
+from earl.model.types import INTEGER_RANGES, PrimitiveType
 
 
 def _conditions(
@@ -419,8 +421,9 @@ def _early_function_reads(
 @rule("EARL-E043", Severity.ERROR, "a memory's initial value is of its data type", "§2.2, Table 3")
 def memory_initial_values(context: CheckContext) -> Iterator[Finding]:
     """Internal Memory starts with the value written after `=`; it must be a value of the memory's data
-    type (`moving/m: boolean = 3` is not), or the subsystem cannot start. The check is the runtime's own,
-    made before anything runs."""
+    type (`moving/m: boolean = 3` is not), or the subsystem cannot start. A real number is no value of an
+    integer type (`count/m: int = 1.0` is refused, as `param X: int = 1.0` is). The check is the
+    runtime's own, made before anything runs."""
     from earl.runtime.values import TypeSystem, ValueTypeError  # values only: no user code is imported
 
     types = TypeSystem(context.system)
@@ -432,10 +435,15 @@ def memory_initial_values(context: CheckContext) -> Iterator[Finding]:
             try:
                 types.constant(memory.initial_value, memory.data_type, f"the initial value of `{key}/m`")
             except ValueTypeError as wrong:
+                value = constant_value(memory.initial_value)
+                structure = context.structural(memory.data_type)
+                integer = isinstance(structure, PrimitiveType) and structure.name in INTEGER_RANGES
                 yield Finding(
                     str(wrong),
                     memory.initial_value.location or memory.location,
-                    "write a constant of the memory's type, or leave out `= …` for the type's zero value",
+                    f"write `{int(value)}`: an integer type holds whole numbers, written without a decimal point"
+                    if integer and isinstance(value, float) and value.is_integer()
+                    else "write a constant of the memory's type, or leave out `= …` for the type's zero value",
                 )
 
 

@@ -372,8 +372,23 @@ class TypeSystem:
         return function
 
     def constant(self, expression: Any, data_type: DataType, where: str) -> Value:
-        """The value of an expanded constant expression (a memory's initial value)."""
-        return self.coerce(_constant(expression), data_type, where)
+        """The value of an expanded constant expression (a memory's initial value).
+
+        Stricter than `coerce`, which takes `3.0` from user code for an `int`: a real number the spec
+        writes for an integer is refused, as for a parameter (`param X: int = 1.0` is EARL-R005)."""
+        value = _constant(expression)
+        self._no_reals_for_integers(value, data_type, where)
+        return self.coerce(value, data_type, where)
+
+    def _no_reals_for_integers(self, value: Any, data_type: DataType, where: str) -> None:
+        resolved = self.resolve(data_type)
+        if isinstance(resolved, PrimitiveType) and resolved.name in INTEGER_RANGES and isinstance(value, float):
+            raise ValueTypeError(
+                f"{where} must be a whole number ({resolved.name}), not the real number {shown_value(value)}"
+            )
+        if isinstance(resolved, ArrayType) and isinstance(value, list):
+            for position, item in enumerate(value):
+                self._no_reals_for_integers(item, resolved.element, f"{where}[{position}]")
 
 
 def _constant(expression: Any) -> Any:
