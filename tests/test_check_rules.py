@@ -1646,10 +1646,50 @@ def test_a_family_of_receptors_off_the_chain_is_said_once_with_its_range() -> No
 
 def test_a_link_family_named_otherwise_is_said_as_a_family() -> None:
     """`link m[K in 1..2],drive: …` into `d[K]/re`: said once, as the family is written, with the index
-    kept in the suggestion (`m[K],d`), not as its first member (`m[1],drive` → `m,d`)."""
+    kept in the suggestion (`m[K],d[K]`), not as its first member (`m[1],drive` → `m,d`)."""
     text = add(FAMILY_AGENT.replace("link m[K in 1..2],d[K]:", "link m[K in 1..2],drive:"))
     found = [d.message for d in findings(text, "EARL-W010") if "drive" in d.message]
-    assert found == ["link `m[K],drive` is not named after its ends; §2.5 suggests `m[K],d`"]
+    assert found == ["link `m[K],drive` is not named after its ends; §2.5 suggests `m[K],d[K]`"]
+
+
+LINKED_FAMILIES = """\
+a4/a {
+    cs {
+        c/ob: double
+    }
+    mc[K in 1..2]/ve {
+        c/ib: double
+    }
+    s[K in 1..2]/rr {
+        o/ob: double
+    }
+    v[K in 1..2]/vr {
+        i[J in 1..2]/ib: double
+    }
+    LINK
+}
+"""
+
+
+@pytest.mark.parametrize(
+    ("declared", "ends", "suggested"),
+    [
+        ("link foo", "cs.c -> mc[2]/ve.c", "cs,mc[2]"),
+        ("link x[K in 1..2]", "s[K]/rr.o -> v[1]/vr.i[K]", "s[K],v[1]"),
+    ],
+)
+def test_the_suggested_link_name_is_the_one_a_link_without_a_name_gets(
+    declared: str, ends: str, suggested: str
+) -> None:
+    """`link foo: cs.c -> mc[2]/ve.c` was told `cs,mc`, and `s[K]/rr -> v[1]/vr` `s[K],v`, while a link declared
+    without a name is named `cs,mc[2]` (what `earl fmt` writes): the suggestion is that name."""
+    text = add(LINKED_FAMILIES.replace("LINK", f"{declared}: {ends}"))
+    [finding] = findings(text, "EARL-W010")
+    assert finding.message.endswith(f"§2.5 suggests `{suggested}`")
+    if "[K in" not in declared:  # a family is declared in its name: it has no name without one
+        unnamed = earl.loads(add(LINKED_FAMILIES.replace("LINK", f"link {ends}")), "spec.earl")
+        [agent] = [agent for agent in unnamed.agents if agent.name == "a4"]
+        assert agent.links[0].name_text == suggested
 
 
 def test_a_link_family_named_in_one_word_is_told_a_name_with_its_index() -> None:

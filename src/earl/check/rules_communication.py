@@ -9,10 +9,10 @@ from operator import attrgetter
 from earl.check.context import CheckContext, ResolvedLink
 from earl.check.registry import Finding, rule
 from earl.diagnostics import Severity
-from earl.model.elements import LinkNamePart
+from earl.model.elements import Link, LinkNamePart, default_link_name
 from earl.model.kinds import KIND_TITLES, Kind
 from earl.model.tables import PERMITTED_LINKS, permitted_link
-from earl.model.text import instance_name, subsystem_name
+from earl.model.text import expression_text, instance_name, subsystem_name
 from earl.model.types import type_text
 
 
@@ -142,10 +142,12 @@ def receptor_chain(context: CheckContext) -> Iterator[Finding]:
 @rule("EARL-W010", Severity.WARNING, "link names join source and destination", "§2.1, §2.5")
 def link_names(context: CheckContext) -> Iterator[Finding]:
     """Good practice (§2.5): a link is named by its source, a comma, and its destination — agent names for
-    inter-agent links (`task,manip`), subsystem names inside an agent. Link names are unique (EARL-R002), so
+    inter-agent links (`task,manip`), subsystem names inside an agent. The name suggested is the one a link
+    declared without a name gets, indices as its ends write them (`cs,mc[2]`). Link names are unique (EARL-R002), so
     of two links between the same ends only one can have that name: the other is named by the pair with what
     tells it apart after the destination's name (`v,csPose`, `v,cs2`)."""
     between = _links_between(context.links)
+    as_written = _declared_links(context)
     reported: set[int] = set()
     for link in context.links:
         parts = [part.name for part in link.link.name]
@@ -157,26 +159,23 @@ def link_names(context: CheckContext) -> Iterator[Finding]:
             continue
         reported.add(id(link.link.location))
         taken = any([part.name for part in other.link.name] == expected for other in alongside)
-        # the pair's name is another link's: the destination buffer, the message's content, tells them apart
-        suggested_names = [expected[0], expected[1] + _capitalised(link.destination_buffer.name)] if taken else expected
-        name, suggested, pair = link.link.name_text, ",".join(suggested_names), ",".join(expected)
+        # the name a link declared without one gets (`cs,mc[2]`, `s[K],v[1]`): what `earl fmt` would write
+        written = as_written.get(id(link.link.location), link.link) if link.link.location is not None else link.link
+        default = list(default_link_name(written.source, written.destination))
+        pair = _name_parts_text(default)
+        if taken:
+            # the pair's name is another link's: the destination buffer, the message's content, tells them apart
+            destination = default[1]
+            apart = destination.name + _capitalised(link.destination_buffer.name)
+            default[1] = LinkNamePart(apart, destination.index)
+        suggested = _name_parts_text(default)
+        name = link.link.name_text
         family = link.link.family
         if family is not None and len(expected) == len(link.link.name):
             # a member of a link family: said as the family is written, its index kept on the indexed side
             name = _family_link_name(parts, link.link.name, family.index)
-            suggested = _family_link_name(suggested_names, link.link.name, family.index)
-            pair = _family_link_name(expected, link.link.name, family.index)
         elif family is not None:
-            # a family named otherwise (`gains[K in 1..N]`): the index goes on the ends that are family members
             name = f"{parts[0]}[{family.index}]" if len(parts) == 1 else name
-            indexed = _indexed_ends(link)
-            suggested, pair = (
-                ",".join(
-                    f"{part}[{family.index}]" if end_indexed else part
-                    for part, end_indexed in zip(names, indexed, strict=True)
-                )
-                for names in (suggested_names, expected)
-            )
         if not taken:
             yield Finding(f"link `{name}` is not named after its ends; §2.5 suggests `{suggested}`", link.link.location)
             continue
@@ -189,11 +188,20 @@ def link_names(context: CheckContext) -> Iterator[Finding]:
         )
 
 
-def _indexed_ends(link: ResolvedLink) -> tuple[bool, bool]:
-    """Which of a link's ends (agents between agents, subsystems inside one) is a member of a family."""
-    if link.between_agents:
-        return link.source_agent.index is not None, link.destination_agent.index is not None
-    return link.source_subsystem.index is not None, link.destination_subsystem.index is not None
+def _declared_links(context: CheckContext) -> dict[int, Link]:
+    """Every link as the spec writes it (`s[K]/rr.o -> v[1]/vr.i`, its family index unexpanded), by the
+    identity of its location, which the expanded members share."""
+    links = list(context.declared.links)
+    for agent in context.declared.agents:
+        links += agent.links
+    return {id(link.location): link for link in links if link.location is not None}
+
+
+def _name_parts_text(parts: Iterable[LinkNamePart]) -> str:
+    """`cs,mc[2]`: a link name's parts, each with the index it is written with."""
+    return ",".join(
+        part.name if part.index is None else f"{part.name}[{expression_text(part.index)}]" for part in parts
+    )
 
 
 def _ends_names(link: ResolvedLink) -> list[str]:

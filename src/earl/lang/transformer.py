@@ -46,6 +46,7 @@ from earl.model.elements import (
     Subsystem,
     Transition,
     TransitionFunction,
+    default_link_name,
 )
 from earl.model.expressions import (
     PYTHON_PREDICATE,
@@ -276,10 +277,11 @@ class ElementBuilder:
             (parts, family), source, destination = children
         else:
             source, destination = children
-            parts, family = _derived_link_name(source, destination), None
+            parts, family = None, None
         source_end = _link_end(source, Kind.OUTPUT_BUFFER)
         destination_end = _link_end(destination, Kind.INPUT_BUFFER)
-        return Link(tuple(parts), source_end, destination_end, family, self._loc(meta))
+        name = tuple(parts) if parts is not None else default_link_name(source_end, destination_end)
+        return Link(name, source_end, destination_end, family, self._loc(meta))
 
     def link_name(self, meta: Meta, children: list[Any]) -> tuple[list[LinkNamePart], Family | None]:
         parts: list[LinkNamePart] = []
@@ -769,16 +771,6 @@ def _link_end(end: dict[str, Any], buffer_kind: Kind) -> LinkEnd:
     name, indices, location = end["buffer"]
     buffer = ElementReference(name, buffer_kind, indices, location)
     return LinkEnd(end["agent"], end["subsystem"], buffer, end["location"])
-
-
-def _derived_link_name(source: dict[str, Any], destination: dict[str, Any]) -> list[LinkNamePart]:
-    """`source,destination` (§2.5): agent names between agents, subsystem names inside one."""
-    parts = []
-    for end in (source, destination):
-        reference: ElementReference = end["agent"] or end["subsystem"]
-        index = reference.indices[0] if len(reference.indices) == 1 else None
-        parts.append(LinkNamePart(reference.name, index if not isinstance(index, Star) else None))
-    return parts
 
 
 def with_location(element: Any, location: SourceLocation) -> Any:

@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import ClassVar
 
-from earl.model.expressions import ElementReference, Expression
+from earl.model.expressions import ElementReference, Expression, Star
 from earl.model.frozen import quick_init
 from earl.model.kinds import Kind
 from earl.model.location import Comments, SourceLocation, comments_field, location_field
@@ -456,6 +456,17 @@ class LinkNamePart:
     name: str
     index: Expression | None = None
     declares_family: bool = False
+
+
+def default_link_name(source: LinkEnd, destination: LinkEnd) -> tuple[LinkNamePart, ...]:
+    """The name of a link declared without one (§2.5): `source,destination`, agent names between agents,
+    subsystem names inside one, each with the index its end is written with (`cs,mc[2]`, `s[K],v[1]`)."""
+    parts = []
+    for end in (source, destination):
+        reference = end.agent or end.subsystem
+        index = reference.indices[0] if len(reference.indices) == 1 else None
+        parts.append(LinkNamePart(reference.name, None if isinstance(index, Star) else index))
+    return tuple(parts)
 
 
 @dataclass
