@@ -1424,6 +1424,16 @@ def test_a_condition_reading_unwritten_memory_is_reported() -> None:
     assert findings(fixed, "EARL-W041") == []
 
 
+def test_an_inter_agent_link_from_a_receptor_is_said_once_at_the_end_it_starts_at() -> None:
+    """From `cam/rr` into another agent's `cs`: E012 and E013 both reported it, and E013 said the link
+    "ends at" `a4/a.cam/rr`, its source."""
+    text = add(RECEPTOR_AGENT + "\nlink a4,a2: a4/a.cam/rr.raw -> a2/a.cs.inp\n")
+    said = [(d.code, d.message) for d in findings(text) if d.code in ("EARL-E012", "EARL-E013")]
+    assert said == [
+        ("EARL-E013", "inter-agent link `a4,a2` starts at `a4/a.cam/rr`, not at a Control Subsystem"),
+    ]
+
+
 def test_a_subsystem_declared_twice_is_reported_once_not_again_by_each_link_to_it() -> None:
     twice = BASE.replace("a1/a {\n    cs {", "a1/a {\n    cs {\n    }\n    cs {")
     with pytest.raises(EarlError) as raised:

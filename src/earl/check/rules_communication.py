@@ -46,11 +46,15 @@ def one_link_per_input(context: CheckContext) -> Iterator[Finding]:
 @rule("EARL-E012", Severity.ERROR, "only permitted pairs of subsystems are linked", "§2.3, Figure 7")
 def permitted_pairs(context: CheckContext) -> Iterator[Finding]:
     """Links follow the permitted-link table (Figure 7): the compulsory chains cs → ve → re and rr → vr → cs,
-    the optional ve → cs, re → ve, cs → vr, vr → rr inside one agent, and cs → cs between two agents."""
+    the optional ve → cs, re → ve, cs → vr, vr → rr inside one agent, and cs → cs between two agents (an
+    inter-agent link with another end is EARL-E013's, which names that end)."""
     for link in context.links:
         source, destination = link.source_subsystem.kind, link.destination_subsystem.kind
-        if link.between_agents and link.source_agent is link.destination_agent:
-            continue  # reported by EARL-E013
+        if link.between_agents and (
+            link.source_agent is link.destination_agent or {source, destination} != {Kind.CONTROL_SUBSYSTEM}
+        ):
+            # EARL-E013 reports it, naming the end that is not a Control Subsystem: said once is enough
+            continue
         if permitted_link(source, destination, link.between_agents) is None:
             allowed = ", ".join(
                 f"{row.source.value} → {row.destination.value}"
@@ -78,13 +82,14 @@ def inter_agent_links_between_control_subsystems(context: CheckContext) -> Itera
                 "declare links between the subsystems of one agent inside that agent",
             )
             continue
-        for subsystem, agent in (
-            (link.source_subsystem, link.source_agent),
-            (link.destination_subsystem, link.destination_agent),
+        for subsystem, agent, end in (
+            (link.source_subsystem, link.source_agent, "starts"),
+            (link.destination_subsystem, link.destination_agent, "ends"),
         ):
             if subsystem.kind is not Kind.CONTROL_SUBSYSTEM:
                 yield Finding(
-                    f"inter-agent link `{link.link.name_text}` ends at `{subsystem_name(agent, subsystem)}`, not at a Control Subsystem",
+                    f"inter-agent link `{link.link.name_text}` {end} at `{subsystem_name(agent, subsystem)}`, "
+                    "not at a Control Subsystem",
                     link.link.location,
                     "agents exchange messages only through their `cs`",
                 )
