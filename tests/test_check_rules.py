@@ -1540,6 +1540,33 @@ def test_a_real_number_for_an_integer_memory_is_refused_with_the_whole_number_to
     assert whole.hint == "write `3`: an integer type holds whole numbers, written without a decimal point"
 
 
+@pytest.mark.parametrize(
+    ("path", "wrong", "hint"),
+    [
+        (
+            "1mod:f",
+            "names the module `1mod`, which `import` cannot name: `1mod` is not a Python identifier",
+            "single dots",
+        ),
+        ("a..b:f", "names the module `a..b`, which `import` cannot name: a dot has no name on one side", "single dots"),
+        ("a/b:f", "names the module `a/b`, which `import` cannot name: `a/b` is not a Python identifier", '"a.b:f"'),
+        ("robot/relay.py:take", "names the module `robot/relay.py`", '`python "robot.relay:take"`'),
+        ("a.b:f-g", "names the function `f-g`, which is not a Python identifier", "the name it is defined with"),
+        ("a:f:g", "names the function `f:g`, which is not a Python identifier", "the name it is defined with"),
+    ],
+)
+def test_an_implementation_that_could_never_be_imported_is_refused(path: str, wrong: str, hint: str) -> None:
+    """E044 asked only for both parts: `"1mod:f"`, `"a..b:f"`, `"a/b:f"` passed, and failed at run time."""
+    text = edit(("        take/pf(inp/ib -> y/mo)\n", f'        take/pf(inp/ib -> y/mo) = python "{path}"\n'))
+    [finding] = findings(text, "EARL-E044")
+    assert finding.message.startswith(f'the implementation of `take/pf`, `python "{path}"`, {wrong}')
+    assert finding.hint is not None and hint in finding.hint
+    # what the runtime imports passes: dotted identifiers, `module.function`, spaces around the parts
+    for importable in ("robot.relay:take", "robot.relay.take", " robot.relay : take ", "_m2.über:ñ"):
+        fixed = text.replace(f'python "{path}"', f'python "{importable}"')
+        assert findings(fixed, "EARL-E044") == [], importable
+
+
 def test_a_constant_index_outside_a_fixed_array_is_refused() -> None:
     text = edit(
         ("        x/m: double = 0.0\n", "        x/m: double = 0.0\n        v/m: double[3] = [0.0, 0.0, 0.0]\n"),

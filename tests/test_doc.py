@@ -303,10 +303,9 @@ def test_markdown_reads_back_as_the_html_says(site: Path) -> None:
 
 def test_markdown_writes_a_bar_inside_code_as_github_reads_it(tmp_path: Path) -> None:
     spec = tmp_path / "bar.earl"
+    # in a string of a condition: a function's name with a bar is no Python identifier (EARL-E044)
     spec.write_text(
-        EXAMPLE.read_text(encoding="utf-8").replace(
-            'python "pick_and_place.task:approach"', 'python "pick_and_place.task:appr|oach"'
-        ),
+        EXAMPLE.read_text(encoding="utf-8").replace("false/pp = false", 'false/pp = "appr|oach" == "x"', 1),
         encoding="utf-8",
     )
     assert "appr|oach" in spec.read_text(encoding="utf-8")

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterator
 from dataclasses import replace
 
@@ -196,24 +197,56 @@ def implementations_name_a_function(context: CheckContext) -> Iterator[Finding]:
     """`= python "module:function"` tells `earl run` which function computes a Partial Transition
     Function or a Primitive Predicate; without both parts there is nothing to import (`earl run`
     refuses it, EARL-X001). A dot does not stand for the colon: `robot.arm.move` could be the module
-    `robot.arm.move` as well as the function `move` of `robot.arm`. Nothing is imported to check this."""
+    `robot.arm.move` as well as the function `move` of `robot.arm`. The module is named as `import` names
+    it, Python identifiers joined by dots (`robot.arm`), and the function by an identifier: `"1mod:f"`,
+    `"a..b:f"` or `"a/b:f"` could never be imported. Nothing is imported to check this."""
     for _, subsystem in context.distinct_subsystems():
         named = [(f"`{f.name}/pf`", f.implementation, f.location) for f in subsystem.partial_transition_functions]
         named += [(f"`{p.name}/pp`", p.implementation, p.location) for p in subsystem.primitive_predicates]
         for what, implementation, location in named:
             if implementation is None:
                 continue
-            if not implementation.module.strip() or not implementation.function.strip():
+            # the runtime strips spaces around each part (`" a : f "` runs)
+            module, function = implementation.module.strip(), implementation.function.strip()
+            written = f'the implementation of {what}, `python "{implementation.path}"`,'
+            if not module or not function:
                 path = implementation.path.strip()
-                module, dot, function = path.rpartition(".")
-                dotted = dot and ":" not in path and module and function.isidentifier()
+                dotted_module, dot, dotted_function = path.rpartition(".")
+                dotted = dot and ":" not in path and dotted_module and dotted_function.isidentifier()
                 yield Finding(
-                    f'the implementation of {what}, `python "{implementation.path}"`, does not name a function',
+                    f"{written} does not name a function",
                     location,
-                    f'did you mean `python "{module}:{function}"`? A colon separates the module from the function'
+                    f'did you mean `python "{dotted_module}:{dotted_function}"`? A colon separates the module from the function'
                     if dotted
                     else 'write `python "module:function"`, e.g. `python "robot.arm:move"`',
                 )
+                continue
+            wrong_part = next((part for part in module.split(".") if not part.isidentifier()), None)
+            if wrong_part is not None:
+                why = f"`{wrong_part}` is not a Python identifier" if wrong_part else "a dot has no name on one side"
+                yield Finding(
+                    f"{written} names the module `{module}`, which `import` cannot name: {why}",
+                    location,
+                    _module_hint(module, function),
+                )
+            if not function.isidentifier():
+                yield Finding(
+                    f"{written} names the function `{function}`, which is not a Python identifier",
+                    location,
+                    "a function is named by an identifier (letters, digits and `_`, not first a digit), the name it "
+                    'is defined with: `python "robot.arm:move"`',
+                )
+
+
+def _module_hint(module: str, function: str) -> str:
+    """How to name a module as `import` does: `a/b.py` is `a.b`."""
+    if "/" in module or "\\" in module or module.endswith(".py"):
+        dotted = ".".join(part for part in re.split(r"[/\\]+", module.removesuffix(".py")) if part)
+        return f'a module is named with dots, not as a file: `python "{dotted}:{function}"`'
+    return (
+        "a module is named as `import` names it, identifiers (letters, digits and `_`, not first a digit) "
+        'joined by single dots: `python "robot.arm:move"`'
+    )
 
 
 @rule("EARL-W047", Severity.WARNING, "a list says each thing once", "§2.1, §2.2")
