@@ -249,6 +249,9 @@ def test_an_environment_that_would_run_twice_or_apart_from_its_effectors_is_refu
         ),
         ("[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:notaport'\n", "`notaport` is not a port"),
         ("[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:99999'\n", "`99999` is not a port"),
+        # digits of other scripts: Zenoh would refuse them only as the process opens, and `int` the superscripts
+        ("[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:\u0661\u0667\u0664\u0665\u0661'\n", "is not a port"),
+        ("[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:7\u00b2'\n", "is not a port"),
         ("[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1'\n", "write it as tcp/HOST:PORT"),
         ("[[process]]\nagents = ['a', 'a/a']\nlisten = 'tcp/127.0.0.1:1'\n", "`a/a` is listed twice"),
         ("[[process]\n", "not valid TOML"),

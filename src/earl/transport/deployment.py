@@ -194,6 +194,11 @@ _NETWORK_PROTOCOLS = frozenset({"tcp", "udp", "tls", "quic", "ws"})
 _OTHER_PROTOCOLS = frozenset({"unixsock-stream", "unixpipe", "serial", "vsock"})
 
 
+def _is_port_number(text: str) -> bool:
+    """ASCII digits only: `str.isdigit` also takes `١٧٤٥١` (which Zenoh refuses) and `²` (which `int` refuses)."""
+    return text.isascii() and text.isdigit()
+
+
 def endpoint_problem(endpoint: str) -> str | None:
     """What is wrong with a `listen` endpoint of the network protocols, checked before anything starts
     (Zenoh would say it only as the process opens, in its own words); None when it looks right."""
@@ -208,8 +213,8 @@ def endpoint_problem(endpoint: str) -> str | None:
     host, colon, port = address.rpartition(":")
     if not colon or not host:
         return f"write it as {protocol}/HOST:PORT, e.g. {protocol}/127.0.0.1:7451"
-    if not port.isdigit() or not 1 <= int(port) <= 65535:
-        return f"`{port}` is not a port (a whole number from 1 to 65535)"
+    if not _is_port_number(port) or not 1 <= int(port) <= 65535:
+        return f"`{port}` is not a port (a whole number from 1 to 65535, in ASCII digits)"
     return None
 
 
@@ -244,7 +249,7 @@ def _endpoint_key(endpoint: str) -> tuple[str, str, str]:
     host = host.strip("[]")
     if host in LOCAL_HOSTS or host in {"0.0.0.0", "::"}:
         host = "this host"
-    if port.isdigit():
+    if _is_port_number(port):
         port = str(int(port))  # `017451` is port 17451
     return (protocol, host, port) if port else (protocol, address, "")
 
