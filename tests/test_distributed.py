@@ -535,15 +535,16 @@ def test_a_zenoh_run_whose_output_is_closed_still_ends(tmp_path: Path) -> None:
 
 def test_launch_checks_the_duration_and_names_processes_of_other_hosts_before_starting(tmp_path: Path) -> None:
     deploy = deployment(tmp_path, [(["sender/a"], False), (["receiver/a"], False)])
-    result = subprocess.run(
-        launch_command(deploy, "abc"),
-        capture_output=True,
-        text=True,
-        timeout=60,
-        check=False,
-    )
-    assert result.returncode == 2 and "--duration `abc` is not a duration" in result.stderr
-    assert "started" not in result.stdout
+    for duration, said in (("abc", "--duration: `abc` is not a duration"), ("", "--duration: the duration is empty")):
+        result = subprocess.run(
+            launch_command(deploy, duration),
+            capture_output=True,
+            text=True,
+            timeout=60,
+            check=False,
+        )
+        assert result.returncode == 2 and said in result.stderr, result.stderr
+        assert "started" not in result.stdout
     deploy.write_text(
         deploy.read_text().replace("environment = false\n", 'environment = false\nhost = "locahost"\n', 1)
     )

@@ -424,6 +424,8 @@ def test_the_checker_runs_first_and_its_errors_stop_the_run(tmp_path: Path) -> N
         (["--duration", "ten seconds"], "is not a duration"),
         (["--duration", "1e400s"], "is too long: a duration is at most"),  # infinite as a float
         (["--duration=-1s"], "must be positive"),
+        (["--duration="], "the duration is empty"),  # not the default 10 s
+        (["--duration", " "], "the duration is empty"),
         (["--agents", ","], "--agents names no agent"),
         (
             ["--plot", "/nonexistent/dir/x.png", "--signal", "counter/a.cs.count"],

@@ -117,15 +117,15 @@ def run(arguments: argparse.Namespace) -> int:
     if shared is not None:
         print(f"earl launch: {deployment_path}: {shared}; nothing was started", file=sys.stderr)
         return EXIT_FAILED
-    if arguments.duration:
+    if arguments.duration is not None:  # `--duration=` too: the processes would run the default
         from earl.runtime.durations import parse_duration
 
         try:
             parse_duration(arguments.duration)
         except ValueError as error:
-            return usage_error(f"--duration {error}")
+            return usage_error(f"--duration: {error}")
     common = [str(path), "--transport", "zenoh", "--deployment", str(deployment_path), "--no-progress"]
-    if arguments.duration:
+    if arguments.duration is not None:
         common += ["--duration", arguments.duration]
     for parameter in arguments.param:
         common += ["--param", parameter]

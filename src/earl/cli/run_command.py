@@ -163,7 +163,10 @@ def _run(arguments: argparse.Namespace) -> int:
         path = spec_path(arguments.spec)
         parameters = parse_parameters(arguments.param)
         settings = read_run_settings(path)
-        duration = parse_duration(arguments.duration) if arguments.duration else (settings.duration or 10.0)
+        duration = (
+            # an empty `--duration=` is refused, not taken for the default
+            parse_duration(arguments.duration) if arguments.duration is not None else (settings.duration or 10.0)
+        )
     except (UsageError, ValueError) as error:
         return usage_error(str(error))
     seed = arguments.seed if arguments.seed is not None else (settings.seed or 0)

@@ -14,6 +14,8 @@ def parse_duration(text: str, zero: bool = False) -> float:
     """Seconds; a bare number is seconds. Raises ValueError with an example of what is accepted.
 
     `zero`: 0, written any way (`0`, `0.0`, `00`, `0min`), is accepted too (and is 0.0)."""
+    if not text.strip():  # `--duration=`: not "the default", which is no option at all
+        raise ValueError("the duration is empty; write e.g. `10s`, `500ms`, `2.5` (seconds) or `1min`")
     match = _PATTERN.match(text)
     if match is None:
         raise ValueError(f"`{text}` is not a duration; write e.g. `10s`, `500ms`, `2.5` (seconds) or `1min`")
