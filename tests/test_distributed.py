@@ -558,6 +558,21 @@ def test_launch_checks_the_duration_and_names_processes_of_other_hosts_before_st
     assert "[sender/a  ] runs on host `locahost`, not started here" in result.stdout, result.stdout
 
 
+def test_launch_help_says_every_exit_code_and_stop_signal_the_docs_say() -> None:
+    result = subprocess.run(
+        [sys.executable, "-m", "earl.cli.main", "launch", "--help"], capture_output=True, text=True, timeout=60
+    )
+    assert result.returncode == 0, result.stderr
+    text = " ".join(result.stdout.split())
+    exit_codes = text.split("exit codes:", 1)[1]
+    assert "1 a process failed, the deployment is invalid or the output was closed" in exit_codes
+    assert "130 interrupted by Ctrl-C, SIGTERM or SIGHUP" in exit_codes
+    assert "Ctrl-C, SIGTERM or SIGHUP (a closed terminal) stops every process" in text
+    docs = " ".join((Path(__file__).parent.parent / "docs" / "distributed.md").read_text().split())
+    assert "Ctrl-C, SIGTERM or SIGHUP (a closed terminal) stops them all" in docs
+    assert "1 one failed, the deployment is invalid or the output was closed" in docs
+
+
 def test_launch_refuses_to_split_the_robots_effectors_from_their_environment(tmp_path: Path) -> None:
     """manip/a and grip/a drive MuJoCo's actuators: in two processes each would simulate a world of its own."""
     deploy = deployment(tmp_path, [(["task/a"], False), (["manip/a"], True), (["grip/a"], False)])

@@ -41,9 +41,14 @@ The deployment file lists the processes: their agents, their Zenoh `listen` endp
 whether the run.toml environment lives there, and extra `earl run` options
 (docs/distributed.md). Only processes whose `host` is this machine are started.
 
-exit codes: 0 every process completed, 1 a process failed or the deployment is invalid,
-            2 usage error (a missing spec or deployment file, a bad option), 130 interrupted
-            (every process was stopped)
+Ctrl-C, SIGTERM or SIGHUP (a closed terminal) stops every process: SIGTERM to each (they
+close their traces), at most 5 s of grace, then SIGKILL; a second Ctrl-C kills at once. A
+reader of the output that goes away (`earl launch … | head`) stops them the same way.
+
+exit codes: 0 every process completed, 1 a process failed, the deployment is invalid or the
+            output was closed (every process was stopped), 2 usage error (a missing spec or
+            deployment file, a bad option; --duration is checked before anything starts),
+            130 interrupted by Ctrl-C, SIGTERM or SIGHUP (every process was stopped)
 """
 
 
@@ -52,7 +57,7 @@ def register(commands: Any) -> None:
         "launch",
         help="start the processes of a deployment (agents split over processes, linked by Zenoh) and supervise them",
         description="Start one `earl run --transport zenoh` process per group of agents of the deployment file that "
-        "runs on this host; show their output prefixed by their agents; stop them all on Ctrl-C.",
+        "runs on this host; show their output prefixed by their agents; stop them all on Ctrl-C, SIGTERM or SIGHUP.",
         epilog=EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
