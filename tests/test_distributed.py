@@ -565,12 +565,13 @@ def test_launch_help_says_every_exit_code_and_stop_signal_the_docs_say() -> None
     assert result.returncode == 0, result.stderr
     text = " ".join(result.stdout.split())
     exit_codes = text.split("exit codes:", 1)[1]
-    assert "1 a process failed, the deployment is invalid or the output was closed" in exit_codes
+    assert "1 a process failed (or ended before its run started" in exit_codes
+    assert "or the output was closed" in exit_codes
     assert "130 interrupted by Ctrl-C, SIGTERM or SIGHUP" in exit_codes
     assert "Ctrl-C, SIGTERM or SIGHUP (a closed terminal) stops every process" in text
     docs = " ".join((Path(__file__).parent.parent / "docs" / "distributed.md").read_text().split())
     assert "Ctrl-C, SIGTERM or SIGHUP (a closed terminal) stops them all" in docs
-    assert "1 one failed, the deployment is invalid or the output was closed" in docs
+    assert "1 one failed (or ended before its run started" in docs and "or the output was closed, 2" in docs
 
 
 def test_launch_refuses_to_split_the_robots_effectors_from_their_environment(tmp_path: Path) -> None:
@@ -700,17 +701,89 @@ def test_processes_of_a_launch_killed_with_sigkill_stop_themselves(tmp_path: Pat
                 os.kill(pid, signal.SIGKILL)
 
 
-def test_launch_says_a_process_failed_as_soon_as_it_ends(tmp_path: Path, processes: list[Process]) -> None:
-    """The sender's code does not compile: it fails at once, while the receiver waits up to 30 s for it.
-    The failure is said then, not when the receiver is done."""
+@pytest.mark.parametrize("failure", ["code that does not compile", "a missing module", "a port held by another"])
+def test_a_process_that_fails_before_its_run_starts_stops_the_launch_at_once(
+    tmp_path: Path, processes: list[Process], failure: str
+) -> None:
+    """The sender cannot start: the receiver would wait for it (--wait-for-peers, 30 s), then run without
+    it. The failure is said as it happens, the receiver is stopped, and the launch ends with exit 1; the
+    sender's spec errors come before it opens its Zenoh session, not after it has shown itself."""
     spec = tmp_path / "pingpong"
     shutil.copytree(PINGPONG, spec)
-    (spec / "pingpong" / "sender.py").write_text("def broken(:\n")
     deploy = deployment(tmp_path, [(["sender/a"], False), (["receiver/a"], False)])
-    launch = Process(tmp_path / "launch.log", [str(spec), "--deployment", str(deploy), "--duration", "3s"], "launch")
-    processes.append(launch)
-    launch.wait_for("] failed with exit code 1", 25)
-    assert launch.child.poll() is None, launch.output  # the receiver is still waiting for its peer
+    holder = socket.socket()
+    try:
+        if failure == "code that does not compile":
+            (spec / "pingpong" / "sender.py").write_text("def broken(:\n")
+        elif failure == "a missing module":
+            (spec / "pingpong" / "sender.py").unlink()
+        else:
+            port = int(endpoints(deploy)[0].rsplit(":", 1)[1])
+            holder.bind(("127.0.0.1", port))
+            holder.listen()
+        started = time.monotonic()
+        launch = Process(
+            tmp_path / "launch.log", [str(spec), "--deployment", str(deploy), "--duration", "60s"], "launch"
+        )
+        processes.append(launch)
+        assert launch.finish(25) == 1, launch.output
+        assert time.monotonic() - started < 25  # not the receiver's 30 s wait, nor its 60 s run
+    finally:
+        holder.close()
+    output = launch.output
+    assert "[sender/a  ] ended with exit code 1 before its run started; the others cannot run" in output, output
+    assert "[receiver/a] stopping" in output
+    assert "earl launch: sender/a ended before its run started; every process was stopped" in output
+    assert "[sender/a  ] earl run: sender/a over Zenoh" not in output  # its errors came first
+    if failure == "a port held by another":
+        assert "Address already in use" in output
+    else:
+        assert "EARL-X00" in output
+    assert "Traceback" not in output
+    assert all(_gone(pid) for pid in _started_pids(output)), output
+
+
+def test_a_process_that_fails_in_the_middle_of_its_run_leaves_the_others_running(
+    tmp_path: Path, processes: list[Process]
+) -> None:
+    """Once its run started, a process that fails is a lost peer: it is said at once and the others go on."""
+    launch = pingpong_launched(tmp_path, processes)
+    sender = next(
+        int(line.split("(pid ")[1].split(")")[0])
+        for line in launch.output.splitlines()
+        if "[sender/a  ] started" in line
+    )
+    os.kill(sender, signal.SIGKILL)
+    launch.wait_for("[sender/a  ] failed with signal 9 (SIGKILL)", 25)
+    launch.wait_for("[receiver/a] earl run: receiver/a.cs: sender/a disappeared", 25)
+    time.sleep(1.0)
+    assert launch.child.poll() is None, launch.output  # the receiver runs on, holding its stale input
+    assert "[receiver/a] stopping" not in launch.output
+    launch.child.send_signal(signal.SIGINT)
+    assert launch.finish(30) == 130, launch.output
+
+
+@pytest.mark.parametrize(
+    ("args", "said"),
+    [
+        ('["--trace", "/nonexistent/dir/s.mcap"]', "cannot write the trace /nonexistent/dir/s.mcap: the directory"),
+        ('["--duration", "soon"]', "--duration: `soon` is not a duration"),
+        ('["--duration="]', "--duration: the duration is empty"),
+        ('["--plot", "/nonexistent/dir/s.png", "--signal", "sender/a.cs.count"]', "--plot '/nonexistent/dir/s.png'"),
+        ('["--wait-for-peers", "soon"]', "--wait-for-peers: `soon` is not a duration"),
+        ('["--seed", "x"]', "argument --seed: `x` is not a whole number"),
+        ('["--bogus"]', "unrecognized arguments: --bogus"),
+        ('["--help"]', "it asks for help"),
+    ],
+)
+def test_launch_checks_each_processs_args_before_starting_any(tmp_path: Path, args: str, said: str) -> None:
+    deploy = deployment(tmp_path, [(["sender/a"], False), (["receiver/a"], False)])
+    deploy.write_text(deploy.read_text().replace("environment = false\n", f"environment = false\nargs = {args}\n", 1))
+    result = subprocess.run(launch_command(deploy, "1s"), capture_output=True, text=True, timeout=60, check=False)
+    assert result.returncode == 1, result.stdout + result.stderr
+    assert f"{deploy}: process 1 (sender/a) cannot run with its `args`: {said}" in result.stderr, result.stderr
+    assert "nothing was started" in result.stderr
+    assert "started" not in result.stdout and "Traceback" not in result.stderr
 
 
 def test_wait_for_peers_0_starts_at_once_and_a_missing_deployment_file_is_a_usage_error(tmp_path: Path) -> None:

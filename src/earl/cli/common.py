@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
 import re
 import sys
@@ -123,6 +124,47 @@ def watch_supervisor() -> None:
         os.kill(os.getpid(), signal.SIGTERM)
 
     threading.Thread(target=watch, name="earl-supervisor-watch", daemon=True).start()
+
+
+#: set by `earl launch` for each child: a file descriptor, the write end of a pipe, on which `earl run`
+#: says `started` once its run is set up (docs/distributed.md, "earl launch")
+STATUS_VARIABLE = "EARL_LAUNCH_STATUS_FD"
+#: what is written on that pipe
+STARTED = b"started\n"
+
+
+def take_launch_status() -> int | None:
+    """The pipe `earl launch` gave this process to say that its run started, or None (not started by
+    `earl launch`). The variable is taken out of the environment and the descriptor kept from child
+    processes, so that a program the spec's code starts never writes on it (nor on another file that
+    happens to have that number there)."""
+    import stat
+
+    text = os.environ.pop(STATUS_VARIABLE, "")
+    if not (text.isascii() and text.isdigit()):
+        return None
+    descriptor = int(text)
+    try:
+        if not stat.S_ISFIFO(os.fstat(descriptor).st_mode):
+            return None
+        os.set_inheritable(descriptor, False)
+    except OSError:
+        return None
+    return descriptor
+
+
+def say_started(descriptor: int | None) -> None:
+    """Tell `earl launch` that this process's run started (its code bound, its links open): from now
+    on, its failure is a lost peer for the others, not a deployment that cannot start."""
+    if descriptor is None:
+        return
+    try:
+        os.write(descriptor, STARTED)
+    except OSError:  # the supervisor is gone: `watch_supervisor` stops this process
+        pass
+    finally:
+        with contextlib.suppress(OSError):
+            os.close(descriptor)
 
 
 def fault_kinds(kinds: Iterable[str]) -> str:

@@ -1,11 +1,14 @@
 """`earl launch SPEC --deployment deploy.toml`: every process of a deployment on this host, supervised.
 
 Each process is `earl run SPEC --transport zenoh --agents …` for one `[[process]]` of the
-deployment file.  Their output is shown line by line, prefixed with the process's
-agents; Ctrl-C, SIGTERM or SIGHUP stops them all (SIGTERM, a bounded wait, then SIGKILL;
-a second Ctrl-C kills at once), and so does a reader of the output that goes away.
-A process that fails is reported and the others go on: the distributed runtime is
-built to outlive a lost peer (docs/distributed.md).
+deployment file; the `args` of each are checked before any is started.  Their output is
+shown line by line, prefixed with the process's agents; Ctrl-C, SIGTERM or SIGHUP stops them
+all (SIGTERM, a bounded wait, then SIGKILL; a second Ctrl-C kills at once), and so does a
+reader of the output that goes away.
+Each process says on a pipe of its own (STATUS_VARIABLE) when its run has started: set up,
+its code bound, its Zenoh session open.  A process that ends before that stops them all (the
+others cannot run the deployment without it); one that fails later is reported and the others
+go on: the distributed runtime is built to outlive a lost peer (docs/distributed.md).
 """
 
 from __future__ import annotations
@@ -23,7 +26,14 @@ import time
 from pathlib import Path
 from typing import IO, Any
 
-from earl.cli.common import SUPERVISOR_VARIABLE, UsageError, spec_path, usage_error
+from earl.cli.common import (
+    STARTED,
+    STATUS_VARIABLE,
+    SUPERVISOR_VARIABLE,
+    UsageError,
+    spec_path,
+    usage_error,
+)
 from earl.cli.output import print_diagnostics
 from earl.cli.run_command import handling_stop_signals
 from earl.diagnostics import EarlError
@@ -45,10 +55,15 @@ Ctrl-C, SIGTERM or SIGHUP (a closed terminal) stops every process: SIGTERM to ea
 close their traces), at most 5 s of grace, then SIGKILL; a second Ctrl-C kills at once. A
 reader of the output that goes away (`earl launch … | head`) stops them the same way.
 
-exit codes: 0 every process completed, 1 a process failed, the deployment is invalid or the
-            output was closed (every process was stopped), 2 usage error (a missing spec or
-            deployment file, a bad option; --duration is checked before anything starts),
-            130 interrupted by Ctrl-C, SIGTERM or SIGHUP (every process was stopped)
+A process that ends before its run has started (its code cannot be bound, its port is held,
+bad options) stops them all: the others cannot run the deployment without it. One that fails
+later is reported, and the others go on (the runtime outlives a lost peer).
+
+exit codes: 0 every process completed, 1 a process failed (or ended before its run started,
+            and every process was stopped), the deployment or a process's `args` is invalid,
+            or the output was closed (every process was stopped), 2 usage error (a missing
+            spec or deployment file, a bad option; --duration is checked before anything
+            starts), 130 interrupted by Ctrl-C, SIGTERM or SIGHUP (every process was stopped)
 """
 
 
@@ -134,6 +149,17 @@ def run(arguments: argparse.Namespace) -> int:
         common += ["--duration", arguments.duration]
     for parameter in arguments.param:
         common += ["--param", parameter]
+    for number, process in enumerate(deployment.processes, start=1):
+        if not process.is_local:
+            continue
+        problem = _args_problem([*common, "--agents", process.label, *process.args])
+        if problem is not None:
+            print(
+                f"earl launch: {deployment_path}: process {number} ({process.label}) cannot run with its `args`: "
+                f"{problem}; nothing was started",
+                file=sys.stderr,
+            )
+            return EXIT_FAILED
     supervisor = _Supervisor([process.label for process in deployment.processes])
     for process in deployment.processes:
         if not process.is_local:
@@ -162,6 +188,40 @@ def _agents(spec: Path, parameters: list[str]) -> tuple[list[str], list[str]]:
     values = parse_parameters(parameters)
     expanded = expand(load(spec, values), values)
     return [agent_name(agent) for agent in expanded.agents], acting_agents(expanded)
+
+
+class _Refused(Exception):
+    """What argparse would say of a process's command line (instead of printing it and exiting)."""
+
+
+class _RefusingParser(argparse.ArgumentParser):
+    def error(self, message: str) -> Any:
+        raise _Refused(message)
+
+    def exit(self, status: int = 0, message: str | None = None) -> Any:
+        # `--help` or `--version` among the args: the process would print them and end, running nothing
+        raise _Refused("it asks for help, and would run nothing")
+
+
+def _args_problem(command: list[str]) -> str | None:
+    """What `earl run` would refuse in `command` (its options after `earl run`) before running anything:
+    an unknown option, a bad value, a trace or plot directory that does not exist, an empty --duration.
+    Found without reading the spec, as `earl run` finds it (`run_command.check_options`)."""
+    import io
+
+    from earl.cli import run_command
+
+    parser = _RefusingParser(prog="earl", add_help=False)
+    run_command.register(parser.add_subparsers(dest="command", parser_class=_RefusingParser))
+    try:
+        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+            options = parser.parse_args(["run", *command])
+        run_command.check_options(options)
+    except _Refused as refused:
+        return str(refused)
+    except UsageError as error:
+        return str(error)
+    return None
 
 
 def _shared_output(processes: list[Any]) -> str | None:
@@ -203,6 +263,14 @@ class _Supervisor:
         self.copier_of: dict[int, threading.Thread] = {}
         #: children whose failure was said as it happened
         self.reported: set[int] = set()
+        #: the read end of each child's status pipe (by pid), until it says its run started or ends
+        self.status: dict[int, int] = {}
+        #: what each child wrote on its status pipe so far
+        self.said: dict[int, bytes] = {}
+        #: children whose run started (said on their status pipe)
+        self.started: set[int] = set()
+        #: the first child that ended before its run started: every other one is stopped
+        self.failed_to_start: str | None = None
         self.lock = threading.Lock()
         self.width = max((len(label) for label in labels), default=0)
         self.signals = 0
@@ -222,16 +290,33 @@ class _Supervisor:
     def start(self, label: str, command: list[str]) -> None:
         # Rich draws the children's tables for a pipe 80 columns wide unless told otherwise
         columns = max(100, shutil.get_terminal_size((160, 24)).columns - self.width - 3)
-        child = subprocess.Popen(
-            command,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.STDOUT,
-            stdin=subprocess.DEVNULL,
-            # a session of its own: Ctrl-C reaches the supervisor, which stops the children in order
-            start_new_session=True,
-            # the child stops itself (as on SIGTERM) should this supervisor die without stopping it (SIGKILL)
-            env={**os.environ, "PYTHONUNBUFFERED": "1", "COLUMNS": str(columns), SUPERVISOR_VARIABLE: str(os.getpid())},
-        )
+        # the child says on this pipe when its run has started; its end closes the pipe in any case
+        status, said = os.pipe()
+        try:
+            child = subprocess.Popen(
+                command,
+                stdout=subprocess.PIPE,
+                stderr=subprocess.STDOUT,
+                stdin=subprocess.DEVNULL,
+                # a session of its own: Ctrl-C reaches the supervisor, which stops the children in order
+                start_new_session=True,
+                pass_fds=(said,),
+                env={
+                    **os.environ,
+                    "PYTHONUNBUFFERED": "1",
+                    "COLUMNS": str(columns),
+                    # the child stops itself (as on SIGTERM) should this supervisor die without stopping it
+                    SUPERVISOR_VARIABLE: str(os.getpid()),
+                    STATUS_VARIABLE: str(said),
+                },
+            )
+        except BaseException:
+            os.close(status)
+            raise
+        finally:
+            os.close(said)
+        os.set_blocking(status, False)
+        self.status[child.pid] = status
         self.children.append((label, child))
         assert child.stdout is not None
         copier = threading.Thread(target=self._copy, args=(label, child.stdout), daemon=True)
@@ -256,11 +341,33 @@ class _Supervisor:
                 self.output_closed = True
 
     def wait(self) -> int:
-        while any(child.poll() is None for _, child in self.children) and not self.stop_requested:
+        try:
+            return self._wait()
+        finally:
+            self._close_status()
+
+    def _wait(self) -> int:
+        while (
+            any(child.poll() is None for _, child in self.children)
+            and not self.stop_requested
+            and self.failed_to_start is None
+        ):
             time.sleep(0.1)
             if _reader_gone():
                 self.output_closed = True
             self._report_failures()
+        if not self.stop_requested:
+            self._report_failures()  # the last to end, since the last look
+        if self.failed_to_start is not None and not self.stop_requested:
+            # the others would wait for it (--wait-for-peers), then run without it: the deployment cannot run
+            self.stop_all()
+            self._join()
+            with contextlib.suppress(OSError):
+                print(
+                    f"earl launch: {self.failed_to_start} ended before its run started; every process was stopped",
+                    file=sys.stderr,
+                )
+            return EXIT_FAILED
         if self.stop_requested:
             self.stop_all()
             self._join()
@@ -276,16 +383,58 @@ class _Supervisor:
 
     def _report_failures(self) -> None:
         """A process that failed is said as soon as it ends (after its last lines), not after the others:
-        they may run for a long while yet."""
+        they may run for a long while yet. One that ended before its run started (whatever its exit code)
+        stops them all (`failed_to_start`)."""
         for label, child in self.children:
+            self._read_status(child.pid)
             code = child.poll()
-            if code is None or code == 0 or child.pid in self.reported:
+            if code is None or child.pid in self.reported:
+                continue
+            self._read_status(child.pid)  # what it said before it ended
+            before_start = child.pid not in self.started
+            if code == 0 and not before_start:
                 continue
             self.reported.add(child.pid)
             copier = self.copier_of.get(child.pid)
             if copier is not None:
                 copier.join(timeout=2.0)
-            self.say(label, f"failed with {_exit_status(code)}")
+            if before_start and self.failed_to_start is None and not self.stop_requested:
+                self.failed_to_start = label
+                self.say(
+                    label,
+                    f"ended with {_exit_status(code)} before its run started; the others cannot run the "
+                    "deployment without it: stopping them",
+                )
+            else:
+                self.say(label, f"failed with {_exit_status(code)}")
+
+    def _read_status(self, pid: int) -> None:
+        """Whatever the child wrote on its status pipe since the last look; the pipe is closed once it said
+        its run started, or it ended."""
+        status = self.status.get(pid)
+        if status is None:
+            return
+        while True:
+            try:
+                data = os.read(status, 64)
+            except BlockingIOError:
+                return
+            except OSError:
+                data = b""
+            if data:
+                self.said[pid] = self.said.get(pid, b"") + data
+                if STARTED in self.said[pid]:
+                    self.started.add(pid)
+                continue
+            del self.status[pid]  # the end of the pipe: the child closed it, or ended
+            os.close(status)
+            return
+
+    def _close_status(self) -> None:
+        for status in self.status.values():
+            with contextlib.suppress(OSError):
+                os.close(status)
+        self.status.clear()
 
     def stop_all(self) -> None:
         """SIGTERM to each (they close their traces and exit 130), then SIGKILL after a bounded wait, or at

@@ -12,8 +12,9 @@ import sys
 import time
 import warnings
 from collections.abc import Callable, Iterator
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
@@ -24,6 +25,10 @@ from earl.cli.common import UsageError, brief, fault_kinds, parse_parameters, sp
 from earl.cli.output import print_diagnostics
 from earl.diagnostics import EarlError
 from earl.transport.deployment import DeploymentError
+
+if TYPE_CHECKING:
+    from earl.lang.loader import ParameterValue
+    from earl.runtime.simulation import RunSettings
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 
@@ -152,69 +157,28 @@ def run(arguments: argparse.Namespace) -> int:
 
 
 def _run(arguments: argparse.Namespace) -> int:
-    from earl.cli.common import watch_supervisor
+    from earl.cli.common import say_started, take_launch_status, watch_supervisor
     from earl.lang.loader import load
 
     watch_supervisor()
-    from earl.runtime.durations import parse_duration
-    from earl.runtime.simulation import RecordingWarning, Simulation, bind_report, read_run_settings
+    launch_status = take_launch_status()
+    from earl.runtime.simulation import RecordingWarning, Simulation, bind_report
 
     try:
-        path = spec_path(arguments.spec)
-        parameters = parse_parameters(arguments.param)
-        settings = read_run_settings(path)
-        duration = (
-            # an empty `--duration=` is refused, not taken for the default
-            parse_duration(arguments.duration) if arguments.duration is not None else (settings.duration or 10.0)
-        )
-    except (UsageError, ValueError) as error:
+        options = check_options(arguments)
+    except UsageError as error:
         return usage_error(str(error))
+    path, parameters, settings, duration = options.path, options.parameters, options.settings, options.duration
+    agents = options.agents
     seed = arguments.seed if arguments.seed is not None else (settings.seed or 0)
-    signals = arguments.signal if arguments.signal is not None else settings.plot
+    signals = arguments.signal
     #: where the signals were named, for messages about them
-    signals_origin = "--signal" if arguments.signal is not None else "run.toml's plot:"
-    if arguments.plot and not signals:
-        return usage_error("--plot needs signals: name them with --signal, or `plot = [...]` in run.toml")
-    if arguments.plot:
-        from earl.runtime.plot import plot_output_problem
-
-        problem = plot_output_problem(Path(arguments.plot))
-        if problem is not None:  # said now, not after a run of minutes
-            return usage_error(f"--plot {arguments.plot!r}: {problem}")
-    arguments.signal = signals
-    if arguments.plot and not arguments.trace:
-        arguments.trace = str(Path(arguments.plot).with_suffix(".mcap"))
-    if arguments.plot and Path(arguments.plot).resolve() == Path(arguments.trace).resolve():
-        return usage_error(f"--trace and --plot both name {arguments.plot}: the plot would replace the trace")
-    if arguments.trace is not None and not Path(arguments.trace).parent.is_dir():
-        # said here in the CLI's words; `Simulation` would say it after the spec is read, in the API's
-        directory = Path(arguments.trace).parent
-        kind = "is not a directory" if directory.exists() else "does not exist"
-        return usage_error(f"cannot write the trace {arguments.trace}: the directory `{directory}` {kind}")
+    signals_origin = "--signal" if options.signals_from_command_line else "run.toml's plot:"
     # only a trace file this command creates may be removed, should a stop signal come before the run
     trace_was_there = arguments.trace is not None and os.path.lexists(arguments.trace)
     environment = arguments.environment or settings.environment
     if environment == "none":
         environment = None
-    agents = [a.strip() for a in arguments.agents.split(",") if a.strip()] if arguments.agents is not None else None
-    if agents == []:  # `--agents ,` or `--agents ""`: not "all of them", which is no --agents at all
-        return usage_error("--agents names no agent; list them, e.g. --agents manip/a,grip/a")
-    if arguments.transport == "zenoh":
-        if not agents:
-            return usage_error("--transport zenoh needs --agents: the agents this process runs, e.g. task/a")
-        from earl.transport.process import peers_wait  # Zenoh is imported only for a distributed run
-
-        try:
-            peers_wait(arguments.wait_for_peers)
-        except ValueError as error:
-            return usage_error(f"--wait-for-peers: {error}")
-        if arguments.deployment and not Path(arguments.deployment).is_file():
-            # as `earl launch` says it: a file named on the command line that is not there is a usage error
-            kind = "is a directory; name its file" if Path(arguments.deployment).is_dir() else "does not exist"
-            return usage_error(f"--deployment {arguments.deployment} {kind}")
-        arguments.realtime = True  # distribution runs in real time only (docs/distributed.md)
-    elif arguments.zenoh_config or arguments.deployment or arguments.wait_for_peers is not None:
-        return usage_error("--zenoh-config, --deployment and --wait-for-peers go with --transport zenoh")
     record_memory = arguments.record_memory if arguments.record_memory is not None else settings.record_memory
     if agents and arguments.record_memory is None and record_memory:
         # run.toml names the subsystems of the whole system; this process records those it runs
@@ -225,11 +189,12 @@ def _run(arguments: argparse.Namespace) -> int:
     try:
         system = load(path, parameters)
         if arguments.transport == "zenoh":
-            from earl.transport.process import open_transport
+            from earl.transport.process import prepare_transport
 
-            # run.toml's environment lives where the deployment file puts it; --environment is the user's
+            # run.toml's environment lives where the deployment file puts it; --environment is the user's;
+            # the Zenoh session opens last, as `Simulation` is set up (its code bound, its environment started)
             from_settings = environment if arguments.environment is None else None
-            agents, transport, environment_here = open_transport(
+            agents, transport, environment_here = prepare_transport(
                 system, parameters, path, agents or [], arguments, from_settings
             )
             if from_settings is not None and not environment_here:
@@ -310,11 +275,17 @@ def _run(arguments: argparse.Namespace) -> int:
         return usage_error(f"cannot write the trace {arguments.trace}{beside}: {error.strerror or error}")
     except RuntimeError as error:  # the transport could not start
         _close(transport)
+        if arguments.zenoh_config:
+            from earl.transport.zenoh_transport import TransportError, network_failure  # imported already
+
+            if isinstance(error, TransportError) and not network_failure(str(error)):
+                return usage_error(str(error))  # the user's own configuration, which Zenoh refuses
         print(f"earl run: {error}", file=sys.stderr)
         return EXIT_FAILED
     # run.toml names the links of the whole system: a process that runs some of its agents has only
     # theirs, and would call every pattern for the others' links wrong
     _say_what_is_not_recorded(arguments, simulation, settings.record_links if not agents else None)
+    say_started(launch_status)  # set up, links open: a failure from now on is a lost peer, not a failed start
     try:
         if transport is not None:
             from earl.transport.process import wait_for_peers
@@ -344,6 +315,84 @@ def _remove_unrun_trace(arguments: argparse.Namespace, trace_was_there: bool) ->
             trace.unlink()
             return f"; no trace was written to {arguments.trace}"
     return ""
+
+
+@dataclass
+class CheckedOptions:
+    """What `check_options` read from the command line and run.toml."""
+
+    path: Path
+    parameters: dict[str, ParameterValue]
+    settings: RunSettings
+    #: seconds
+    duration: float
+    #: --agents, split (None: every agent)
+    agents: list[str] | None
+    #: whether --signal named the signals (else run.toml's `plot` did)
+    signals_from_command_line: bool
+
+
+def check_options(arguments: argparse.Namespace) -> CheckedOptions:
+    """What is wrong in the options of `earl run`, found without reading the spec (UsageError): said before
+    anything runs, by `earl run` and by `earl launch` for each process's `args`. Fills in what follows from
+    them: --signal from run.toml's `plot`, --trace from --plot, --realtime with --transport zenoh."""
+    from earl.runtime.durations import parse_duration
+    from earl.runtime.simulation import read_run_settings
+
+    path = spec_path(arguments.spec)
+    parameters = parse_parameters(arguments.param)
+    try:
+        settings = read_run_settings(path)
+    except ValueError as error:
+        raise UsageError(str(error)) from None
+    try:
+        # an empty `--duration=` is refused, not taken for the default
+        duration = parse_duration(arguments.duration) if arguments.duration is not None else (settings.duration or 10.0)
+    except ValueError as error:
+        raise UsageError(f"--duration: {error}") from None
+    from_command_line = arguments.signal is not None
+    signals = arguments.signal if from_command_line else settings.plot
+    if arguments.plot and not signals:
+        raise UsageError("--plot needs signals: name them with --signal, or `plot = [...]` in run.toml")
+    if arguments.plot:
+        from earl.runtime.plot import plot_output_problem
+
+        problem = plot_output_problem(Path(arguments.plot))
+        if problem is not None:  # said now, not after a run of minutes
+            raise UsageError(f"--plot {arguments.plot!r}: {problem}")
+    arguments.signal = signals
+    if arguments.plot and not arguments.trace:
+        arguments.trace = str(Path(arguments.plot).with_suffix(".mcap"))
+    if arguments.plot and Path(arguments.plot).resolve() == Path(arguments.trace).resolve():
+        raise UsageError(f"--trace and --plot both name {arguments.plot}: the plot would replace the trace")
+    if arguments.trace is not None and not Path(arguments.trace).parent.is_dir():
+        # said here in the CLI's words; `Simulation` would say it after the spec is read, in the API's
+        directory = Path(arguments.trace).parent
+        kind = "is not a directory" if directory.exists() else "does not exist"
+        raise UsageError(f"cannot write the trace {arguments.trace}: the directory `{directory}` {kind}")
+    agents = [a.strip() for a in arguments.agents.split(",") if a.strip()] if arguments.agents is not None else None
+    if agents == []:  # `--agents ,` or `--agents ""`: not "all of them", which is no --agents at all
+        raise UsageError("--agents names no agent; list them, e.g. --agents manip/a,grip/a")
+    if arguments.transport == "zenoh":
+        if not agents:
+            raise UsageError("--transport zenoh needs --agents: the agents this process runs, e.g. task/a")
+        from earl.transport.process import peers_wait  # Zenoh is imported only for a distributed run
+
+        try:
+            peers_wait(arguments.wait_for_peers)
+        except ValueError as error:
+            raise UsageError(f"--wait-for-peers: {error}") from None
+        if arguments.deployment and not Path(arguments.deployment).is_file():
+            # as `earl launch` says it: a file named on the command line that is not there is a usage error
+            kind = "is a directory; name its file" if Path(arguments.deployment).is_dir() else "does not exist"
+            raise UsageError(f"--deployment {arguments.deployment} {kind}")
+        if arguments.zenoh_config and not Path(arguments.zenoh_config).is_file():
+            kind = "a directory, not a file" if Path(arguments.zenoh_config).is_dir() else "no such file"
+            raise UsageError(f"--zenoh-config: {kind}: {arguments.zenoh_config}")
+        arguments.realtime = True  # distribution runs in real time only (docs/distributed.md)
+    elif arguments.zenoh_config or arguments.deployment or arguments.wait_for_peers is not None:
+        raise UsageError("--zenoh-config, --deployment and --wait-for-peers go with --transport zenoh")
+    return CheckedOptions(path, parameters, settings, duration, agents, from_command_line)
 
 
 def _say_what_is_not_recorded(

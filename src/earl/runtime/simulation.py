@@ -62,8 +62,9 @@ class Transport(RemoteLinks, Protocol):
     def inbox(self) -> Inbox: ...
 
     def start(self, specification: str | None = None) -> None:
-        """Every link is declared: announce this process's agents, and the digest of the expanded system it
-        runs (`earl.model.digest.model_digest`), which peers compare with theirs."""
+        """Every link is declared and the run set up: open the links (if they are not open yet) and
+        announce this process's agents, and the digest of the expanded system it runs
+        (`earl.model.digest.model_digest`), which peers compare with theirs."""
 
     def close(self) -> None: ...
 
@@ -145,8 +146,6 @@ class Simulation:
             remote=transport,
         )
         self.transport = transport
-        if transport is not None:
-            transport.start(model_digest(self.expanded))
         memory = set(record_memory or [])
         if "all" in memory:
             memory = set(self.network.by_name)
@@ -158,6 +157,10 @@ class Simulation:
             )
         _refuse_unknown_outputs(record_outputs, self.expanded)
         _warn_of_patterns_matching_nothing(record_links, self.network.link_types)
+        if transport is not None:
+            # last of what the spec and the options can get wrong (its code bound, the environment started):
+            # only now does this process open its links and show itself to its peers
+            transport.start(model_digest(self.expanded))
         self.trace: TraceWriter | None = None
         if trace is not None:
             self.trace = TraceWriter(

@@ -1,7 +1,7 @@
 """One process of a distributed run: its agents, its Zenoh configuration, its peers.
 
-`earl run SPEC --transport zenoh --agents manip/a,grip/a` comes here to open the
-transport before the network is built (docs/distributed.md, "Running by hand").
+`earl run SPEC --transport zenoh --agents manip/a,grip/a` comes here for its transport before
+the network is built; its Zenoh session opens once the run is set up (`ZenohTransport.start`).
 """
 
 from __future__ import annotations
@@ -23,11 +23,10 @@ from earl.transport.zenoh_transport import (
     ZenohTransport,
     config_from_file,
     default_config,
-    network_failure,
 )
 
 DEPLOYMENT_FILE = "deploy.toml"
-#: seconds; see open_transport
+#: seconds; see prepare_transport
 SWITCH_INTERVAL = 0.0005
 
 
@@ -44,7 +43,7 @@ def acting_agents(expanded: System) -> list[str]:
     return [agent_name(agent) for agent in expanded.agents if any(s.kind in real for s in agent.subsystems)]
 
 
-def open_transport(
+def prepare_transport(
     system: System,
     parameters: Mapping[str, Any],
     spec: Path,
@@ -52,8 +51,11 @@ def open_transport(
     arguments: argparse.Namespace,
     environment: str | None = None,
 ) -> tuple[list[str], ZenohTransport, bool]:
-    """The agents this process runs (normalised), its open transport, and whether `environment` (the one
-    run.toml or --environment names, if any) runs here; `ValueError` for bad options.
+    """The agents this process runs (normalised), its transport, and whether `environment` (the one
+    run.toml or --environment names, if any) runs here; `ValueError` for bad options.  The transport's
+    session is not open yet: `Simulation` opens it once the spec's code is bound and the environment
+    started, so that none of their errors is said after the process has shown itself to its peers; a
+    session Zenoh refuses then raises `TransportError`, naming the endpoints and where they come from.
 
     The deployment file says where the environment lives (`Deployment.place_environment`); with
     the user's own --zenoh-config it lives in the process that runs every agent acting on it."""
@@ -108,15 +110,10 @@ def open_transport(
     # Zenoh's callbacks need the GIL: while the scheduler runs Python, a message would wait up
     # to the interpreter's switch interval (5 ms) to be taken; 0.5 ms bounds that delay
     sys.setswitchinterval(SWITCH_INTERVAL)
-    try:
-        transport = ZenohTransport(system.name, names, config, log)
-    except TransportError as error:
-        if arguments.zenoh_config:
-            if network_failure(str(error)):  # not the file's fault: as from a deployment file (exit 1)
-                raise TransportError(f"{error} (with {where})") from None
-            raise ValueError(f"{error} (with {where})") from None  # the user's own file, refused: exit 2
-        raise TransportError(f"{error} ({where}, as {path} says)") from None
-    log(f"earl run: {', '.join(names)} over Zenoh ({where})")
+    # the user's own file that Zenoh refuses is a usage error (exit 2, `earl run` says it)
+    context = f"with {where}" if arguments.zenoh_config else f"{where}, as {path} says"
+    announce = f"earl run: {', '.join(names)} over Zenoh ({where})"
+    transport = ZenohTransport(system.name, names, config, log, announce=announce, context=context)
     return names, transport, environment_here
 
 

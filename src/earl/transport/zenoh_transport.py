@@ -131,10 +131,14 @@ class _Output:
 
     __slots__ = ("_encode", "_put", "statistics")
 
-    def __init__(self, publisher: zenoh.Publisher, codec: LinkCodec, statistics: LinkStatistics) -> None:
-        self._put = publisher.put
+    def __init__(self, codec: LinkCodec, statistics: LinkStatistics) -> None:
+        self._put: Callable[[bytes], object] = _unopened
         self._encode = codec.encode
         self.statistics = statistics
+
+    def attach(self, publisher: zenoh.Publisher) -> None:
+        """The session is open: messages go to `publisher` (bound once, for every message)."""
+        self._put = publisher.put
 
     def deliver(self, value: Any) -> None:
         try:
@@ -143,6 +147,11 @@ class _Output:
             self.statistics.failed += 1
             return
         self.statistics.messages += 1
+
+
+def _unopened(payload: bytes) -> object:
+    """A send before the session is open (none is made: the run starts after `ZenohTransport.start`)."""
+    raise TransportError("the Zenoh session is not open")
 
 
 class _Input:
@@ -222,7 +231,15 @@ class _Input:
 
 
 class ZenohTransport:
-    """One process's Zenoh session, its remote links, and its peers' liveliness."""
+    """One process's Zenoh session, its remote links, and its peers' liveliness.
+
+    The session opens in `start` (or `open`), once the network is built: the links the builder
+    declares meanwhile are declared on the session as it opens. Whatever can fail in the spec's
+    code or the run's options (a function that cannot be bound, an environment that does not
+    start) thus fails before this process listens, connects or shows itself to its peers.
+    `announce` is logged once the session is open; `context` ends the message of a session that
+    cannot open (which endpoints, from which file).
+    """
 
     def __init__(
         self,
@@ -230,6 +247,9 @@ class ZenohTransport:
         local_agents: list[str],
         config: zenoh.Config,
         log: Callable[[str], None],
+        *,
+        announce: str | None = None,
+        context: str | None = None,
     ) -> None:
         self.system = system
         self.local_agents = list(local_agents)
@@ -259,15 +279,38 @@ class ZenohTransport:
         self._peer_specifications: dict[str, tuple[str, str]] = {}
         #: peer processes found running another specification (said once each)
         self._other_specifications: set[str] = set()
+        self._config = config
+        self._announce = announce
+        self._context = context
+        #: None until `open`
+        self.session: zenoh.Session | None = None
+        #: what the builder declared before the session opened: declared on it as it opens
+        self._pending: list[Callable[[zenoh.Session], None]] = []
+        self._closed = False
+
+    def open(self) -> None:
+        """Open the Zenoh session (once) and declare on it every link built so far."""
+        if self.session is not None:
+            return
+        if self._closed:
+            raise TransportError("the transport was closed before its Zenoh session opened")
         try:
-            self.session = zenoh.open(config)
+            session = zenoh.open(self._config)
         except Exception as error:
-            raise TransportError(f"Zenoh could not start: {zenoh_reason(error)}") from None
-        self._declared.append(self.session.declare_queryable(f"earl/{escape(system)}/types/*", self._answer_type_query))
+            context = f" ({self._context})" if self._context else ""
+            raise TransportError(f"Zenoh could not start: {zenoh_reason(error)}{context}") from None
+        self.session = session
+        system = self.system
+        self._declared.append(session.declare_queryable(f"earl/{escape(system)}/types/*", self._answer_type_query))
         self._declared.append(
-            self.session.liveliness().declare_subscriber(alive_prefix(system) + "**", self._on_liveliness, history=True)
+            session.liveliness().declare_subscriber(alive_prefix(system) + "**", self._on_liveliness, history=True)
         )
-        self._declared.append(self.session.declare_subscriber(finished_prefix(system) + "*", self._on_finished))
+        self._declared.append(session.declare_subscriber(finished_prefix(system) + "*", self._on_finished))
+        pending, self._pending = self._pending, []
+        for declare in pending:
+            declare(session)
+        if self._announce:
+            self.log(self._announce)
 
     # ---------------------------------------------------------------- building (RemoteLinks)
     def outgoing(
@@ -278,9 +321,15 @@ class ZenohTransport:
         statistics = LinkStatistics(link, key, "out")
         self.statistics.append(statistics)
         self._peers.add(destination_agent)
-        publisher = self.session.declare_publisher(key, express=True)
-        self._declared.append(publisher)
-        return _Output(publisher, codec, statistics)
+        output = _Output(codec, statistics)
+
+        def declare(session: zenoh.Session) -> None:
+            publisher = session.declare_publisher(key, express=True)
+            self._declared.append(publisher)
+            output.attach(publisher)
+
+        self._when_open(declare)
+        return output
 
     def incoming(
         self, link: str, data_type: DataType, types: TypeSystem, engine: SubsystemEngine, buffer: str, source_agent: str
@@ -295,7 +344,13 @@ class ZenohTransport:
         with self._alive_changed:
             if source_agent not in self._alive:
                 engine.stale.add(buffer)  # stale until its sender is seen
-        self._declared.append(self.session.declare_subscriber(key, remote.on_sample))
+        self._when_open(lambda session: self._declared.append(session.declare_subscriber(key, remote.on_sample)))
+
+    def _when_open(self, declare: Callable[[zenoh.Session], None]) -> None:
+        if self.session is None:
+            self._pending.append(declare)
+        else:
+            declare(self.session)
 
     def _codec(self, types: TypeSystem, data_type: DataType, where: str) -> LinkCodec:
         codec = LinkCodec(types, data_type, where)
@@ -306,7 +361,10 @@ class ZenohTransport:
         """Declare this process's agents alive: called once every link is declared, so a peer that
         sees the token also finds the subscribers.  `specification` is the digest of the expanded
         system this process runs (`earl.model.digest.model_digest`); a peer that runs another is
-        reported once (None: this process does not say, and compares with none)."""
+        reported once (None: this process does not say, and compares with none).  Opens the session
+        first, if it is not open yet (`TransportError` when Zenoh cannot start)."""
+        self.open()
+        assert self.session is not None
         with self._alive_changed:
             self.specification = specification
             seen = list(self._peer_specifications.items())
@@ -471,7 +529,10 @@ class ZenohTransport:
                     "buffer": remote.buffer,
                     "expects": remote.codec.description,
                 }
-                replies = self.session.get(type_key(self.system, received), timeout=2.0, payload=json.dumps(said))
+                session = self.session
+                if session is None:
+                    raise TransportError("the session is not open")
+                replies = session.get(type_key(self.system, received), timeout=2.0, payload=json.dumps(said))
                 for reply in replies:
                     ok = reply.ok
                     if ok is not None:
@@ -490,16 +551,21 @@ class ZenohTransport:
 
     # ---------------------------------------------------------------- the end
     def close(self) -> None:
+        session = self.session
+        if session is None:  # never opened (the run could not be set up): nothing was declared
+            self._pending.clear()
+            self._closed = True
+            return
         if self._tokens:
             # said before the liveliness tokens go, and given a moment to arrive first (declarations and
             # data may travel at different priorities): the peers then know this is an end, not a crash
             for agent in self.local_agents:
                 with contextlib.suppress(Exception):
-                    self.session.put(finished_key(self.system, agent), b"")
+                    session.put(finished_key(self.system, agent), b"")
             wall.sleep(FINISHED_LEAD)
         for token in self._tokens:
             with contextlib.suppress(Exception):  # already gone with the session
                 token.undeclare()  # type: ignore[no-untyped-call]
         self._tokens.clear()
         with contextlib.suppress(Exception):  # closing twice, or Zenoh already shut down at interpreter exit
-            self.session.close()  # type: ignore[no-untyped-call]
+            session.close()  # type: ignore[no-untyped-call]
