@@ -6,6 +6,7 @@ import os
 import re
 import shutil
 import signal
+import socket
 import subprocess
 import sys
 import time
@@ -1338,3 +1339,83 @@ def test_a_run_of_some_agents_plots_their_signals_of_run_toml_and_refuses_anothe
     none = earl_cli(*command)
     assert none.returncode == 1, none.stdout + none.stderr
     assert "no signal of run.toml's `plot` is of an agent this process runs" in " ".join(none.stderr.split())
+
+
+def _interrupted_early(command: list[str], delay: float) -> tuple[int, list[str]] | None:
+    """`command` (run with `python -X importtime`, which says on stderr each module as it is imported)
+    gets SIGINT `delay` seconds after the first module of earl's own is imported: past Python's start,
+    which no program can answer, somewhere in the imports, the parsing or the command itself. Its exit
+    code and what it said on stderr; None when it had ended before the signal."""
+    child = subprocess.Popen(
+        [sys.executable, "-X", "importtime", *command],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        stdin=subprocess.DEVNULL,
+        start_new_session=True,
+    )
+    try:
+        assert child.stderr is not None
+        lines: list[str] = []
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline:
+            line = child.stderr.readline().decode(errors="replace")
+            lines.append(line)
+            if not line or line.rsplit("|", 1)[-1].strip() == "earl._program":
+                break
+        assert lines[-1].strip(), "the program ended before it imported earl"
+        time.sleep(delay)
+        if child.poll() is not None:
+            return None
+        child.send_signal(signal.SIGINT)
+        rest = child.communicate(timeout=60)[1].decode(errors="replace")
+    finally:
+        if child.poll() is None:
+            child.kill()
+            child.wait()
+    said = [line for line in "".join(lines).splitlines() + rest.splitlines() if not line.startswith("import time:")]
+    return child.returncode, said
+
+
+@pytest.mark.parametrize("entry", ["python -m earl", "python -m earl.cli.main", "the earl script"])
+def test_ctrl_c_at_any_moment_of_the_start_is_exit_130_with_one_line(tmp_path: Path, entry: str) -> None:
+    """A Ctrl-C while the program imports its modules printed a KeyboardInterrupt traceback from an import
+    (and `python -m earl` could end by SIGINT itself, -2, instead of exit 130)."""
+    if entry == "the earl script":
+        script = tmp_path / "earl"  # what pip writes for the console script `earl`
+        script.write_text("import sys\nfrom earl.cli.main import script\nsys.exit(script())\n")
+        program = [str(script)]
+    else:
+        program = ["-m", entry.split()[-1]]
+    spec = str(Path(__file__).parent.parent / "examples" / "pick_and_place")
+    interrupted = 0
+    for delay in (0.0, 0.0, 0.01, 0.02, 0.03, 0.05, 0.08, 0.12, 0.2, 0.3):
+        result = _interrupted_early([*program, "check", spec], delay)
+        if result is None:
+            continue  # done before the signal
+        code, said = result
+        assert code == 130, (delay, said)
+        assert len(said) == 1 and "interrupted" in said[0], (delay, said)
+        interrupted += 1
+    assert interrupted >= 4
+
+
+def test_ctrl_c_while_launch_starts_is_exit_130_without_a_traceback(tmp_path: Path) -> None:
+    spec = Path(__file__).parent / "distributed_specs" / "pingpong"
+    ports = []
+    for _ in range(2):
+        with socket.socket() as probe:
+            probe.bind(("127.0.0.1", 0))
+            ports.append(probe.getsockname()[1])
+    deploy = tmp_path / "deploy.toml"
+    deploy.write_text(
+        "".join(
+            f'[[process]]\nagents = ["{agent}"]\nlisten = "tcp/127.0.0.1:{port}"\n'
+            for agent, port in zip(("sender/a", "receiver/a"), ports, strict=True)
+        )
+    )
+    for delay in (0.0, 0.02, 0.05, 0.1):
+        result = _interrupted_early(["-m", "earl", "launch", str(spec), "--deployment", str(deploy)], delay)
+        assert result is not None
+        code, said = result
+        assert code == 130, (delay, said)
+        assert len(said) <= 1 and "Traceback" not in "".join(said), (delay, said)

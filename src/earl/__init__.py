@@ -12,6 +12,8 @@ and writes `.earl` text.
 
 from __future__ import annotations
 
+# first: in the `earl` program, Ctrl-C while it imports is one line, not a traceback (earl/_program.py)
+from earl import _program  # noqa: F401  # isort: skip
 from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING

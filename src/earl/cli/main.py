@@ -4,6 +4,7 @@ Exit codes (documented in docs/language.md, "Errors and exit codes"):
     0  the specification is valid (or the command succeeded)
     1  the specification is invalid (or, with `fmt --check`, not canonical)
     2  usage error: a missing file, an unknown option, a bad value
+    130  interrupted (Ctrl-C), at any point: one line, never a traceback (earl/_program.py)
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ import importlib
 import sys
 from collections.abc import Sequence
 
-from earl import __version__, collector
+from earl import __version__, _program, collector
 
 #: every command, in the order `earl --help` lists them, and the module that implements it
 COMMANDS = {
@@ -36,6 +37,7 @@ ALIASES = {"plot": "trace"}
 EXIT_OK = 0
 EXIT_INVALID = 1
 EXIT_USAGE = 2
+EXIT_INTERRUPTED = 130
 
 DESCRIPTION = """\
 earl reads robot control systems written in EARL, the Embodied Agent-Based Robot
@@ -95,6 +97,18 @@ def _command_named(argv: Sequence[str]) -> str | None:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    """The command `argv` (default: the program's arguments) names, run; its exit code. Ctrl-C at any
+    point is exit 130 with one line (a command that stops in order says its own)."""
+    try:
+        _program.take_over()
+        return _main(argv)
+    except KeyboardInterrupt:  # while the command's modules are imported, its arguments parsed
+        with contextlib.suppress(OSError):
+            sys.stderr.write("earl: interrupted\n")
+        return EXIT_INTERRUPTED
+
+
+def _main(argv: Sequence[str] | None) -> int:
     words = sys.argv[1:] if argv is None else list(argv)
     for stream in (sys.stdout, sys.stderr):
         # a file name of undecodable bytes (`spec\udcfe.earl`) is printed escaped, never a traceback
@@ -112,8 +126,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         result: int = arguments.run(arguments)
     except KeyboardInterrupt:
-        sys.stderr.write("earl: interrupted\n")
-        return 130
+        with contextlib.suppress(OSError):
+            sys.stderr.write("earl: interrupted\n")
+        return EXIT_INTERRUPTED
     except BrokenPipeError:
         # The reader went away (`earl check … | head`): not an error of ours.
         _stdout_to_devnull()
@@ -159,12 +174,19 @@ def script() -> int:
     Only the program does this: a caller of `main` (a test) keeps its collector as it was.
     """
     global AS_PROGRAM
-    AS_PROGRAM = True
-    collector.FREEZE_ON_RESUME = True  # what a command builds lives until the process ends
-    code = main()
-    _end_lingering_threads(code)
-    gc.collect()
-    gc.freeze()
+    code = EXIT_INTERRUPTED
+    try:
+        AS_PROGRAM = True
+        collector.FREEZE_ON_RESUME = True  # what a command builds lives until the process ends
+        code = main()
+        _end_lingering_threads(code)
+        gc.collect()
+        gc.freeze()
+    except KeyboardInterrupt:  # as the command ends: it is done, or said why it stopped
+        with contextlib.suppress(OSError):
+            sys.stderr.write("earl: interrupted\n")
+        code = EXIT_INTERRUPTED
+    _program.hand_back(code)  # and while the interpreter ends
     return code
 
 
