@@ -596,3 +596,17 @@ def test_a_mermaid_label_keeps_a_backslash() -> None:
     from earl.render.mermaid import text
 
     assert text('"a\\"b"') == "#quot;a#92;#quot;b#quot;"
+
+
+def test_a_mermaid_note_is_not_ended_by_end_note_in_a_comment() -> None:
+    """Mermaid's lexer ends a note at the first `end note`, in any case: a comment saying "the end note of
+    Table 5" ended it there, and the rest was read as states."""
+    text = _ASSUMES_NOTHING.replace(
+        "            s -> s when p/pp",
+        "            s -> s when p/pp\n            // the End  Note of Table 5 says so\n            assume p/pp",
+        1,
+    )
+    lines = mermaid_of(Subject(earl.loads(text, "plain.earl")), "fsm", None).splitlines()
+    note = lines[lines.index("    note right of fsm") :]
+    assert note[2] == "        the End#160;Note of Table 5 says so"
+    assert [line for line in lines if "end note" in line.lower()] == ["    end note"]

@@ -816,3 +816,21 @@ def test_every_kind_of_element_keeps_its_comment_and_where_it_was_written() -> N
     without = re.search(r"transition <'s,t/t'> s_t_t\s+first s\s+if p_pp\s+then t \{(.*?)\n\s*\}", exported, re.DOTALL)
     assert without is not None and "From every.earl:" in without.group(1) and "Priority" not in without.group(1)
     assert not syntax_errors(exported)
+
+
+def test_a_doc_joins_a_comment_s_lines_and_leaves_out_a_section_above_a_blank_line() -> None:
+    """Each line of a comment was wrapped apart (`…  An imported` / `file` / `holds …`), and an imported
+    file's header, parted by a blank line from its first declaration, became that declaration's doc."""
+    text = (
+        "system s\n\n// Section: the parameters of the line, which the next block of comments is about and\n"
+        "// this one heads.\n\n// The count of belts on the line, which the controller drives one\n"
+        "// after another.\n// - at least one\n// - at most four\nparam N: int = 2\n"
+    )
+    exported = export_sysml(earl.loads(text, "s.earl"))
+    doc = exported[exported.index("attribute N") :]
+    doc = doc[: doc.index("*/")]
+    assert "Section" not in doc
+    assert "The count of belts on the line, which the controller drives one after another." in " ".join(
+        line.strip(" *") for line in doc.splitlines()
+    )
+    assert "* - at least one\n" in doc and "* - at most four\n" in doc  # a list keeps its items

@@ -7,6 +7,8 @@ links agents directly (the buffers go in the link's label) and a transition from
 
 from __future__ import annotations
 
+import re
+
 from earl.model.elements import FSM, Agent, Subsystem
 from earl.model.text import expression_text
 from earl.render.build import Subject
@@ -103,11 +105,17 @@ def fsm_mermaid(fsm: FSM, owner: str, subsystem: Subsystem | None = None) -> str
         lines.append("    }")
         lines.append(f"    note right of {FSM_STATE}")
         for assumption in assumptions:
-            lines.append(f"        assume {text(assumption.formula)}")
+            lines.append(f"        assume {_note_text(text(assumption.formula))}")
             if assumption.comment:
-                lines.append(f"        {text(assumption.comment)}")
+                lines.append(f"        {_note_text(text(assumption.comment))}")
         lines.append("    end note")
     return "\n".join(lines) + "\n"
+
+
+def _note_text(line: str) -> str:
+    """A line of a note: Mermaid's lexer ends a note at the first `end note` in it, in any case, so the
+    space of one in the text is a non-breaking one (`#160;`)."""
+    return re.sub(r"(?i)\b(end)\s+(note)", r"\1#160;\2", line)
 
 
 def mermaid_of(subject: Subject, view: str, target: str | None) -> str:
