@@ -283,8 +283,7 @@ def test_a_comment_that_ends_a_block_stays_in_it(tmp_path: Path, capsys: pytest.
         lines = formatted.splitlines()
         assert lines[lines.index(comment) + 1] == closing, formatted
     assert (
-        "            * -> r when f/pp  // from every state\n            // however it was reached\n\n            // TODO"
-        in formatted
+        "            * -> r when f/pp  // from every state  // however it was reached\n            // TODO" in formatted
     )
     assert "// not this one: after the `}`, it goes to what follows\nr/r {" in formatted
     again = tmp_path / "again.earl"
@@ -365,3 +364,20 @@ def test_a_member_a_robot_lists_twice_keeps_its_own_comments() -> None:
         "link b,a: b/a.cs.o -> a/a.cs.i\n"
     )
     assert earl.loads(text, "c.earl").to_earl() == text
+
+
+def test_a_comment_on_a_later_line_of_a_clause_ends_that_clause_s_line() -> None:
+    """`tf = {f/pf}` / `then {g/pf}  // the second stage sends`: the comment went above the next clause (`tc`),
+    and the SysML export said it was about `tc`."""
+    text = (
+        "system s\na/a {\n    cs {\n        period 1 ms\n        p/pp = true\n        q/pp = p/pp\n"
+        "            // inside\n            and true\n        f/pf(->)\n        g/pf(->)\n        b/bb {\n"
+        "            tf = {f/pf}\n                then {g/pf}  // the second stage sends\n"
+        "            tc = p/pp\n                or q/pp  // the reverse case\n            ec = not p/pp\n"
+        "        }\n        fsm {\n            initial b\n            state b: b/bb\n        }\n    }\n}\n"
+    )
+    formatted = earl.loads(text, "s.earl").to_earl()
+    assert "        q/pp = p/pp and true  // inside\n" in formatted
+    assert "            tf = {f/pf} then {g/pf}  // the second stage sends\n" in formatted
+    assert "            tc = p/pp or q/pp  // the reverse case\n            ec = not p/pp\n" in formatted
+    assert earl.loads(formatted, "s.earl").to_earl() == formatted

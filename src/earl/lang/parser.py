@@ -383,12 +383,27 @@ def attach_comments(declarations: list[Any], comments: list[Token], path: str, t
     last_line: dict[int, int] = {}  # id(element) -> line of its last leading (or closing) comment
     commented: list[Any] = []
     last_closing = 0
+    # the statements written over several lines that hold no others (`tc = a/pp` / `or b/pp`, a long
+    # `/pf` header), by their first line: a comment on one of their later lines stays with them
+    spanning = sorted(
+        (e.location.line, e.location.end_line, e)
+        for e in statements
+        if not isinstance(e, _BLOCKS) and e.location.end_line > e.location.line
+    )
+    spanning_starts = [start for start, _, _ in spanning]
     for comment in comments:
         said = str(comment)
         line = comment.line or 1
         owner = by_line.get(line)
         if owner is not None and (comment.column or 1) > owner.location.column:
             owner.comments.trailing = said
+            continue
+        within = bisect_left(spanning_starts, line) - 1  # the last statement that starts above the comment
+        if within >= 0 and spanning[within][1] >= line and line not in by_line:
+            # written one line by `earl fmt`: the comment ends that line, after any it had already
+            statement = spanning[within][2]
+            trailing = statement.comments.trailing
+            statement.comments.trailing = said if trailing is None else f"{trailing.rstrip()}  {said}"
             continue
         while next_block < len(blocks) and blocks[next_block].location.line < line:
             block = blocks[next_block]
