@@ -138,7 +138,9 @@ def spec_line(copy: Path, text: str) -> int:
     return 1 + next(number for number, line in enumerate(lines) if line.strip().startswith(text))
 
 
-def test_an_actuator_missing_from_the_model_is_refused_before_the_run_at_the_effector(tmp_path: Path) -> None:
+def test_an_actuator_missing_from_the_model_is_a_fault_naming_it_not_a_refusal_of_the_system(tmp_path: Path) -> None:
+    """No convention of names tells a missing actuator from a family numbered otherwise (`motor[K in 0..N-1]/re`
+    driving `motor1`…), so the run starts, and the effector's fault names the actuator and the model's."""
     copy = pendulum_copy(tmp_path)
     xml = copy / "pendulum.xml"
     text = xml.read_text(encoding="utf-8")
@@ -147,40 +149,9 @@ def test_an_actuator_missing_from_the_model_is_refused_before_the_run_at_the_eff
         text = text.replace(line, "")
     xml.write_text(text, encoding="utf-8")
     result = earl_cli("run", str(copy), "--duration", "10ms", cwd=copy)
-    assert result.returncode == 1, result.stdout
-    assert "fault" not in result.stdout + result.stderr  # said before the first iteration, not 12 faults later
-    assert result.stderr.splitlines()[0] == (
-        "error[EARL-X021]: the model has no actuator named `motor2`, which `arm/a.motor[2]/re` acts on: each member "
-        "of `arm/a.motor[K]/re` acts on the actuator named after it (`arm/a.motor[1]/re` acts on `motor1`); the "
-        "model's actuators: motor1"
-    )
-    assert f" --> system.earl:{spec_line(copy, 'motor[K in 1..J]/re {')}:5" in result.stderr
-    assert "nothing was executed" in result.stderr
-
-
-def test_a_misspelt_actuator_is_refused_with_the_name_meant(tmp_path: Path) -> None:
-    copy = pendulum_copy(tmp_path)
-    xml = copy / "pendulum.xml"
-    xml.write_text(xml.read_text(encoding="utf-8").replace("motor2", "motr2"), encoding="utf-8")  # and its encoder
-    with pytest.raises(EarlError) as refused:
-        earl.simulate(earl.load(copy))
-    [diagnostic] = refused.value.diagnostics
-    assert diagnostic.code == "EARL-X021" and "the model's actuators: motor1, motr2" in diagnostic.message
-    assert diagnostic.hint == "did you mean `motr2`?"
-    assert diagnostic.location is not None and diagnostic.location.line == spec_line(copy, "motor[K in 1..J]/re {")
-
-
-def test_an_encoder_missing_for_one_member_of_a_family_is_refused(tmp_path: Path) -> None:
-    copy = pendulum_copy(tmp_path, old='    <numeric name="earl.encoder.motor2" data="100 4096"/>\n', new="")
-    result = earl_cli("run", str(copy), "--duration", "10ms")
-    assert result.returncode == 1
-    assert (
-        f"error[EARL-X021]: {copy / 'pendulum.xml'} declares no encoder for `motor2`, which `arm/a.motor[2]/re` "
-        "acts on, but does for `motor1`"
-    ) in result.stderr
-    assert (
-        '= hint: add <numeric name="earl.encoder.motor2" data="GEAR COUNTS"/> to its <custom> section' in result.stderr
-    )
+    assert "EARL-X021" not in result.stderr
+    said = result.stdout + result.stderr
+    assert "fault" in said and "motor2" in said, said
 
 
 def test_effectors_whose_code_names_the_actuators_otherwise_are_not_held_to_their_own_names(tmp_path: Path) -> None:

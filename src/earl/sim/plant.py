@@ -209,15 +209,14 @@ class MujocoPlant:
 
     def bind(self, system: System) -> None:
         """Refuse, before the first iteration, a system whose real effectors and receptors the model cannot
-        serve (the runtime calls it with the system as it runs; docs/simulation.md says what is checked).
+        serve (the runtime calls it with the system as it runs; docs/simulation.md says what is checked):
+        the timestep must divide their periods, so that the plant is stepped to each of their instants
+        exactly.
 
-        A real effector or receptor acts on the model by names its code gives (`set_input("motor2", …)`), so
-        a missing name would only show as a fault in every iteration. The names are checked where the spec
-        shows them: the members of a family that acts on actuators (sensors, joints) named after them,
-        `motor[1]/re` on `motor1`, must all find theirs. And the timestep must divide their periods, so that
-        the plant is stepped to each of their instants exactly."""
-        families = _real_families(system)
-        problems = self._unserved_members(families) + self._unmet_periods(families)
+        The names of the model's objects they act on are not checked: their code gives them
+        (`set_input(arm.actuator_name(joint), …)`), and no convention of names (`motor[2]/re` on `motor2`)
+        tells a missing actuator from a family numbered otherwise (`motor[K in 0..N-1]/re` on `motor1…`)."""
+        problems = self._unmet_periods(_real_families(system))
         if problems:
             raise EarlError(problems)
 
@@ -248,31 +247,6 @@ class MujocoPlant:
                 f'<option timestep="{_divisor_below(math.gcd(*periods), step) / 1e9:g}"/>',
             )
         ]
-
-    def _unserved_members(self, families: dict[str, list[_Member]]) -> list[Diagnostic]:
-        names = {
-            "actuator": self.actuator_names(),
-            "sensor": [self.model.sensor(i).name for i in range(self.model.nsensor)],
-            "joint": [self.model.joint(i).name for i in range(self.model.njnt)],
-        }
-        problems = []
-        for family, members in families.items():
-            # the kind of the model's objects most members are named after; none: its code names them otherwise
-            kind, served = max(
-                ((kind, [m for m in members if m.addressed in known]) for kind, known in names.items()),
-                key=lambda found: len(found[1]),
-            )
-            if not served:
-                continue
-            missing = [member for member in members if member not in served]
-            if missing:
-                problems.append(_missing(kind, names[kind], family, served, missing))
-            elif kind == "actuator":
-                with_encoder = [member for member in members if member.addressed in self.encoders]
-                without = [member for member in members if member not in with_encoder]
-                if with_encoder and without:
-                    problems.append(_missing_encoders(self.origin.name, with_encoder, without))
-        return problems
 
     def set_input(self, actuator: str, value: float) -> float:
         """Set an actuator's input (a winding current for a `motor` with gear = kt·G); returns what is applied.
@@ -441,10 +415,9 @@ class MujocoPlant:
 
 @dataclass(frozen=True)
 class _Member:
-    """A real effector or receptor, and the name of the model's object it is named after (`motor[2]/re`: `motor2`)."""
+    """A real effector or receptor, as a message about its period names it."""
 
     shown: str
-    addressed: str
     location: SourceLocation | None
     #: nanoseconds; None: it runs when a message wakes it
     period: int | None
@@ -466,7 +439,7 @@ def _real_families(system: System) -> dict[str, list[_Member]]:
             if index and subsystem.family is not None:  # `arm/a.motor[2]/re` is a member of `arm/a.motor[K]/re`
                 family = shown.rsplit("[", 1)[0] + f"[{subsystem.family.index}]/{subsystem.kind}"
             period = None if subsystem.period is None else round(subsystem.period.seconds * 1e9)
-            member = _Member(shown, subsystem.name + index, subsystem.location, period)
+            member = _Member(shown, subsystem.location, period)
             families.setdefault(family, []).append(member)
     return families
 
@@ -482,41 +455,6 @@ def _divisor_below(period: int, step: int) -> int:
     """The longest step, no longer than `step`, that divides `period` (nanoseconds): what to suggest instead."""
     # a million tries: the periods' common divisor in nanoseconds is a round number unless written to the nanosecond
     return next((period // n for n in range(1, min(period, 10**6) + 1) if period % n == 0 and period // n <= step), 1)
-
-
-def _listed(members: list[_Member], what: Callable[[_Member], str]) -> str:
-    return ", ".join(f"`{what(member)}`" for member in members)
-
-
-def _missing(kind: str, known: list[str], family: str, served: list[_Member], missing: list[_Member]) -> Diagnostic:
-    """A member of a family whose others find the model's objects named after them, and it not."""
-    some = len(missing) > 1
-    taken = {member.addressed for member in served}
-    suggestions = [did_you_mean(member.addressed, [name for name in known if name not in taken]) for member in missing]
-    examples = "; ".join(f"`{member.shown}` acts on `{member.addressed}`" for member in served[:2])
-    return Diagnostic(
-        Severity.ERROR,
-        f"the model has no {kind} named {_listed(missing, lambda m: m.addressed)}, which "
-        f"{_listed(missing, lambda m: m.shown)} {'act' if some else 'acts'} on: each member of `{family}` acts on "
-        f"the {kind} named after it ({examples}); the model's {kind}s: {', '.join(known) or 'none'}",
-        missing[0].location,
-        code="EARL-X021",
-        hint="; ".join(hint for hint in suggestions if hint)
-        or f"add {'them' if some else 'it'} to the model's <{kind}> section, or correct the name there",
-    )
-
-
-def _missing_encoders(origin: str, served: list[_Member], missing: list[_Member]) -> Diagnostic:
-    some = len(missing) > 1
-    return Diagnostic(
-        Severity.ERROR,
-        f"{origin} declares no encoder for {_listed(missing, lambda m: m.addressed)}, which "
-        f"{_listed(missing, lambda m: m.shown)} {'act' if some else 'acts'} on, but does for "
-        f"{_listed(served, lambda m: m.addressed)}",
-        missing[0].location,
-        code="EARL-X021",
-        hint=f'add <numeric name="{ENCODER_PREFIX}{missing[0].addressed}" data="GEAR COUNTS"/> to its <custom> section',
-    )
 
 
 def _pose(position: FloatArray, quaternion: FloatArray) -> Pose:
