@@ -26,3 +26,32 @@ def test_python_dash_m_earl_is_the_earl_command(tmp_path: Path) -> None:
     assert missing.returncode == 2
     assert "no such file" in missing.stderr
     assert "Traceback" not in missing.stderr
+
+
+def test_a_ctrl_c_the_shell_has_earl_ignore_stays_ignored(tmp_path: Path) -> None:
+    """`trap '' INT` (or a background job of a script): earl's own Ctrl-C handler replaced the ignore, and
+    `earl doc` ended with 130 instead of writing the document."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    flagship = Path(__file__).parent.parent / "examples" / "pick_and_place"
+    child = subprocess.Popen(
+        [sys.executable, "-m", "earl", "doc", str(flagship), "-o", str(tmp_path / "site")],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN),
+    )
+    try:
+        deadline = time.monotonic() + 60
+        for delay in (0.05, 0.2, 0.5):  # in the imports, and in the command
+            time.sleep(delay)
+            if child.poll() is None:
+                child.send_signal(signal.SIGINT)
+        _, err = child.communicate(timeout=max(1.0, deadline - time.monotonic()))
+    finally:
+        if child.poll() is None:
+            child.kill()
+    assert child.returncode == 0, err
+    assert (tmp_path / "site" / "index.html").is_file()

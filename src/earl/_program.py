@@ -50,9 +50,11 @@ PROGRAM = False
 
 
 def guard() -> None:
-    """`interrupted` for Ctrl-C, in the program only."""
+    """`interrupted` for Ctrl-C, in the program only, and only where Ctrl-C would interrupt it: a SIGINT
+    that the shell had the program ignore (`trap '' INT`, a job started with `&` by a non-interactive
+    shell, `nohup`) stays ignored."""
     global PROGRAM
-    PROGRAM = is_program()
+    PROGRAM = is_program() and signal.getsignal(signal.SIGINT) is signal.default_int_handler
     if PROGRAM:
         with contextlib.suppress(ValueError, OSError):  # not the main thread: Python's handler stays
             signal.signal(signal.SIGINT, interrupted)
