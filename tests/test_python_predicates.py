@@ -222,9 +222,12 @@ def test_a_predicate_that_returns_no_boolean_is_a_fault_and_the_condition_counts
         sys.modules.pop("limits", None)
 
 
-def test_a_predicate_may_return_a_numpy_boolean(tmp_path: Path) -> None:
+@pytest.mark.parametrize("numpy_boolean", ["numpy.bool_", "numpy.array"])
+def test_a_predicate_may_return_a_numpy_boolean(tmp_path: Path, numpy_boolean: str) -> None:
+    """NumPy's Boolean, alone or as an array of no dimension (what `numpy.all(…)` of a 0-d array gives)."""
     code = "import numpy\n\n" + CODE.replace(
-        'return inputs.x >= context.parameters["LIMIT"]', 'return numpy.bool_(inputs.x >= context.parameters["LIMIT"])'
+        'return inputs.x >= context.parameters["LIMIT"]',
+        f'return {numpy_boolean}(inputs.x >= context.parameters["LIMIT"])',
     )
     sim = earl.simulate(earl.load(write(tmp_path, code)))
     try:

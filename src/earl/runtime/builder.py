@@ -472,7 +472,7 @@ def _python_predicate(engine: SubsystemEngine, predicate: PrimitivePredicate) ->
 
     Anything else (None, "no", NaN, a number) is a fault rather than its truth value: `return "no"` or a
     NaN would hold, and a function that forgot its `return` would never hold, without a word."""
-    from numpy import bool_
+    from numpy import bool_, ndarray
 
     assert predicate.implementation is not None
     function = resolve_callable(
@@ -505,8 +505,10 @@ def _python_predicate(engine: SubsystemEngine, predicate: PrimitivePredicate) ->
                 raise known from None
             if result is True or result is False:
                 known = values[name] = result
-            elif isinstance(result, bool_):
-                known = values[name] = bool(result)
+            elif isinstance(result, bool_) or (
+                isinstance(result, ndarray) and result.shape == () and result.dtype == bool
+            ):
+                known = values[name] = bool(result)  # NumPy's Boolean, alone or as an array of no dimension
             else:
                 known = values[name] = PredicateFault(
                     name,
