@@ -610,3 +610,34 @@ def test_a_mermaid_note_is_not_ended_by_end_note_in_a_comment() -> None:
     note = lines[lines.index("    note right of fsm") :]
     assert note[2] == "        the End#160;Note of Table 5 says so"
     assert [line for line in lines if "end note" in line.lower()] == ["    end note"]
+
+
+def test_each_composition_arrow_of_the_types_view_leaves_the_row_of_its_field(system: System) -> None:
+    """Figures 9 and 11: the diamond of `currentJointPos` sat beside `currentOperationalPos` and its arrow
+    crossed the other, for the arrows left the block anywhere; each now starts at its field's port."""
+    diagram = build_diagram(system, "types")
+    assert 'port="f0"' in diagram.dot and 'tailport="f0:e"' in diagram.dot
+    root = ElementTree.fromstring(diagram.svg())
+    rows: dict[str, dict[str, float]] = {}  # node -> field -> y of its row's text
+    starts: list[tuple[str, str, float]] = []  # (node, field, y where the arrow starts)
+    for group in root.iter(f"{SVG_NAMESPACE}g"):
+        title = group.findtext(f"{SVG_NAMESPACE}title") or ""
+        texts = ["".join(t.itertext()) for t in group.iter(f"{SVG_NAMESPACE}text")]
+        ys = [float(t.get("y", "nan")) for t in group.iter(f"{SVG_NAMESPACE}text")]
+        if group.get("class") == "node":
+            rows[title] = {text.split(":")[0]: y for text, y in zip(texts, ys, strict=True) if ": " in text}
+        elif group.get("class") == "edge":
+            path = group.find(f"{SVG_NAMESPACE}path")
+            assert path is not None
+            start = re.match(r"M([-\d.]+),([-\d.]+)", path.get("d", ""))
+            assert start is not None and texts
+            starts.append((title.split("->")[0].split(":")[0], texts[0], float(start.group(2))))
+    assert {(node, field) for node, field, _ in starts} >= {
+        ("n_type_ManipulatorState", "currentJointPos"),
+        ("n_type_ManipulatorState", "currentOperationalPos"),
+        ("n_type_ManipulatorCommand", "jointPosSetpoint"),
+        ("n_type_ManipulatorCommand", "operationalPosSetpoint"),
+    }
+    for node, field, y in starts:
+        nearest = min(rows[node], key=lambda name: abs(rows[node][name] - y))
+        assert nearest == field, (node, field, y, rows[node])

@@ -57,16 +57,28 @@ def agent_types(system: System, agent: Agent) -> list[TypeDefinition]:
     return closure(system, roots)
 
 
+def field_port(index: int) -> str:
+    """The DOT port of a struct's field row, the tail of the composition arrow its field draws."""
+    return f"f{index}"
+
+
+#: The port of an alias's one row (`= double[N]`).
+ALIAS_PORT = "alias"
+
+
 def _block(definition: TypeDefinition) -> str:
     if isinstance(definition, StructType):
         stereotype = "dataType"
         rows = [
-            f'<tr><td align="left">{html(f.name)}: {html(type_text(f.data_type))}{" [0..1]" if f.optional else ""}&#160;&#160;</td></tr>'
-            for f in definition.fields
+            f'<tr><td port="{field_port(index)}" align="left">{html(f.name)}: {html(type_text(f.data_type))}'
+            f"{' [0..1]' if f.optional else ''}&#160;&#160;</td></tr>"
+            for index, f in enumerate(definition.fields)
         ]
     else:
         stereotype = "valueType"
-        rows = [f'<tr><td align="left">= {html(type_text(definition.data_type))}&#160;&#160;</td></tr>']
+        rows = [
+            f'<tr><td port="{ALIAS_PORT}" align="left">= {html(type_text(definition.data_type))}&#160;&#160;</td></tr>'
+        ]
     head = f"<tr><td><i>«{stereotype}»</i><br/><b>{html(definition.name)}</b></td></tr>"
     separator = "<hr/>" if rows else ""
     return (
@@ -89,20 +101,21 @@ def types_view(definitions: Sequence[TypeDefinition], owner: str, subject: str =
         names.append(definition.name)
         graph.add(f'{node_id("type", definition.name)} [shape="plain", label={_block(definition)}];')
     for definition in definitions:
-        parts: list[tuple[str, str]] = []
+        # (label, the row's port, target): each arrow leaves the row of the field it stands for.
+        parts: list[tuple[str, str, str]] = []
         if isinstance(definition, StructType):
-            for field in definition.fields:
-                parts += [(field.name, target) for target in referenced_type_names(field.data_type)]
+            for index, field in enumerate(definition.fields):
+                parts += [(field.name, field_port(index), target) for target in referenced_type_names(field.data_type)]
         else:
-            parts += [("", target) for target in referenced_type_names(definition.data_type)]
-        for label, target in parts:
+            parts += [("", ALIAS_PORT, target) for target in referenced_type_names(definition.data_type)]
+        for label, port, target in parts:
             if target in shown:
                 connected |= {definition.name, target}
                 if label:
                     names.append(label)
                 graph.add(
                     f"{node_id('type', definition.name)} -> {node_id('type', target)} "
-                    f'[dir="both", arrowtail="diamond", arrowhead="open", label="{html(label)}"];'
+                    f'[tailport="{port}:e", dir="both", arrowtail="diamond", arrowhead="open", label="{html(label)}"];'
                 )
     if not definitions:  # Graphviz draws no cluster without a node: the frame and its header would vanish
         graph.add('none [shape="plaintext", fontsize="10", label="no struct or alias: only primitive types"];')
