@@ -641,3 +641,33 @@ def test_each_composition_arrow_of_the_types_view_leaves_the_row_of_its_field(sy
     for node, field, y in starts:
         nearest = min(rows[node], key=lambda name: abs(rows[node][name] - y))
         assert nearest == field, (node, field, y, rows[node])
+
+
+@pytest.mark.parametrize(
+    "target", ["task/a.cs", "manip/a.cs", "grip/a.cs", "manip/a.motorController[K]/ve", "grip/a.fingerController/ve"]
+)
+def test_every_transition_label_of_an_fsm_is_inside_its_frame(system: System, target: str) -> None:
+    """dot sizes a cluster by its nodes: `[phaseComplete/pp and not manipulatorEmergency/pp]` of
+    approach→grasp, and the labels of self-loops on the right, were drawn across the stm frame's border.
+    The frame's margin is widened by what sticks out."""
+    import json
+
+    from earl.render.graphviz import _dot, label_overflow
+
+    diagram = build_diagram(system, "fsm", target)
+    assert label_overflow(json.loads(_dot(diagram.dot, "json"))) > 0  # as dot lays the source out
+    assert label_overflow(json.loads(_dot(diagram.laid_out, "json"))) <= 0  # as earl draws it
+    assert diagram.laid_out != diagram.dot and 'margin="14"' in diagram.dot
+    # what is drawn is the widened source: the frame's rectangle holds the label's text
+    root = ElementTree.fromstring(diagram.svg())
+    frame = next(g for g in root.iter(f"{SVG_NAMESPACE}g") if g.findtext(f"{SVG_NAMESPACE}title") == "cluster_frame")
+    polygon = frame.find(f"{SVG_NAMESPACE}polygon")
+    assert polygon is not None
+    right = max(float(point.split(",")[0]) for point in polygon.get("points", "").split())
+    centres = [
+        float(text.get("x", "nan"))
+        for g in root.iter(f"{SVG_NAMESPACE}g")
+        if g.get("class") == "edge"
+        for text in g.iter(f"{SVG_NAMESPACE}text")
+    ]
+    assert centres and max(centres) < right

@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
-from earl.render.graphviz import run_dot
+from earl.render.graphviz import fit_frame, run_dot
 
 
 @dataclass(frozen=True)
@@ -16,8 +17,14 @@ class Diagram:
     #: The element names the diagram shows, so tests and tooltips know what to look for.
     names: tuple[str, ...] = ()
 
+    @cached_property
+    def laid_out(self) -> str:
+        """The DOT source drawn: `dot` with the frame widened to hold every edge label (one more
+        layout by Graphviz; see `fit_frame`)."""
+        return fit_frame(self.dot)
+
     def render(self, output_format: str = "svg") -> bytes:
-        return run_dot(self.dot, output_format)
+        return run_dot(self.laid_out, output_format)
 
     def svg(self) -> str:
         return self.render("svg").decode("utf-8")

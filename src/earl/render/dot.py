@@ -19,6 +19,13 @@ FILL = {
 }
 
 
+#: Space between the frame and what it holds, in points; `earl.render.graphviz.fit_frame` widens it
+#: when an edge label sticks out (dot leaves edge labels out of a cluster's bounding box).
+FRAME_MARGIN = 14
+#: Ends the line of the frame's margin, so that the margin can be found and widened.
+FRAME_MARGIN_COMMENT = "// the frame's margin"
+
+
 def html(text: str) -> str:
     """Text for an HTML-like label."""
     return escape(text, quote=True)
@@ -77,7 +84,8 @@ class Graph:
             f'  edge [fontname="{FONT}", fontsize="9", arrowsize="0.7", color="#333333"];\n'
             "  subgraph cluster_frame {\n"
             f"    label={frame_label(self.header)};\n"
-            '    labeljust="l"; labelloc="t"; style="solid"; color="#333333"; margin="14";\n'
+            '    labeljust="l"; labelloc="t"; style="solid"; color="#333333";\n'
+            f'    margin="{FRAME_MARGIN}";  {FRAME_MARGIN_COMMENT}\n'
             f"{body}\n"
             "  }\n"
             f"{after}\n"

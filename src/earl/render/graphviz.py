@@ -8,9 +8,15 @@ calling the program ourselves lets a missing `dot` become one clear message.
 
 from __future__ import annotations
 
+import json
+import math
 import os
+import re
 import shutil
 import subprocess
+from typing import Any
+
+from earl.render.dot import FRAME_MARGIN_COMMENT
 
 #: Output formats earl asks `dot` for.
 FORMATS = ("svg", "png")
@@ -36,6 +42,13 @@ def run_dot(source: str, output_format: str) -> bytes:
     """`source` (DOT text) laid out and drawn as `svg` or `png`."""
     if output_format not in FORMATS:
         raise ValueError(f"unknown Graphviz output format {output_format!r}")
+    output = _dot(source, output_format)
+    if output_format == "svg":
+        output = standalone_svg(output.decode("utf-8")).encode("utf-8")
+    return output
+
+
+def _dot(source: str, output_format: str) -> bytes:
     arguments = [dot_program(), f"-T{output_format}"]
     if output_format == "png":
         arguments.append("-Gdpi=144")  # screen text stays readable when the picture is shrunk
@@ -52,10 +65,57 @@ def run_dot(source: str, output_format: str) -> bytes:
         raise GraphvizError(
             f"Graphviz could not draw the diagram: {detail or 'exit status ' + str(completed.returncode)}"
         )
-    output = completed.stdout
-    if output_format == "svg":
-        output = standalone_svg(output.decode("utf-8")).encode("utf-8")
-    return output
+    return completed.stdout
+
+
+_FRAME_MARGIN = re.compile(r'margin="(\d+)";  ' + re.escape(FRAME_MARGIN_COMMENT))
+
+
+def fit_frame(source: str, attempts: int = 3) -> str:
+    """`source` with the SysML frame widened until every label of an edge inside it is inside it.
+
+    dot sizes a cluster by its nodes only: the label of a slanting edge or of a self-loop on the
+    right-hand state of an FSM was drawn across the frame's border.  The source is laid out, how
+    far such labels stick out is measured, and the frame's margin grows by that much; a source
+    without the frame (or whose labels fit) comes back unchanged.
+    """
+    for _ in range(attempts):
+        found = _FRAME_MARGIN.search(source)
+        if found is None:
+            return source
+        overflow = label_overflow(json.loads(_dot(source, "json")))
+        if overflow <= 0:
+            return source
+        margin = int(found.group(1)) + math.ceil(overflow) + 4
+        source = source[: found.start(1)] + str(margin) + source[found.end(1) :]
+    return source
+
+
+def label_overflow(layout: dict[str, Any], frame: str = "cluster_frame") -> float:
+    """How far, in points, the text of a label of an edge between two nodes of `frame` reaches
+    beyond the frame, on its worst side (0 or less: all inside); `layout` is dot's JSON output."""
+    objects = layout.get("objects", [])
+    clusters = [o for o in objects if o.get("name") == frame and "bb" in o]
+    if not clusters:
+        return 0.0
+    left, bottom, right, top = (float(v) for v in clusters[0]["bb"].split(","))
+    inside = set(clusters[0].get("nodes", []))
+    worst = 0.0
+    for edge in layout.get("edges", []):
+        if edge.get("tail") not in inside or edge.get("head") not in inside:
+            continue  # a link to an agent outside the frame is labelled outside it on purpose
+        size = 14.0
+        for key in ("_ldraw_", "_hldraw_", "_tldraw_", "_xldraw_"):
+            for operation in edge.get(key, []):
+                if operation.get("op") == "F":
+                    size = float(operation.get("size", size))
+                if operation.get("op") != "T":
+                    continue
+                x, y = (float(v) for v in operation["pt"])
+                width = float(operation.get("width", 0))
+                start = {"l": x, "r": x - width}.get(operation.get("align", "c"), x - width / 2)
+                worst = max(worst, left - start, start + width - right, bottom - (y - 0.25 * size), y + size - top)
+    return worst
 
 
 def standalone_svg(svg: str) -> str:
