@@ -72,18 +72,19 @@ _FRAME_MARGIN = re.compile(r'margin="(\d+)";  ' + re.escape(FRAME_MARGIN_COMMENT
 
 
 def fit_frame(source: str, attempts: int = 3) -> str:
-    """`source` with the SysML frame widened until every label of an edge inside it is inside it.
+    """`source` with the SysML frame widened until every edge inside it, and its label, is inside it.
 
     dot sizes a cluster by its nodes only: the label of a slanting edge or of a self-loop on the
-    right-hand state of an FSM was drawn across the frame's border.  The source is laid out, how
-    far such labels stick out is measured, and the frame's margin grows by that much; a source
-    without the frame (or whose labels fit) comes back unchanged.
+    right-hand state of an FSM was drawn across the frame's border, and a link going back to an
+    earlier subsystem could loop around a block along the border or outside it.  The source is
+    laid out, how far such labels and paths stick out is measured, and the frame's margin grows
+    by that much; a source without the frame (or whose edges fit) comes back unchanged.
     """
     for _ in range(attempts):
         found = _FRAME_MARGIN.search(source)
         if found is None:
             return source
-        overflow = label_overflow(json.loads(_dot(source, "json")))
+        overflow = frame_overflow(json.loads(_dot(source, "json")))
         if overflow <= 0:
             return source
         margin = int(found.group(1)) + math.ceil(overflow) + 4
@@ -91,9 +92,14 @@ def fit_frame(source: str, attempts: int = 3) -> str:
     return source
 
 
-def label_overflow(layout: dict[str, Any], frame: str = "cluster_frame") -> float:
-    """How far, in points, the text of a label of an edge between two nodes of `frame` reaches
-    beyond the frame, on its worst side (0 or less: all inside); `layout` is dot's JSON output."""
+#: How near, in points, a path drawn inside the frame may come to its border.
+EDGE_CLEARANCE = 6.0
+
+
+def frame_overflow(layout: dict[str, Any], frame: str = "cluster_frame") -> float:
+    """How far, in points, an edge between two nodes of `frame` reaches beyond the frame on its worst
+    side: the text of its label, or its path to within `EDGE_CLEARANCE` of the border (0 or less:
+    all inside); `layout` is dot's JSON output."""
     objects = layout.get("objects", [])
     clusters = [o for o in objects if o.get("name") == frame and "bb" in o]
     if not clusters:
@@ -103,7 +109,9 @@ def label_overflow(layout: dict[str, Any], frame: str = "cluster_frame") -> floa
     worst = 0.0
     for edge in layout.get("edges", []):
         if edge.get("tail") not in inside or edge.get("head") not in inside:
-            continue  # a link to an agent outside the frame is labelled outside it on purpose
+            continue  # a link to an agent outside the frame is drawn outside it on purpose
+        if "invis" in edge.get("style", ""):
+            continue
         size = 14.0
         for key in ("_ldraw_", "_hldraw_", "_tldraw_", "_xldraw_"):
             for operation in edge.get(key, []):
@@ -115,7 +123,35 @@ def label_overflow(layout: dict[str, Any], frame: str = "cluster_frame") -> floa
                 width = float(operation.get("width", 0))
                 start = {"l": x, "r": x - width}.get(operation.get("align", "c"), x - width / 2)
                 worst = max(worst, left - start, start + width - right, bottom - (y - 0.25 * size), y + size - top)
+        for operation in edge.get("_draw_", []):
+            if operation.get("op") not in ("b", "B"):
+                continue
+            for x, y in _bezier_points([(float(a), float(b)) for a, b in operation["points"]]):
+                worst = max(
+                    worst,
+                    left + EDGE_CLEARANCE - x,
+                    x - (right - EDGE_CLEARANCE),
+                    bottom + EDGE_CLEARANCE - y,
+                    y - (top - EDGE_CLEARANCE),
+                )
     return worst
+
+
+def _bezier_points(points: list[tuple[float, float]], steps: int = 8) -> list[tuple[float, float]]:
+    """Points along a piecewise cubic Bézier curve (dot's spline: 1 + 3n control points)."""
+    result = points[:1]
+    for index in range(0, len(points) - 3, 3):
+        p0, p1, p2, p3 = points[index : index + 4]
+        for step in range(1, steps + 1):
+            t = step / steps
+            a, b, c, d = (1 - t) ** 3, 3 * t * (1 - t) ** 2, 3 * t * t * (1 - t), t**3
+            result.append(
+                (
+                    a * p0[0] + b * p1[0] + c * p2[0] + d * p3[0],
+                    a * p0[1] + b * p1[1] + c * p2[1] + d * p3[1],
+                )
+            )
+    return result
 
 
 def standalone_svg(svg: str) -> str:

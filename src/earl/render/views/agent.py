@@ -95,7 +95,7 @@ def subsystem_block(subsystem: Subsystem) -> str:
 def agent_view(agent: Agent, system: System | None = None) -> Diagram:
     name = agent_name(agent)
     graph = Graph(f"ibd [Agent] {name}")
-    graph.graph_attributes["ranksep"] = "1.1"
+    graph.graph_attributes["ranksep"] = "0.5"
     names: list[str] = [name]
     nodes: dict[Key, tuple[str, Subsystem]] = {}
     if not agent.subsystems:  # Graphviz draws no cluster without a node: the frame and its header would vanish

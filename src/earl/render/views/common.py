@@ -76,16 +76,22 @@ def node_id(*parts: str) -> str:
 def link_statements(number: int, source: str, destination: str, name: str, data_type: str, backward: bool) -> list[str]:
     """A link drawn through a small label node, so its name and data type sit on its own path.
 
-    A `backward` link runs against the layout's direction (a state going back to
-    the Control Subsystem) and loops around the blocks; its first half does not
-    constrain the layout, so its label lands just before the Input Buffer it feeds
-    instead of far beyond its source.
+    A `backward` link runs against the layout's direction (a Virtual Effector's state going
+    back to the Control Subsystem): its label sits just before the Input Buffer it feeds, and
+    its first half is declared from the label to the Output Buffer (drawn without arrowheads,
+    so it reads the same), which dot then routes back through the frame past the blocks in
+    between.  Left free of the layout (`constraint=false`), that half looped along the
+    frame's border or outside it.
     """
     node = f"link_{number}"
     label = f"<{html(name)}<br/><i>{html(data_type)}</i>>"
-    constraint = ', constraint="false"' if backward else ""
+    first = (
+        f'{node} -> {source} [dir="none", tooltip="{html(name)}"];'
+        if backward
+        else f'{source} -> {node} [arrowhead="none", tooltip="{html(name)}"];'
+    )
     return [
         f'{node} [shape="plain", fontsize="9", label={label}, tooltip="{html(name)}"];',
-        f'{source} -> {node} [arrowhead="none", tooltip="{html(name)}"{constraint}];',
+        first,
         f'{node} -> {destination} [tooltip="{html(name)}"];',
     ]
