@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from html import escape
 
 from earl.render.document.tree import (
@@ -58,6 +59,8 @@ td.note { color: var(--muted); }
 tr:target, td:target { background: #fff6cc; }
 figure { margin: 16px 0 28px; }
 figure img { max-width: 100%; height: auto; border: 1px solid var(--rule); background: white; }
+figure .diagram { overflow-x: auto; max-width: 100%; }
+figure .diagram img { max-width: none; }
 figcaption { color: var(--muted); font-size: 13px; margin-top: 4px; }
 @media print { nav { display: none; } main { margin-left: 0; } }
 """
@@ -105,7 +108,29 @@ def table(item: Table) -> str:
     )
 
 
-def block(item: Block) -> str:
+#: A diagram wider than the page is shrunk to fit it, but never below this share of its own size:
+#: at 43 % (the manip/a agent view) its text was 5 px high.  Beyond, its box scrolls sideways.
+LEGIBLE_SCALE = 0.8
+
+
+def figure(item: Figure, widths: Mapping[str, float]) -> str:
+    """The diagram linked to its SVG (which opens at full size); one whose width in CSS pixels is known
+    fits the page down to `LEGIBLE_SCALE` of that width, and scrolls sideways in its box when wider."""
+    anchor = f' id="{escape(item.anchor)}"' if item.anchor else ""
+    width = widths.get(item.path)
+    size = ""
+    if width:
+        size = f' style="width: clamp({LEGIBLE_SCALE * width:.0f}px, 100%, {width:.0f}px)"'
+    image = (
+        f'<a href="{escape(item.path)}" title="open the diagram at full size">'
+        f'<img src="{escape(item.path)}" alt="{escape(item.alt)}"{size}></a>'
+    )
+    if width:
+        image = f'<div class="diagram">{image}</div>'
+    return f"<figure{anchor}>{image}<figcaption>{content(item.caption)}</figcaption></figure>"
+
+
+def block(item: Block, widths: Mapping[str, float] | None = None) -> str:
     if isinstance(item, Paragraph):
         return f"<p>{content(item.content)}</p>"
     if isinstance(item, BulletList):
@@ -113,17 +138,13 @@ def block(item: Block) -> str:
     if isinstance(item, Table):
         return table(item)
     if isinstance(item, Figure):
-        anchor = f' id="{escape(item.anchor)}"' if item.anchor else ""
-        return (
-            f'<figure{anchor}><a href="{escape(item.path)}"><img src="{escape(item.path)}" alt="{escape(item.alt)}"></a>'
-            f"<figcaption>{content(item.caption)}</figcaption></figure>"
-        )
-    return section(item)
+        return figure(item, widths or {})
+    return section(item, widths)
 
 
-def section(item: Section) -> str:
+def section(item: Section, widths: Mapping[str, float] | None = None) -> str:
     tag = f"h{min(item.level, 6)}"
-    inner = "\n".join(block(b) for b in item.blocks)
+    inner = "\n".join(block(b, widths) for b in item.blocks)
     return f'<section id="{escape(item.anchor)}">\n<{tag}>{content(item.title)}</{tag}>\n{inner}\n</section>'
 
 
@@ -140,8 +161,9 @@ def _navigation(sections: list[Section]) -> str:
     return "<nav><ul>" + "".join(items) + "</ul></nav>"
 
 
-def render_html(document: Document) -> str:
-    body = "\n".join(section(s) for s in document.sections)
+def render_html(document: Document, widths: Mapping[str, float] | None = None) -> str:
+    """The page; `widths` gives the natural width in CSS pixels of the diagrams drawn, by path."""
+    body = "\n".join(section(s, widths) for s in document.sections)
     return (
         "<!DOCTYPE html>\n"
         '<html lang="en">\n<head>\n<meta charset="utf-8">\n'

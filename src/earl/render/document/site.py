@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
@@ -50,10 +51,14 @@ def write_site(subject: Subject, diagnostics: Sequence[Diagnostic], directory: P
     with ThreadPoolExecutor(max_workers=max(1, min(4, os.cpu_count() or 1))) as pool:
         drawn = list(pool.map(lambda diagram: diagram.render("svg"), unique))
     paths = []
+    widths: dict[str, float] = {}
     for diagram, svg in zip(unique, drawn, strict=True):
         path = folder / f"{diagram.slug}.svg"
         path.write_bytes(svg)
         paths.append(path)
+        width = svg_width(svg)
+        if width is not None:
+            widths[f"diagrams/{path.name}"] = width
     # an element renamed since the last run must not leave its old picture behind; what earl did not
     # write there (a logo, the user's own drawings) stays
     manifest = folder / MANIFEST
@@ -66,9 +71,20 @@ def write_site(subject: Subject, diagnostics: Sequence[Diagnostic], directory: P
     html = directory / "index.html"
     markdown = directory / "index.md"
     # a file name of undecodable bytes is written escaped (`\udcfe`), not as a UnicodeEncodeError
-    html.write_text(render_html(document), encoding="utf-8", errors="backslashreplace")
+    html.write_text(render_html(document, widths), encoding="utf-8", errors="backslashreplace")
     markdown.write_text(render_markdown(document), encoding="utf-8", errors="backslashreplace")
     return DocumentResult(html, markdown, tuple(paths))
+
+
+_SVG_WIDTH = re.compile(rb'<svg\s[^>]*?\bwidth="([\d.]+)(pt|px)?"')
+
+
+def svg_width(svg: bytes) -> float | None:
+    """The natural width of a diagram drawn by Graphviz, in CSS pixels (its `width` is in points)."""
+    found = _SVG_WIDTH.search(svg[:4096])
+    if found is None:
+        return None
+    return float(found.group(1)) * (4 / 3 if found.group(2) == b"pt" else 1)
 
 
 def _head(path: Path) -> str:
