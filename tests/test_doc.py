@@ -159,6 +159,38 @@ def test_table_5_states_what_the_fsm_assumes(site: Path) -> None:
     )
 
 
+def test_table_5_of_an_fsm_of_one_state_says_so_instead_of_an_empty_transition_header(site: Path) -> None:
+    """motor[K]/re and fingerDrive/re have one state and no transition: Table 5 showed a `t | PREDICATE |
+    priority` header over no row.  A line under the caption says the FSM has one state and stays in it, and
+    the table holds the terminal conditions under their own header, in the HTML and in the Markdown."""
+    from markdown_it import MarkdownIt
+
+    html = (site / "index.html").read_text(encoding="utf-8")
+    read = MarkdownIt("commonmark").enable("table").render((site / "index.md").read_text(encoding="utf-8"))
+    for qualified, escaped in [
+        ("manip/a.motor[K]/re", r"manip/a\.motor\[K\]/re"),
+        ("grip/a.fingerDrive/re", r"grip/a\.fingerDrive/re"),
+    ]:
+        table = re.search(rf"<caption>Table 5: initial conditions labelling {escaped}\.fsm.*?</table>", html)
+        assert table is not None
+        said = f'<div class="note">No transition: {qualified}.fsm has one state, <code>drive</code>, and stays in it.</div>'
+        assert said in table.group()
+        assert "<thead><tr><th>bb</th><th>PREDICATE (terminal condition tc; error condition ec)</th></tr></thead>" in (
+            table.group()
+        )
+        assert "<th>t</th>" not in table.group() and "priority" not in table.group()
+        written = re.search(
+            rf"<p><strong>Table 5: initial conditions labelling {escaped}\.fsm[^<]*</strong></p>\s*"
+            rf"<p>No transition: {escaped}\.fsm has one state, <code>drive</code>, and stays in it\.</p>\s*"
+            r"<table>\s*<thead>\s*<tr>\s*<th>bb</th>",
+            read,
+        )
+        assert written is not None
+    # an FSM with transitions keeps its `t` header and its `bb` sub-header, and says nothing of the kind
+    cs = re.search(r"<caption>Table 5: initial conditions labelling manip/a\.cs\.fsm.*?</table>", html)
+    assert cs is not None and "<th>t</th>" in cs.group() and "No transition" not in cs.group()
+
+
 # ---------------------------------------------------------------- the written document
 
 
@@ -394,7 +426,8 @@ def test_document_opens_in_headless_chromium_without_errors(site: Path, tmp_path
             )
             # Table 5's caption as a reader sees it: the assumption on a line of its own, not bold
             assumed = page.evaluate(
-                "Array.from(document.querySelectorAll('caption .note')).map(n => [n.innerText, "
+                "Array.from(document.querySelectorAll('caption .note')).filter(n => n.innerText.startsWith('Assumed'))"
+                ".map(n => [n.innerText, "
                 "getComputedStyle(n).fontWeight, n.getBoundingClientRect().top > "
                 "n.parentElement.getBoundingClientRect().top + 5])"
             )

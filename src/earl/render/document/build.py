@@ -479,12 +479,17 @@ class DocumentBuilder:
         return Table(text(f"Table 4: definitions of {qualified}.pp.fun"), header, rows)
 
     def conditions_table(self, subsystem: Subsystem, qualified: str, scope: Scope) -> Table:
+        transitions = transition_table(subsystem)
+        # an FSM of one state (a Real Effector's `drive`) has no transition: a `t` header over no row said
+        # nothing, so the table holds the terminal conditions alone and a line under the caption says why
         header = [[cell("t"), cell("PREDICATE (initial condition ic)"), cell("priority")]]
+        if not transitions:
+            header = [[cell("bb"), cell("PREDICATE (terminal condition tc; error condition ec)")]]
         rows: list[list[Cell]] = []
         #: transitions between the same two states, with different conditions, are valid and share a name:
         #: the second `one,two` is anchored `…-one-two-2`, so every id of the page stays unique
         seen: dict[str, int] = {}
-        for row in transition_table(subsystem):
+        for row in transitions:
             seen[row.name] = seen.get(row.name, 0) + 1
             anchor = slug("t", qualified, row.name) + ("" if seen[row.name] == 1 else f"-{seen[row.name]}")
             if row.source is None:
@@ -498,30 +503,49 @@ class DocumentBuilder:
                     cell("—" if row.priority is None else str(row.priority)),
                 ]
             )
-        rows.append(
-            [
-                cell((Strong(text("bb")),)),
-                cell((Strong(text("PREDICATE (terminal condition tc; error condition ec)")),)),
-                cell(""),
-            ]
-        )
+        if transitions:
+            rows.append(
+                [
+                    cell((Strong(text("bb")),)),
+                    cell((Strong(text("PREDICATE (terminal condition tc; error condition ec)")),)),
+                    cell(""),
+                ]
+            )
         for condition in condition_table(subsystem):
             predicate: Content = (Text("tc: "), *self.expression_content(condition.terminal_condition, scope))
             if condition.error_condition is not None:
                 predicate += (Text("; ec: "), *self.expression_content(condition.error_condition, scope))
-            rows.append(
-                [
-                    cell(code(f"{condition.behaviour}/bb"), anchor=scope.anchor(condition.behaviour, "bb")),
-                    cell(predicate),
-                    cell(""),
-                ]
-            )
+            row_cells = [
+                cell(code(f"{condition.behaviour}/bb"), anchor=scope.anchor(condition.behaviour, "bb")),
+                cell(predicate),
+            ]
+            rows.append(row_cells + ([cell("")] if transitions else []))
         caption = text(
             f"Table 5: initial conditions labelling {qualified}.fsm transitions and terminal conditions of {qualified}.bb"
         )
+        notes: list[Content] = []
+        if not transitions and subsystem.fsm is not None:
+            states = subsystem.fsm.states
+            if len(states) == 1:
+                notes.append(
+                    (
+                        Text(f"No transition: {qualified}.fsm has one state, "),
+                        Code(states[0].name),
+                        Text(", and stays in it."),
+                    )
+                )
+            else:
+                notes.append(
+                    (
+                        Text(
+                            f"No transition: {qualified}.fsm has {len(states)} states and stays in its initial state "
+                        ),
+                        Code(subsystem.fsm.initial),
+                        Text("."),
+                    )
+                )
         # the manual's caption states what the FSM assumes ("It is assumed that task/a can not set simultaneously
         # …"): the conditions above are read under those facts, so they are said where the conditions are
-        notes: list[Content] = []
         for assumption in assumption_table(subsystem.fsm):
             said = with_code(f" — {assumption.comment}") if assumption.comment else ()
             notes.append((Text("Assumed: "), *self.expression_content(assumption.formula, scope), *said))
