@@ -311,7 +311,10 @@ def _present_branch(schema: Any) -> Any:
 
 @dataclass
 class Series:
-    """One signal: its subsystem, its name inside the subsystem, and (time s, value) samples."""
+    """One signal: its subsystem, its name inside the subsystem, and (time s, value) samples.
+
+    A value holds until the next sample; NaN is no value, a gap in the line: an infinite real, or a
+    message without the (optional) field or array element, until a message has it again."""
 
     subsystem: str
     name: str
@@ -372,6 +375,9 @@ def read_signals(path: Path, names: list[str]) -> Signals:
     #: whether that field holds text when present (an optional string never sent is no number either)
     null_meaning: dict[tuple[str, str], tuple[bool, bool]] = {}
     stays: dict[str, list[tuple[float, str]]] = {}
+    #: each topic's leaves that its messages have held: one that a later message lacks (an optional
+    #: field withdrawn, an array sent shorter) has no value from then on, a gap until it comes back
+    held: dict[str, set[tuple[str, str]]] = {}
     end = 0.0
     cut: list[bool] = []
     for topic, _, time, data in _messages(path, [*wanted, "/earl/run"], cut):
@@ -384,6 +390,7 @@ def read_signals(path: Path, names: list[str]) -> Signals:
             if topic.endswith("/fsm"):
                 stays.setdefault(subsystem, []).append((seconds, str(data["to"])))
                 continue
+            present: set[tuple[str, str]] = set()
             for raw, value in iter_leaves(data):
                 leaf = raw
                 if buffer:
@@ -418,6 +425,15 @@ def read_signals(path: Path, names: list[str]) -> Signals:
                     found = leaves[key] = ([], [])
                 found[0].append(seconds)
                 found[1].append(number)
+                present.add(key)
+            before = held.setdefault(topic, present)
+            if before is not present:
+                for key in before - present:
+                    times, numbers = leaves[key]
+                    if not math.isnan(numbers[-1]):  # the line ends here, not at the next value
+                        times.append(seconds)
+                        numbers.append(math.nan)
+                before |= present
         except (KeyError, TypeError, ValueError, AttributeError):
             raise _not_from_earl(path, topic) from None
     series: list[Series] = []

@@ -1,0 +1,67 @@
+"""`read_signals` and `plot_signals` on small traces written here, message by message."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+from mcap.writer import Writer
+
+from earl.runtime.trace_reader import read_signals
+
+SECOND = 1_000_000_000
+
+
+def write_trace(path: Path, states: list[tuple[float, str]], messages: list[tuple[float, Any]], schema: Any) -> None:
+    """A trace of subsystem `s/a.cs`: its FSM's `states` and what its output buffer `cmd` sent."""
+    with open(path, "wb") as stream:
+        writer = Writer(stream)
+        writer.start()
+        fsm_schema = writer.register_schema("Fsm", "jsonschema", json.dumps({"type": "object"}).encode())
+        fsm = writer.register_channel("s/a.cs/fsm", "json", fsm_schema, {"subsystem": "s/a.cs"})
+        link_schema = writer.register_schema("Cmd", "jsonschema", json.dumps(schema).encode())
+        link = writer.register_channel(
+            "link/s/a:cs,ve", "json", link_schema, {"link": "s/a:cs,ve", "source": "s/a.cs.cmd"}
+        )
+        for time, state in states:
+            data = {"from": "", "to": state, "transition": "t"}
+            writer.add_message(fsm, int(time * SECOND), json.dumps(data).encode(), int(time * SECOND))
+        for time, value in messages:
+            writer.add_message(link, int(time * SECOND), json.dumps(value).encode(), int(time * SECOND))
+        writer.finish()
+
+
+GOAL = {
+    "type": "object",
+    "properties": {
+        "goal": {
+            "anyOf": [
+                {"type": "object", "properties": {"x": {"type": "array", "items": {"type": "number"}}}},
+                {"type": "null"},
+            ]
+        },
+        "ready": {"type": "boolean"},
+    },
+}
+
+
+def test_an_optional_field_a_later_message_withdraws_ends_its_line_there(tmp_path: Path) -> None:
+    """A message without the optional field (null) is a gap from its time on, not the last value held;
+    the line comes back with the field. An array sent shorter ends the line of the elements it lost."""
+    trace = tmp_path / "t.mcap"
+    messages = [
+        (1.0, {"goal": {"x": [1.0, 5.0]}, "ready": True}),
+        (2.0, {"goal": None, "ready": True}),
+        (2.5, {"goal": None, "ready": True}),
+        (3.0, {"goal": {"x": [3.0]}, "ready": False}),
+    ]
+    write_trace(trace, [(0.0, "idle")], messages, GOAL)
+    data = read_signals(trace, ["s/a.cs.cmd.goal.x[*]", "s/a.cs.cmd.ready"])
+    found = {series.name: list(zip(series.times, series.values, strict=True)) for series in data.series}
+    first, second = found["cmd.goal.x[0]"], found["cmd.goal.x[1]"]
+    assert [time for time, _ in first] == [1.0, 2.0, 3.0]
+    assert first[0][1] == 1.0 and math.isnan(first[1][1]) and first[2][1] == 3.0
+    assert [time for time, _ in second] == [1.0, 2.0] and math.isnan(second[1][1])  # one gap, not one a message
+    assert [value for _, value in found["cmd.ready"]] == [1.0, 1.0, 1.0, 0.0]
