@@ -65,3 +65,35 @@ def test_an_optional_field_a_later_message_withdraws_ends_its_line_there(tmp_pat
     assert first[0][1] == 1.0 and math.isnan(first[1][1]) and first[2][1] == 3.0
     assert [time for time, _ in second] == [1.0, 2.0] and math.isnan(second[1][1])  # one gap, not one a message
     assert [value for _, value in found["cmd.ready"]] == [1.0, 1.0, 1.0, 0.0]
+
+
+def test_legends_are_beside_the_panels_and_hide_no_data_however_many_series(tmp_path: Path) -> None:
+    """Each panel's legend is right of its axes, inside the figure, which is widened for it (the panels
+    keep their width); twenty series go in columns no taller than the panel, and past the ten colours
+    the line style tells them apart."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from earl.runtime.plot import PANEL_WIDTH, draw_signals
+
+    trace = tmp_path / "t.mcap"
+    schema = {"type": "object", "properties": {"v": {"type": "array", "items": {"type": "number"}}}}
+    messages = [(time, {"v": [time * k for k in range(20)]}) for time in (0.0, 1.0, 2.0)]
+    write_trace(trace, [(0.0, "idle"), (1.0, "moving")], messages, schema)
+    figure = draw_signals(read_signals(trace, ["s/a.cs.cmd.v[*]"]), "a title")
+    try:
+        renderer = figure.canvas.get_renderer()  # type: ignore[attr-defined]
+        assert figure.get_figwidth() > PANEL_WIDTH
+        for axis in figure.axes:
+            legend = axis.get_legend()
+            box, panel = legend.get_window_extent(renderer), axis.get_window_extent(renderer)
+            assert box.x0 > panel.x1 and box.x1 <= figure.bbox.x1
+            assert box.height <= panel.height * 1.2
+            texts = [text.get_text() for text in legend.get_texts()]
+            assert texts[:2] == ["cmd.v[0]", "cmd.v[1]"] and texts[-2:] == ["state idle", "state moving"]
+        styles = {line.get_label(): line.get_linestyle() for line in figure.axes[0].get_lines()}
+        assert styles["cmd.v[0]"] == "-" and styles["cmd.v[10]"] == "--"
+    finally:
+        plt.close(figure)

@@ -4,13 +4,17 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from earl.diagnostics import did_you_mean
 from earl.model.elements import Memory, OutputBuffer, Subsystem, System
 from earl.model.expressions import Literal
 from earl.model.text import subsystem_name
 from earl.model.types import ArrayType, PrimitiveType, StructType
-from earl.runtime.trace_reader import CUT, read_signals, signal_element
+from earl.runtime.trace_reader import CUT, Signals, read_signals, signal_element
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 #: the kinds of file a plot is written as, by the suffix (what Matplotlib's Agg backend writes)
 PLOT_SUFFIXES = (".png", ".svg", ".pdf", ".jpg", ".jpeg", ".eps", ".ps")
@@ -163,8 +167,21 @@ def _not_a_number(named: str, resolved: object) -> str | None:
     return None
 
 
+#: the width of the panels' plotting area, in inches; the legends go to the right of it
+PANEL_WIDTH = 10.0
+#: the height of a panel, in inches
+PANEL_HEIGHT = 2.6
+#: the legends' font size, in points
+LEGEND_FONT = 7
+#: the line styles a panel goes through once the ten colours have each been used
+LINE_STYLES = ("-", "--", ":", "-.")
+
+
 def plot_signals(trace: Path, signals: list[str], output: Path, title: str | None = None) -> list[str]:
     """Write a PNG (or SVG/PDF, by the suffix): one panel per element of a subsystem, its FSM states behind.
+
+    Each panel's legend is to the right of it, outside the axes, so that it hides no data: the figure
+    is as much wider as the widest legend needs.
 
     Returns a line for each signal left out because it had no value in the run (`Signals.empty`)."""
     import matplotlib
@@ -173,40 +190,76 @@ def plot_signals(trace: Path, signals: list[str], output: Path, title: str | Non
     import matplotlib.pyplot as plt
 
     data = read_signals(trace, signals)
+    figure = draw_signals(data, title)
+    figure.savefig(output, dpi=110)
+    plt.close(figure)
+    return [f"{line}; drawn without it" for line in data.empty] + ([CUT] if data.cut else [])
+
+
+def draw_signals(data: Signals, title: str | None = None) -> Figure:
+    """The figure of `plot_signals`, not yet written (Matplotlib's Agg backend chosen by the caller)."""
+    import matplotlib.pyplot as plt
+
     panels = list(dict.fromkeys((s.subsystem, signal_element(s.name)) for s in data.series))
-    figure, axes = plt.subplots(len(panels), 1, figsize=(10, 2.6 * len(panels) + 0.6), sharex=True, squeeze=False)
+    height = PANEL_HEIGHT * len(panels) + 0.6
+    figure, axes = plt.subplots(len(panels), 1, figsize=(PANEL_WIDTH, height), sharex=True, squeeze=False)
     palette = plt.get_cmap("Pastel1")
+    legends = []
     for row, (subsystem, element) in enumerate(panels):
         axis = axes[row][0]
         colours: dict[str, object] = {}
+        bands = []
         for start, stop, state in data.bands.get(subsystem, []):
             colour = colours.setdefault(state, palette(len(colours) % 9))
-            axis.axvspan(start, stop, color=colour, alpha=0.6, linewidth=0, label=f"state {state}")
-        for series in data.series:
-            if series.subsystem == subsystem and signal_element(series.name) == element:
-                # a value holds until the next one: extend the last to the end of the run
-                times = [*series.times, data.end]
-                values = [*series.values, series.values[-1]]
-                sparse = len(series.times) < 50
-                axis.step(
-                    times,
-                    values,
-                    where="post",
-                    label=series.name,
-                    linewidth=1.2,
-                    marker="o" if sparse else None,
-                    markersize=3,
-                    markevery=list(range(len(series.times))) if sparse else None,
-                )
-        handles, labels = axis.get_legend_handles_labels()
-        unique = dict(zip(labels, handles, strict=False))
-        axis.legend(unique.values(), unique.keys(), loc="upper right", fontsize=7, ncol=2)
+            bands.append(axis.axvspan(start, stop, color=colour, alpha=0.6, linewidth=0, label=f"state {state}"))
+        lines = []
+        drawn = [s for s in data.series if s.subsystem == subsystem and signal_element(s.name) == element]
+        for number, series in enumerate(drawn):
+            # a value holds until the next one: extend the last to the end of the run
+            times = [*series.times, data.end]
+            values = [*series.values, series.values[-1]]
+            sparse = len(series.times) < 50
+            (line,) = axis.step(
+                times,
+                values,
+                where="post",
+                label=series.name,
+                linewidth=1.2,
+                # past the ten colours of the cycle, the line style tells the series apart
+                linestyle=LINE_STYLES[number // 10 % len(LINE_STYLES)],
+                marker="o" if sparse else None,
+                markersize=3,
+                markevery=list(range(len(series.times))) if sparse else None,
+            )
+            lines.append(line)
+        # the signals first, then the states (one entry each, however many stays)
+        entries = {line.get_label(): line for line in lines}
+        for band in bands:
+            entries.setdefault(str(band.get_label()), band)
+        # as many rows as the panel's height holds, the rest in more columns
+        rows = max(1, int((PANEL_HEIGHT - 0.7) * 72 / (LEGEND_FONT * 1.55)))
+        legend = axis.legend(
+            list(entries.values()),
+            list(entries.keys()),
+            loc="upper left",
+            bbox_to_anchor=(1.01, 1.0),
+            borderaxespad=0.0,
+            fontsize=LEGEND_FONT,
+            ncol=-(-len(entries) // rows),
+        )
+        legend.set_in_layout(False)  # placed by the widening below, not by squeezing the panels
+        legends.append(legend)
         axis.set_title(f"{subsystem} {element}", fontsize=9, loc="left")
         axis.grid(True, alpha=0.3)
     axes[-1][0].set_xlabel("time [s]")
     if title:
         figure.suptitle(title)
     figure.tight_layout()
-    figure.savefig(output, dpi=110)
-    plt.close(figure)
-    return [f"{line}; drawn without it" for line in data.empty] + ([CUT] if data.cut else [])
+    # widen the figure by the widest legend, the panels keeping their width
+    renderer = figure.canvas.get_renderer()  # type: ignore[attr-defined]
+    widest = max(legend.get_window_extent(renderer).width for legend in legends) / figure.dpi
+    gap = 0.01 * axes[0][0].get_position().width * PANEL_WIDTH
+    width = PANEL_WIDTH + widest + gap + 0.15
+    figure.set_size_inches(width, height)
+    figure.tight_layout(rect=(0.0, 0.0, PANEL_WIDTH / width, 1.0))
+    return figure
