@@ -97,3 +97,41 @@ def test_legends_are_beside_the_panels_and_hide_no_data_however_many_series(tmp_
         assert styles["cmd.v[0]"] == "-" and styles["cmd.v[10]"] == "--"
     finally:
         plt.close(figure)
+
+
+def test_a_panel_of_booleans_reads_false_and_true_and_each_panel_says_what_it_shows(tmp_path: Path) -> None:
+    """A Boolean panel has the ticks `false` and `true` on a fixed range around 0..1, an all-false one
+    too (it had a range of ±0.04 with decimal ticks); a panel with numbers keeps numeric ticks. The y
+    axis names the signals: one by its name, several by what they share, `[*]` for differing indices."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from earl.runtime.plot import draw_signals, panel_label
+
+    trace = tmp_path / "t.mcap"
+    messages = [(time, {"goal": {"x": [time, 1.0]}, "ready": False}) for time in (0.0, 1.0, 2.0)]
+    write_trace(trace, [(0.0, "idle")], messages, GOAL)
+    data = read_signals(trace, ["s/a.cs.cmd.ready"])
+    assert [series.boolean for series in data.series] == [True]
+    figure = draw_signals(data)
+    try:
+        axis = figure.axes[0]
+        assert [label.get_text() for label in axis.get_yticklabels()] == ["false", "true"]
+        assert axis.get_ylim() == (-0.25, 1.25) and axis.get_ylabel() == "cmd.ready"
+    finally:
+        plt.close(figure)
+    mixed = read_signals(trace, ["s/a.cs.cmd.goal.x[*]", "s/a.cs.cmd.ready"])
+    assert [series.boolean for series in mixed.series] == [False, False, True]
+    figure = draw_signals(mixed)
+    try:
+        axis = figure.axes[0]
+        assert "true" not in [label.get_text() for label in axis.get_yticklabels()]
+        assert axis.get_ylabel() == "cmd"
+    finally:
+        plt.close(figure)
+    assert panel_label(["windingCurrent[1]", "windingCurrent[6]"]) == "windingCurrent[*]"
+    assert panel_label(["cmd.jointPosSetpoint[0]", "cmd.jointPosSetpoint[5]"]) == "cmd.jointPosSetpoint[*]"
+    assert panel_label(["mc[1].desiredWindingCurrent", "mc[2].desiredWindingCurrent"]) == "mc[*].desiredWindingCurrent"
+    assert panel_label(["cmd.jointPosSetpoint[0]", "cmd.operationalPosSetpoint.position[1]"]) == "cmd"

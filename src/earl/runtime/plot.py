@@ -250,6 +250,11 @@ def draw_signals(data: Signals, title: str | None = None) -> Figure:
         legend.set_in_layout(False)  # placed by the widening below, not by squeezing the panels
         legends.append(legend)
         axis.set_title(f"{subsystem} {element}", fontsize=9, loc="left")
+        # no unit: a trace does not carry any
+        axis.set_ylabel(_wrapped(panel_label([series.name for series in drawn])), fontsize=8)
+        if all(series.boolean for series in drawn):
+            axis.set_yticks([0.0, 1.0], ["false", "true"])
+            axis.set_ylim(-0.25, 1.25)
         axis.grid(True, alpha=0.3)
     axes[-1][0].set_xlabel("time [s]")
     if title:
@@ -263,3 +268,38 @@ def draw_signals(data: Signals, title: str | None = None) -> Figure:
     figure.set_size_inches(width, height)
     figure.tight_layout(rect=(0.0, 0.0, PANEL_WIDTH / width, 1.0))
     return figure
+
+
+def panel_label(names: list[str]) -> str:
+    """What a panel's signals are, for its y axis: the name of one (`currentFingerPos`); for several,
+    the name they share with `[*]` where their indices differ (`windingCurrent[*]`,
+    `manipulatorCommand.jointPosSetpoint[*]`), else the part they start with (`manipulatorCommand`)."""
+    paths = [re.findall(r"\[[^\]]*\]|\.?[^.\[]+", name) for name in names]
+    first = paths[0]
+    if all(len(path) == len(first) for path in paths):
+        merged = []
+        for steps in zip(*paths, strict=True):
+            if len(set(steps)) == 1:
+                merged.append(steps[0])
+            elif all(step.startswith("[") for step in steps):
+                merged.append("[*]")
+            else:
+                break
+        else:
+            return "".join(merged)
+    shared: list[str] = []
+    for steps in zip(*paths, strict=False):
+        if len(set(steps)) > 1:
+            break
+        shared.append(steps[0])
+    return "".join(shared)
+
+
+def _wrapped(label: str, width: int = 30) -> str:
+    """A long label on lines of about `width` characters, broken before a `.` (a y axis is short)."""
+    lines = [""]
+    for part in re.findall(r"\.?[^.]+", label):
+        if lines[-1] and len(lines[-1]) + len(part) > width:
+            lines.append("")
+        lines[-1] += part
+    return "\n".join(lines)

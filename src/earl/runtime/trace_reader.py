@@ -320,6 +320,8 @@ class Series:
     name: str
     times: list[float]
     values: list[float]
+    #: whether the signal is a Boolean, its values 0.0 (false) and 1.0 (true)
+    boolean: bool = False
 
 
 @dataclass
@@ -369,6 +371,8 @@ def read_signals(path: Path, names: list[str]) -> Signals:
     leaves: dict[tuple[str, str], tuple[list[float], list[float]]] = {}
     #: the leaves that had a value at least once: a number, a Boolean, or an infinite real (null)
     valued: set[tuple[str, str]] = set()
+    #: the leaves that held a number that is no Boolean: the others that had a value are Booleans
+    numeric: set[tuple[str, str]] = set()
     #: the leaves that held text: no number, which the plot says instead of "no value"
     texts: set[tuple[str, str]] = set()
     #: (topic, leaf) -> whether a null there is an absent optional field (else an infinite real), and
@@ -415,11 +419,14 @@ def read_signals(path: Path, names: list[str]) -> Signals:
                         continue
                     # either way a gap in the line: an absent field has no value to hold until the next
                     number = math.nan
-                    if not meaning[0]:
+                    if not meaning[0]:  # an infinite real
                         valued.add(key)
+                        numeric.add(key)
                 else:
                     number = float(value)
                     valued.add(key)
+                    if not isinstance(value, bool):
+                        numeric.add(key)
                 found = leaves.get(key)
                 if found is None:
                     found = leaves[key] = ([], [])
@@ -443,7 +450,9 @@ def read_signals(path: Path, names: list[str]) -> Signals:
         pattern = re.compile(re.escape(inner).replace(r"\[\*\]", r"\[\d+\]") + "$")
         named = [key for key in leaves if key[0] == subsystem and pattern.match(key[1])]
         matched = [
-            Series(subsystem, leaf, *leaves[(subsystem, leaf)]) for _, leaf in named if (subsystem, leaf) in valued
+            Series(subsystem, leaf, *leaves[(subsystem, leaf)], boolean=(subsystem, leaf) not in numeric)
+            for _, leaf in named
+            if (subsystem, leaf) in valued
         ]
         if not matched:
             if any(owner == subsystem and pattern.match(leaf) for owner, leaf in texts):
