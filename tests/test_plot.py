@@ -135,3 +135,18 @@ def test_a_panel_of_booleans_reads_false_and_true_and_each_panel_says_what_it_sh
     assert panel_label(["cmd.jointPosSetpoint[0]", "cmd.jointPosSetpoint[5]"]) == "cmd.jointPosSetpoint[*]"
     assert panel_label(["mc[1].desiredWindingCurrent", "mc[2].desiredWindingCurrent"]) == "mc[*].desiredWindingCurrent"
     assert panel_label(["cmd.jointPosSetpoint[0]", "cmd.operationalPosSetpoint.position[1]"]) == "cmd"
+
+
+def test_the_help_of_signal_says_how_a_family_and_an_array_are_indexed() -> None:
+    """A family's members are written with their declared index (`windingCurrent[1]` is member 1 of
+    `1..6`), an array's elements from 0: the plot labels `windingCurrent[1..6]` beside
+    `currentJointPos[0..5]`, as the spec names them, and `--help` says so."""
+    from earl.cli.main import build_parser
+
+    plot = build_parser()._subparsers._group_actions[0].choices["plot"]  # type: ignore[union-attr]
+    said = " ".join(plot.format_help().split())
+    assert "windingCurrent[1] is member 1 of windingCurrent[K in 1..6]" in said
+    assert "an element counted from 0 (currentJointPos[0] is its first)" in said
+    assert "x[1] of a family is member 1, v[0] of an array its first element" in said
+    run = build_parser()._subparsers._group_actions[0].choices["run"]  # type: ignore[union-attr]
+    assert "x[1] of a family is member 1, v[0] of an array its first element" in " ".join(run.format_help().split())

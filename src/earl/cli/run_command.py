@@ -109,7 +109,8 @@ def register(commands: Any) -> None:
         action="append",
         default=None,
         metavar="SIGNAL",
-        help="a signal for --plot, e.g. 'manip/a.cs.windingCurrent[*]' (repeatable; see `earl plot --help`)",
+        help="a signal for --plot, e.g. 'manip/a.cs.windingCurrent[*]' (repeatable; x[1] of a family is "
+        "member 1, v[0] of an array its first element; see `earl plot --help`)",
     )
     parser.add_argument(
         "--agents",

@@ -35,16 +35,26 @@ def register(commands: Any) -> None:
     plot = commands.add_parser(
         "plot",
         help="plot signals of a trace, with the FSM states as shaded bands (PNG)",
-        description="Plot signals recorded in a trace against time; the FSM states of each signal's "
-        "subsystem are shaded behind it. A signal is memory (recorded with --record-memory), e.g. "
-        "manip/a.cs.windingCurrent[1], or a field of what an output buffer sent, e.g. "
-        "manip/a.cs.manipulatorState.currentJointPos[0].",
+        description="Plot signals recorded in a trace against time; the FSM states of each signal's\n"
+        "subsystem are shaded behind it. A signal is memory (recorded with --record-memory), e.g.\n"
+        "manip/a.cs.windingCurrent[1], or a field of what an output buffer sent, e.g.\n"
+        "manip/a.cs.manipulatorState.currentJointPos[0].\n\n"
+        "Indices are written as in the spec, and the plot's labels write them the same way:\n"
+        "brackets after a family's name choose a member by its declared index (windingCurrent[1]\n"
+        "is member 1 of windingCurrent[K in 1..6]), brackets after an array an element counted\n"
+        "from 0 (currentJointPos[0] is its first); [*] is every member or element.",
         epilog="example:\n  earl plot run.mcap --signal manip/a.cs.windingCurrent[1] -o current.png\n\n"
         "exit codes: 0 written, 1 the trace lacks a signal or is unreadable, 2 usage error",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     plot.add_argument("file", metavar="FILE.mcap")
-    plot.add_argument("--signal", action="append", required=True, metavar="SIGNAL", help="repeatable")
+    plot.add_argument(
+        "--signal",
+        action="append",
+        required=True,
+        metavar="SIGNAL",
+        help="a signal to draw (repeatable); x[1] of a family is member 1, v[0] of an array its first element",
+    )
     plot.add_argument("-o", "--output", default="plot.png", metavar="FILE.png", help="default plot.png")
     plot.add_argument("--title", help="a title over the figure")
     plot.set_defaults(run=run_plot)
