@@ -135,3 +135,36 @@ def test_an_opengl_backend_mujoco_cannot_load_stops_only_the_pictures(tmp_path: 
     said = " ".join((result.stdout + result.stderr).split())
     assert "MUJOCO_GL=nothing names no OpenGL backend of MuJoCo" in said
     assert "pick-and-place: placed=" in said
+
+
+class Messages(Recorder):
+    def __init__(self) -> None:
+        self.sent: list[tuple[int, str, Any]] = []
+
+    def message_sent(self, time: int, link: str, value: Any) -> None:
+        self.sent.append((time, link, value))
+
+
+def test_the_first_state_reported_is_measured_and_the_fingers_are_not_driven_before_they_are() -> None:
+    """The first iterations ran on input buffers that had received nothing: manip/a reported joints all 0
+    and the grasp point at z = 1.08 m (the arm is at 0.26 m) for 0–4 ms, and grip/a read an opening of 0
+    (the fingers are at 0.08 m), drove them at its 2 A limit and they opened to 0.0824 m."""
+    messages = Messages()
+    sim = earl.simulate(earl.load(EXAMPLE), recorders=[messages])
+    plant = sim.environment.plant  # type: ignore[attr-defined]
+    grasp_point = plant.site_pose("grasp").position
+    sim.advance_to(0.3)
+    sim.close()
+    states = [value for _, link, value in messages.sent if link == "manip,task"]
+    first = states[0]
+    assert abs(first["currentOperationalPos"]["position"][2] - grasp_point[2]) < 0.002, first
+    assert abs(first["currentJointPos"][1] - 0.66) < 0.01 and abs(first["currentJointPos"][2] - 1.58) < 0.01
+    statuses = [value for _, link, value in messages.sent if link == "grip,task"]
+    assert statuses and all(abs(s["currentFingerPos"] - 0.08) < 0.001 for s in statuses), statuses[:3]
+    finger_currents = [
+        value["desiredWindingCurrent"] for _, link, value in messages.sent if "cs,fingerController" in link
+    ]
+    assert max(abs(c) for c in finger_currents) < 0.1, finger_currents[:3]
+    # no motor position is reported before its drive's first reading
+    reported = [value for _, link, value in messages.sent if link == "manip/a:motorController[2],cs"]
+    assert reported and all(value["currentMotorPos"] > 1.0 for value in reported)

@@ -289,9 +289,25 @@ def test_calculate_position_turns_motor_positions_into_joints_and_pose() -> None
     q = arm.tool_down_configuration(n, (0.45, 0.0, 0.06))
     motor = [qk * d.gear_ratio for qk, d in zip(q, arm.drives(n), strict=True)]
     outputs = Outputs("currentJointPos", "currentOperationalPos")
-    manip.calculate_position(Inputs(motorControllerState=controller_states(motor)), outputs, context())
+    manip.calculate_position(Inputs(motorControllerState=controller_states(motor)), outputs, context(time=0.002))
     assert np.allclose(outputs.written["currentJointPos"], q)
     assert np.allclose(outputs.written["currentOperationalPos"]["position"], [0.45, 0.0, 0.06], atol=1e-9)
+
+
+def test_nothing_is_measured_or_reported_in_the_first_iteration_of_the_run() -> None:
+    """It runs before anything was received (Figure 5b): its buffers hold zeros, which are no reading."""
+    first = context(time=0.0, iteration=0)
+    position = Outputs("currentJointPos", "currentOperationalPos")
+    manip.calculate_position(Inputs(motorControllerState=controller_states([0.0] * 6)), position, first)
+    assert position.written == {}
+    state = Outputs("manipulatorState")
+    pose = Msg(position=(0.0, 0.0, 0.0), orientation=(0.0, 0.0, 0.0, 0.0))
+    manip.output_manip_state(
+        Inputs(currentJointPos=(0.0,) * 6, currentOperationalPos=pose, motionFinished=True, emergencyStopCommand={}),
+        state,
+        first,
+    )
+    assert state.written == {}
 
 
 def test_emergency_stop_is_copied_to_every_motor_controller() -> None:
@@ -328,7 +344,7 @@ def test_output_manip_state_composes_figure_14a() -> None:
         motionFinished=True,
         emergencyStopCommand={1: False, 2: False, 3: True},
     )
-    manip.output_manip_state(inputs, outputs, context())
+    manip.output_manip_state(inputs, outputs, context(time=0.002))
     state = outputs.written["manipulatorState"]
     assert state["emergencyStop"] is True and state["motionFinished"] is True
     assert state["currentOperationalPos"] == pose

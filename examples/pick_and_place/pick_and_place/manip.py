@@ -49,9 +49,15 @@ def _measured_motor_positions(inputs: Any, n: int) -> Vector:
     return np.array([float(states[k].currentMotorPos) for k in range(1, n + 1)])
 
 
-def _has_data(motor_positions: Vector) -> bool:
-    """Before the first reading arrives an input buffer holds zeros; a tool-down arm never reads all zeros."""
-    return bool(np.any(motor_positions != 0.0))
+def _no_reading_yet(context: Any) -> bool:
+    """The first iteration of the run, the only one that has no motor position to work from.
+
+    An iteration computes before it receives (Figure 5b), so the first one sees input buffers that
+    received nothing and hold zeros, not readings.  From the second on every motor controller has
+    reported: a controller reports only once its drive's first encoder reading has arrived (its
+    `start` state), and idle waits for all of them (obligatory).
+    """
+    return context.iteration == 0 and context.time == 0.0
 
 
 def _write_currents(outputs: Any, currents: Vector) -> None:
@@ -102,7 +108,7 @@ class _Controller:
 def _controller(context: Any, measured: Vector) -> _Controller | None:
     memory = state_of(context)
     controller: _Controller | None = memory.get("controller")
-    if controller is None and _has_data(measured):
+    if controller is None and not _no_reading_yet(context):
         controller = memory["controller"] = _Controller(robot_model(_joints(context)), measured)
     return controller
 
@@ -111,7 +117,12 @@ def _controller(context: Any, measured: Vector) -> _Controller | None:
 
 
 def calculate_position(inputs: Any, outputs: Any, context: Any) -> None:
-    """currentJointPos and currentOperationalPos from the motor controllers' encoder readings."""
+    """currentJointPos and currentOperationalPos from the motor controllers' encoder readings.
+
+    Before the first reading nothing is written: memory keeps its initial value, which is not reported.
+    """
+    if _no_reading_yet(context):
+        return
     model = robot_model(_joints(context))
     q = model.motor_to_joint(_measured_motor_positions(inputs, model.n))
     pose = model.forward(q)
@@ -208,7 +219,9 @@ def emergency_stop(inputs: Any, outputs: Any, context: Any) -> None:
 
 
 def output_manip_state(inputs: Any, outputs: Any, context: Any) -> None:
-    """Figure 14a: compose manipulatorState/ob from memory."""
+    """Figure 14a: compose manipulatorState/ob from memory; nothing before the first reading (no pose is known)."""
+    if _no_reading_yet(context):
+        return
     stops = inputs.emergencyStopCommand
     outputs.manipulatorState = {
         "currentJointPos": inputs.currentJointPos,
