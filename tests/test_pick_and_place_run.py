@@ -6,6 +6,7 @@ whole task (about 13 s of virtual time).
 
 from __future__ import annotations
 
+import itertools
 from pathlib import Path
 from typing import Any
 
@@ -168,3 +169,18 @@ def test_the_first_state_reported_is_measured_and_the_fingers_are_not_driven_bef
     # no motor position is reported before its drive's first reading
     reported = [value for _, link, value in messages.sent if link == "manip/a:motorController[2],cs"]
     assert reported and all(value["currentMotorPos"] > 1.0 for value in reported)
+
+
+def test_the_grasp_is_reported_without_a_break_from_grasp_to_release() -> None:
+    """task/a re-sent the closed set-point with every arm phase; grip/a took each as a new move, in which
+    it reports no grasp: objectGrasped dropped for 150 ms at lift, carry and place with the box held."""
+    messages = Messages()
+    sim = earl.simulate(earl.load(EXAMPLE), recorders=[messages])
+    sim.advance_to(8.0)
+    sim.close()
+    commands = [value["desiredFingerPos"] for _, link, value in messages.sent if link == "task,grip"]
+    assert commands == [0.08, 0.0, 0.08]  # approach, grasp, release: each once
+    grasped = [(t, value["objectGrasped"]) for t, link, value in messages.sent if link == "grip,task"]
+    changes = [(t, now) for (_, before), (t, now) in itertools.pairwise(grasped) if now != before]
+    assert [now for _, now in changes] == [True, False], changes  # grasped once, released once
+    assert changes[1][0] - changes[0][0] > 4.0 * 1e9  # held through lift, carry and place
