@@ -385,3 +385,39 @@ def test_a_nan_that_no_text_can_say_is_named_where_it_is_by_to_earl() -> None:
         ValueError, match=r"^system\.agents\[0\]\.subsystems\[0\]\.memories\[0\]\.initial_value\.value: nan"
     ):
         system.to_earl()
+
+
+def test_what_draws_exports_or_expands_a_model_built_in_python_names_a_wrong_value_as_check_does(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """`timeout = 0.05`, `reads = ["command/ib"]`, `initial_value = 0`: diagrams, the notebook's display,
+    export_sysml and expand failed inside earl (`'float' object has no attribute 'value'`) where check and
+    to_earl named the value; they now raise the same ModelTypeError, at the same path."""
+    from earl.export import export_sysml
+    from earl.model.expand import expand
+    from earl.model.validate import ModelTypeError
+    from earl.render import build_diagram
+    from earl.render.jupyter import svg_for
+
+    spec = Path(__file__).parent / "runtime_specs" / "counter"
+    timeout = r"system\.agents\[0\]\.subsystems\[1\]\.fsm\.states\[\d\]\.timeout: expected Duration"
+    system = earl.load(spec)
+    relay = system.agents[0].subsystems[1]
+    next(s for s in relay.fsm.states if s.timeout is not None).timeout = 0.05  # type: ignore[union-attr,assignment]
+    for draw in (
+        lambda: build_diagram(system, "fsm", "counter/a.relay/ve"),
+        lambda: build_diagram(system, "agent", "counter/a"),
+        lambda: export_sysml(system),
+    ):
+        with pytest.raises(ModelTypeError, match=timeout):
+            draw()
+    assert svg_for(relay) is None  # IPython then shows the text; the reason is one line, not a traceback
+    assert "earl: virtualEffector.fsm.states" in capsys.readouterr().err
+    system = earl.load(spec)
+    system.agents[0].subsystems[1].partial_transition_functions[0].reads = ["command/ib"]  # type: ignore[list-item]
+    with pytest.raises(ModelTypeError, match=r"partial_transition_functions\[0\]\.reads\[0\]: expected Element"):
+        export_sysml(system)
+    system = earl.load(spec)
+    system.agents[0].subsystems[0].memories[0].initial_value = 0  # type: ignore[assignment]
+    with pytest.raises(ModelTypeError, match=r"memories\[0\]\.initial_value: .*write `Literal\(0\)`"):
+        expand(system)

@@ -20,6 +20,7 @@ from earl.lang.resolver import resolve
 from earl.model.elements import System
 from earl.model.expand import expand
 from earl.model.types import PARAMETER_TYPES, parameter_value_problem, refuse_wrong_parameters
+from earl.model.validate import explaining
 
 # The rule modules register themselves on import; they are listed here so that none is forgotten.
 RULE_MODULES = (rules_structure, rules_communication, rules_behaviour, rules_optional_fields, fsm_analysis)
@@ -44,18 +45,14 @@ def check(system: System, parameters: Mapping[str, bool | int | float | str] | N
     unknown = unknown_parameters(system, parameters or {}) + wrong_parameter_values(system, parameters or {})
     if unknown:
         return unknown
-    with collector_paused():
-        try:
-            # A system built or edited in Python never met the reader: its names are resolved here, as
-            # `load` resolves a file's (a transition to a state that does not exist, a duplicate agent …).
-            unresolved = [d for d in resolve(system, parameters or {}) if d.severity is Severity.ERROR]
-            if unresolved:
-                return unresolved
-            return check_context(context_for(system, parameters))
-        except (AttributeError, TypeError, KeyError) as error:  # a value of the wrong type, built in Python
-            from earl.model.validate import explained
-
-            raise explained(system, error) from error
+    # a value of the wrong type, built in Python, fails somewhere inside: said at its path instead
+    with collector_paused(), explaining(system):
+        # A system built or edited in Python never met the reader: its names are resolved here, as
+        # `load` resolves a file's (a transition to a state that does not exist, a duplicate agent …).
+        unresolved = [d for d in resolve(system, parameters or {}) if d.severity is Severity.ERROR]
+        if unresolved:
+            return unresolved
+        return check_context(context_for(system, parameters))
 
 
 def unknown_parameters(system: System, parameters: Mapping[str, object]) -> list[Diagnostic]:

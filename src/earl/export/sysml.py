@@ -52,6 +52,7 @@ from earl.model.kinds import Kind
 from earl.model.location import Comments, SourceLocation
 from earl.model.text import expression_text, instance_name, robot_member_keys
 from earl.model.types import ArrayType, DataType, PrimitiveType, StructType, TypeAlias, TypeReference, type_text
+from earl.model.validate import refuse_wrong_types
 
 Value = bool | int | float | str
 
@@ -88,7 +89,9 @@ def export_sysml(system: System, parameters: Mapping[str, Value] | None = None) 
 
     A system built or edited in Python never met the reader: its names and types are resolved first,
     and what the reader would refuse (a type alias naming itself, which the writer would follow for
-    ever) raises `EarlError` with the reader's diagnostics."""
+    ever) raises `EarlError` with the reader's diagnostics; a value of a wrong type (`reads = ["cmd/ib"]`)
+    raises ModelTypeError naming where it is, as `check` and `to_earl` do, not Python's error from inside."""
+    refuse_wrong_types(system)
     unresolved = [d for d in resolve(system, parameters or {}) if d.severity is Severity.ERROR]
     if unresolved:
         raise EarlError(unresolved)

@@ -592,13 +592,11 @@ class System:
     def to_earl(self) -> str:
         """This system as canonical `.earl` text (what `earl fmt` prints)."""
         from earl.lang.formatter import format_system  # the model itself imports no reader
+        from earl.model.validate import explaining
 
         try:
-            return format_system(self)
-        except (AttributeError, TypeError, KeyError) as error:  # a model built in Python with a wrong value
-            from earl.model.validate import explained
-
-            raise explained(self, error) from error
+            with explaining(self):  # a model built in Python with a wrong value: said at its path
+                return format_system(self)
         except ValueError as error:  # a value no text can say (`Literal(float("nan"))`): said where it is
             from earl.model.validate import not_a_number
 

@@ -67,6 +67,7 @@ from earl.model.expressions import (
 from earl.model.kinds import Kind
 from earl.model.location import SourceLocation
 from earl.model.types import REAL_TYPES, ArrayType, DataType, StructType, TypeAlias
+from earl.model.validate import explaining
 
 Value = bool | int | float | str
 Environment = dict[str, Value]
@@ -100,7 +101,13 @@ def parameter_values(
 
 
 def expand(system: System, overrides: Mapping[str, Value] | None = None) -> System:
-    """The concrete system: every family member, every reference resolved to a member."""
+    """The concrete system: every family member, every reference resolved to a member. A value of a wrong
+    type in a model built in Python (`initial_value = 0.0`) raises ModelTypeError naming where it is."""
+    with explaining(system):
+        return _expand(system, overrides)
+
+
+def _expand(system: System, overrides: Mapping[str, Value] | None) -> System:
     environment = parameter_values(system.parameters, {}, overrides or {})
     cache = _Shared()
     expanded = System(

@@ -17,6 +17,7 @@ from earl.check import context_for
 from earl.check.context import CheckContext
 from earl.model.elements import Agent, System
 from earl.model.tables import AgentType
+from earl.model.validate import refuse_wrong_types
 from earl.render.diagram import Diagram
 from earl.render.names import agent_name, qualified_subsystem_name
 from earl.render.targets import TargetError, all_subsystems, find_agent, find_behaviour, find_subsystem, only_fsm
@@ -40,6 +41,11 @@ class Subject:
     declared: System
     expand: bool = False
     parameters: Parameters | None = None
+
+    def __post_init__(self) -> None:
+        # a model built in Python with a value of the wrong type (`timeout = 0.05`) would fail inside a
+        # view with Python's words, or be drawn as it is: said as check and to_earl say it, at its path
+        refuse_wrong_types(self.declared)
 
     @cached_property
     def context(self) -> CheckContext:

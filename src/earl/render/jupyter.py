@@ -14,6 +14,7 @@ from typing import Any
 
 from earl.model.elements import FSM, Agent, BasicBehaviour, Subsystem, System
 from earl.model.types import StructType, TypeAlias
+from earl.model.validate import ModelTypeError, refuse_wrong_types, root_path
 from earl.render.diagram import Diagram
 from earl.render.graphviz import GraphvizError
 from earl.render.names import subsystem_name
@@ -27,7 +28,10 @@ SVG = "image/svg+xml"
 
 
 def diagram_for(element: object) -> Diagram | None:
-    """The diagram an element is shown as, or None for elements without one."""
+    """The diagram an element is shown as, or None for elements without one. A value of a wrong type in
+    it raises ModelTypeError naming where it is, as `check` and `to_earl` do."""
+    if isinstance(element, (Agent, Subsystem, FSM, BasicBehaviour, StructType, TypeAlias)):
+        refuse_wrong_types(element, root_path(element))  # a System is looked at by its Subject
     if isinstance(element, System):
         from earl.render.build import Subject
 
@@ -49,8 +53,14 @@ def diagram_for(element: object) -> Diagram | None:
 
 
 def svg_for(element: object) -> str | None:
-    """The SVG of an element; None (IPython then shows the text repr) when there is none or `dot` is missing."""
-    diagram = diagram_for(element)
+    """The SVG of an element; None (IPython then shows the text repr) when there is none, when `dot` is
+    missing, or when the element holds a value of a wrong type (said in a line, not IPython's traceback
+    from inside earl)."""
+    try:
+        diagram = diagram_for(element)
+    except ModelTypeError as error:
+        sys.stderr.write(f"earl: {error}\n")
+        return None
     if diagram is None:
         return None
     try:
