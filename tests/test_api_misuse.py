@@ -421,3 +421,20 @@ def test_what_draws_exports_or_expands_a_model_built_in_python_names_a_wrong_val
     system.agents[0].subsystems[0].memories[0].initial_value = 0  # type: ignore[assignment]
     with pytest.raises(ModelTypeError, match=r"memories\[0\]\.initial_value: .*write `Literal\(0\)`"):
         expand(system)
+
+
+def test_a_function_given_for_the_python_implementation_is_refused_by_to_earl_at_its_path() -> None:
+    """`PythonImplementation(my_function)` for `PythonImplementation("module:function")`: to_earl wrote
+    `= python <function idle at 0x…>`, a text that does not read back."""
+    from earl import PythonImplementation
+    from earl.model.validate import ModelTypeError
+
+    def increment(*arguments: object) -> None: ...
+
+    system = earl.load(Path(__file__).parent / "runtime_specs" / "counter")
+    system.agents[0].subsystems[0].partial_transition_functions[0].implementation = PythonImplementation(
+        increment  # type: ignore[arg-type]
+    )
+    said = r'implementation\.path: expected str, got function .*: name the function as text, `".*:.*increment"`'
+    with pytest.raises(ModelTypeError, match=said):
+        system.to_earl()

@@ -68,6 +68,9 @@ def literal_text(value: bool | int | float | str) -> str:
             raise ValueError("nan has no EARL literal: no number in the language reads as nan")
         # The reader turns a number too large for a float into infinity, so this reads back as it.
         return "1e999" if value > 0 else "-1e999"
+    if not isinstance(value, int | float):
+        # `PythonImplementation(my_function)`: its repr (`<function idle at 0x…>`) is no text the reader reads
+        raise TypeError(f"no EARL literal is {type(value).__name__} {value!r:.60}")
     return repr(value)
 
 

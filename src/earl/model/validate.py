@@ -114,6 +114,10 @@ def _fits(value: object, hint: Any) -> bool:
 def _advice(value: object, expected: tuple[Any, ...]) -> str:
     """How to write it instead, where the mistake is a common one."""
     names = {getattr(option, "__name__", "") for option in expected}
+    if callable(value) and not isinstance(value, type) and str in expected:
+        # `PythonImplementation(my_function)`: the model names its code as text, which the run imports
+        module, name = getattr(value, "__module__", "module"), getattr(value, "__qualname__", "function")
+        return f': name the function as text, `"{module}:{name}"`'
     if "Predicate" in names and type(value).__module__ == "earl.model.expressions":
         return f": wrap the expression, `Predicate({type(value).__name__}(…))`"
     if isinstance(value, str) and names & {"PrimitiveType", "TypeReference"}:
