@@ -438,3 +438,25 @@ def test_a_function_given_for_the_python_implementation_is_refused_by_to_earl_at
     said = r'implementation\.path: expected str, got function .*: name the function as text, `".*:.*increment"`'
     with pytest.raises(ModelTypeError, match=said):
         system.to_earl()
+
+
+@pytest.mark.parametrize("name", ["period", "fsm", "state", "true", "link"])
+def test_a_keyword_given_as_a_name_in_python_is_said_by_check_and_refused_by_to_earl(name: str) -> None:
+    """`Memory("period", …)` passed check and ran, but `to_earl()` and `earl.save` wrote `period/m: int`,
+    which the reader does not read back. A keyword the reader reads as a name there (`python/m`) stays."""
+    from earl import Memory
+    from earl.model.validate import ModelNameError
+
+    spec = Path(__file__).parent / "runtime_specs" / "counter"
+    system = earl.load(spec)
+    system.agents[0].subsystems[0].memories.append(Memory(name, PrimitiveType("int")))
+    [said] = [d for d in check(system) if d.code == "EARL-R006"]
+    assert said.message.startswith(f"`{name}` is a keyword of EARL where it is declared (a memory of counter/a.cs)")
+    with pytest.raises(ModelNameError, match=rf"system\.agents\[0\]\.subsystems\[0\]\.memories\[2\]\.name: '{name}'"):
+        system.to_earl()
+    system = earl.load(spec)
+    system.agents[0].subsystems[0].memories.append(Memory("python", PrimitiveType("int")))
+    assert earl.loads(system.to_earl()) == system
+    system.name = "my system"
+    with pytest.raises(ModelNameError, match=r"system\.name: 'my system' \(the system\) is no EARL name"):
+        system.to_earl()

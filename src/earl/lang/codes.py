@@ -42,7 +42,7 @@ READING_CODES: dict[str, str] = {
     "EARL-R003": "a parameter whose type is not primitive",
     "EARL-R004": "a parameter value that is not a constant",
     "EARL-R005": "a parameter value of the wrong type",
-    "EARL-R006": "a declared name that is not an EARL name (a model built in Python)",
+    "EARL-R006": "a declared name that is not an EARL name, or a keyword where it stands (a model built in Python)",
     "EARL-R010": "a primitive type redefined",
     "EARL-R011": "a type that contains itself",
     "EARL-R012": "an unknown data type",

@@ -214,10 +214,17 @@ class Resolver:
         return self.diagnostics
 
     def _names(self) -> None:
-        """EARL-R006: a declared name the language could not read back (`my arm`, `a1/a`, `système`); only
-        a model built in Python can hold one, and `to_earl()` would write text that does not load."""
-        for name, what, location in _declared_names(self.system):
-            if isinstance(name, str) and _NAME.fullmatch(name):
+        """EARL-R006: a declared name the language could not read back (`my arm`, `a1/a`, `système`, a
+        keyword where it stands: `period/m`); only a model built in Python can hold one, and `to_earl()`
+        would write text that does not load."""
+        for name, what, location, _ in unreadable_names(self.system):
+            if isinstance(name, str) and _NAME.fullmatch(name):  # a keyword where it stands
+                self.error(
+                    f"`{name}` is a keyword of EARL where it is declared ({what}): the text would not read back",
+                    location,
+                    "EARL-R006",
+                    f"rename it, e.g. `{name}_` or `my{name[:1].upper()}{name[1:]}`",
+                )
                 continue
             if isinstance(name, str) and "/" in name and _NAME.fullmatch(name.split("/")[0]):
                 hint = f"write the name without its kind: `{name.split('/')[0]}` (the kind is the element's class)"
@@ -1425,37 +1432,83 @@ _ELEMENT_LISTS = {
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 
 
-def _declared_names(system: System) -> Iterator[tuple[object, str, SourceLocation | None]]:
-    """Every name the system declares, with what it names (for a message without a location)."""
-    yield system.name, "the system", system.location
-    for parameter in system.parameters:
-        yield parameter.name, "a system parameter", parameter.location
-    for definition in system.types:
-        yield definition.name, "a type", definition.location
-        for member in getattr(definition, "fields", ()):
-            yield member.name, f"a field of `{definition.name}`", member.location
-    for robot in system.robots:
-        yield robot.name, "a robot", robot.location
-    for agent in system.agents:
-        yield agent.name, "an agent", agent.location
+def _declared_names(system: System) -> Iterator[tuple[object, str, SourceLocation | None, str]]:
+    """Every name the system declares, with what it names (for a message without a location) and the
+    attribute path that holds it (`system.agents[1].subsystems[0].memories[0].name`)."""
+    yield system.name, "the system", system.location, "system.name"
+    for i, parameter in enumerate(system.parameters):
+        yield parameter.name, "a system parameter", parameter.location, f"system.parameters[{i}].name"
+    for i, definition in enumerate(system.types):
+        yield definition.name, "a type", definition.location, f"system.types[{i}].name"
+        for j, member in enumerate(getattr(definition, "fields", ())):
+            where = f"system.types[{i}].fields[{j}].name"
+            yield member.name, f"a field of `{definition.name}`", member.location, where
+    for i, robot in enumerate(system.robots):
+        yield robot.name, "a robot", robot.location, f"system.robots[{i}].name"
+    for i, agent in enumerate(system.agents):
+        at = f"system.agents[{i}]"
+        yield agent.name, "an agent", agent.location, f"{at}.name"
         if agent.family is not None:
-            yield agent.family.index, f"the family index of `{agent.name}/a`", agent.family.location
-        for parameter in agent.parameters:
-            yield parameter.name, f"a parameter of `{agent.name}/a`", parameter.location
-        for subsystem in agent.subsystems:
-            owner = f"{agent.name}/a.{subsystem.name}"
-            yield subsystem.name, f"a subsystem of `{agent.name}/a`", subsystem.location
+            where = f"{at}.family.index"
+            yield agent.family.index, f"the family index of `{agent.name}/a`", agent.family.location, where
+        for j, parameter in enumerate(agent.parameters):
+            where = f"{at}.parameters[{j}].name"
+            yield parameter.name, f"a parameter of `{agent.name}/a`", parameter.location, where
+        for j, subsystem in enumerate(agent.subsystems):
+            owner, held = f"{agent.name}/a.{subsystem.name}", f"{at}.subsystems[{j}]"
+            yield subsystem.name, f"a subsystem of `{agent.name}/a`", subsystem.location, f"{held}.name"
             if subsystem.family is not None:
-                yield subsystem.family.index, f"the family index of `{owner}`", subsystem.family.location
+                where = f"{held}.family.index"
+                yield subsystem.family.index, f"the family index of `{owner}`", subsystem.family.location, where
             for kind, called in _ELEMENT_LISTS.items():
-                for element in getattr(subsystem, kind):
-                    yield element.name, f"{called} of {owner}", element.location
+                for k, element in enumerate(getattr(subsystem, kind)):
+                    yield element.name, f"{called} of {owner}", element.location, f"{held}.{kind}[{k}].name"
                     family = getattr(element, "family", None)
                     if family is not None:
-                        yield family.index, f"the family index of `{element.name}` in {owner}", family.location
+                        what = f"the family index of `{element.name}` in {owner}"
+                        yield family.index, what, family.location, f"{held}.{kind}[{k}].family.index"
             if subsystem.fsm is not None:
-                for state in subsystem.fsm.states:
-                    yield state.name, f"a state of the FSM of {owner}", state.location
+                for k, state in enumerate(subsystem.fsm.states):
+                    where = f"{held}.fsm.states[{k}].name"
+                    yield state.name, f"a state of the FSM of {owner}", state.location, where
+
+
+def unreadable_names(system: System) -> list[tuple[object, str, SourceLocation | None, str]]:
+    """The declared names (as `_declared_names` gives them) that the reader would not read back from
+    `to_earl()`'s text: no EARL name at all (`my arm`), or a keyword where it stands (`period/m`,
+    `state/a`). Whether a keyword is one depends on where it is written (`python/m` and `initial/m`
+    read back; `period/m` does not), so a system naming something as a keyword is printed and parsed:
+    the names a syntax error's line holds are the unreadable ones. Costs nothing without such names."""
+    from earl.lang.parser import keyword_terminals  # the grammar's keywords; imported on need only
+
+    declared = list(_declared_names(system))
+    if system.name == "":
+        declared = declared[1:]  # a system without a name is printed without its `system` line
+    found = [entry for entry in declared if not (isinstance(entry[0], str) and _NAME.fullmatch(entry[0]))]
+    if found:
+        return found  # the text would not read back for these alone; keywords are asked once they are gone
+    keywords = set(keyword_terminals().values())
+    suspects = [entry for entry in declared if entry[0] in keywords]
+    if not suspects:
+        return []
+    from earl.diagnostics import EarlError
+    from earl.lang.formatter import format_system
+    from earl.lang.parser import parse_text
+
+    try:
+        text = format_system(system)
+    except (AttributeError, TypeError, KeyError, ValueError):
+        return []  # a value no text can say: named elsewhere (ModelTypeError, EARL-R0xx)
+    try:
+        parse_text(text)
+    except EarlError as error:
+        location = error.diagnostics[0].location if error.diagnostics else None
+        lines = text.splitlines()
+        # the parser may place its error at the end of the token before the keyword (`… = 0.0` ⏎ `state/m`)
+        at = location.line - 1 if location is not None else len(lines)
+        near = "\n".join(lines[at : at + 2])
+        return [entry for entry in suspects if re.search(rf"(?<![\w]){entry[0]}(?![\w])", near)]
+    return []
 
 
 def _size(family: IndexRange | None) -> int:

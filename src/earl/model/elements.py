@@ -592,10 +592,21 @@ class System:
     def to_earl(self) -> str:
         """This system as canonical `.earl` text (what `earl fmt` prints)."""
         from earl.lang.formatter import format_system  # the model itself imports no reader
-        from earl.model.validate import explaining
+        from earl.lang.resolver import unreadable_names
+        from earl.model.validate import ModelNameError, explaining
 
+        with explaining(self):  # a model built in Python with a wrong value: said at its path
+            unreadable = unreadable_names(self)
+        if unreadable:  # `System("my system")`, `Memory("period", …)`: a text that would not read back
+            name, what, _, path = unreadable[0]
+            why = (
+                "a keyword of EARL where it stands"
+                if isinstance(name, str) and name.isidentifier()
+                else "no EARL name (a letter or `_`, then letters, digits and `_`)"
+            )
+            raise ModelNameError(f"{path}: {name!r} ({what}) is {why}: the text would not read back; rename it")
         try:
-            with explaining(self):  # a model built in Python with a wrong value: said at its path
+            with explaining(self):
                 return format_system(self)
         except ValueError as error:  # a value no text can say (`Literal(float("nan"))`): said where it is
             from earl.model.validate import not_a_number

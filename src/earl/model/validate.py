@@ -183,6 +183,11 @@ class ModelTypeError(TypeError):
     """A value of a model built in Python is not of its declared type; the message says where."""
 
 
+class ModelNameError(ValueError):
+    """A name of a model built in Python that the reader would not read back (`my system`, a memory called
+    `period`): `to_earl()` refuses to write it; the message says where it is."""
+
+
 def explained(system: object, error: Exception, path: str = "system") -> Exception:
     """What to raise for `error`, met while reading `system`: a ModelTypeError naming the first value of
     a wrong type, when there is one (the likely cause), else `error` itself."""
