@@ -6,6 +6,7 @@ text, not crash the checker or go into the run's generated code."""
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -459,4 +460,23 @@ def test_a_keyword_given_as_a_name_in_python_is_said_by_check_and_refused_by_to_
     assert earl.loads(system.to_earl()) == system
     system.name = "my system"
     with pytest.raises(ModelNameError, match=r"system\.name: 'my system' \(the system\) is no EARL name"):
+        system.to_earl()
+
+
+def test_a_predicate_given_as_earl_text_is_told_to_be_built_not_made_a_string_literal() -> None:
+    """`expression = "count/mi >= 3"` was told to write `Literal('count/mi >= 3')`, which is a string,
+    not a Boolean (EARL-E030); the hint builds the comparison instead."""
+    from earl.model.validate import ModelTypeError
+
+    system = earl.load(Path(__file__).parent / "runtime_specs" / "counter")
+    system.agents[0].subsystems[0].primitive_predicates[0].expression = "count/mi >= 3"  # type: ignore[assignment]
+    built = 'Comparison(">=", Read(ElementReference("count", Kind.MEMORY_INPUT)), Literal(3))'
+    with pytest.raises(ModelTypeError, match=re.escape(f"build the expression, e.g. `{built}`")):
+        system.to_earl()
+    system.agents[0].subsystems[0].primitive_predicates[0].expression = "done or busy/pp"  # type: ignore[assignment]
+    with pytest.raises(ModelTypeError, match=r"build the expression, e.g. `Comparison\("):
+        check(system)
+    system = earl.load(Path(__file__).parent / "runtime_specs" / "counter")
+    system.agents[0].subsystems[0].memories[0].initial_value = "ready"  # type: ignore[assignment]
+    with pytest.raises(ModelTypeError, match=r"initial_value: .*write `Literal\('ready'\)`"):
         system.to_earl()

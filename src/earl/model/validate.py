@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import re
 import types
 import typing
 from collections.abc import Iterator
@@ -122,9 +123,31 @@ def _advice(value: object, expected: tuple[Any, ...]) -> str:
         return f": wrap the expression, `Predicate({type(value).__name__}(…))`"
     if isinstance(value, str) and names & {"PrimitiveType", "TypeReference"}:
         return f': write `PrimitiveType("{value}")` or `TypeReference("{value}")`'
+    if isinstance(value, str) and "Literal" in names and _EXPRESSION_TEXT.search(value):
+        # `expression = "count/mi >= 3"`: EARL text, not a string; `Literal(…)` would make it a string (E030)
+        return f": build the expression, e.g. `{_built(value)}`; `Literal(…)` would make it a string"
     if isinstance(value, bool | int | float | str) and "Literal" in names:
         return f": write `Literal({value!r})`"
     return ""
+
+
+#: what makes a string look like EARL text of an expression rather than a string value: a kind's slash
+#: (`count/mi`), a comparison, a call, `and`/`or`/`not`
+_EXPRESSION_TEXT = re.compile(r"\w/\w|[<>]|[=!]=|\w\(|\b(?:and|or|not)\b")
+_COMPARISON_TEXT = re.compile(r"\s*(\w+)/(\w+)\s*(>=|<=|==|!=|>|<)\s*(-?\d+(?:\.\d*)?|true|false)\s*")
+
+
+def _built(text: str) -> str:
+    """The Python that builds `text` when it is a plain comparison (`count/mi >= 3`), else an example."""
+    from earl.model.kinds import Kind
+
+    match = _COMPARISON_TEXT.fullmatch(text)
+    kinds = {kind.value: kind.name for kind in Kind}
+    if match is None or match[2] not in kinds:
+        return 'Comparison(">=", Read(ElementReference("count", Kind.MEMORY_INPUT)), Literal(3))'
+    name, kind, operator, right = match.groups()
+    value = right.capitalize() if right in ("true", "false") else right
+    return f'Comparison("{operator}", Read(ElementReference("{name}", Kind.{kinds[kind]})), Literal({value}))'
 
 
 def _name(hint: Any) -> str:
