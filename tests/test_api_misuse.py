@@ -64,7 +64,7 @@ NEVER = Read(ElementReference("never", Kind.PRIMITIVE_PREDICATE))
     [
         (
             Comparison("=>", X, Literal(3.0)),
-            "`=>` is no comparison operator of EARL (in `a/a.cs`)",
+            "`=>` is no comparison operator of EARL (in the condition of transition `run,other/t` of `a/a.cs`)",
             "did you mean `>`?",
         ),
         (BooleanOperation("xor", (NEVER, Literal(True))), "`xor` is no Boolean operator of EARL", "did you mean `or`?"),
@@ -198,7 +198,8 @@ def test_a_link_pattern_matching_nothing_is_a_warning_and_an_unknown_subsystem_a
 
 
 def test_a_finding_in_an_element_built_in_python_says_which_declaration_it_is_about() -> None:
-    """Such elements have no location: `a FIFO holds at least one message, not 0` did not say whose."""
+    """Such elements have no location: `a FIFO holds at least one message, not 0` did not say whose, and then
+    said only the subsystem, not which of its declarations."""
     from earl import ArrayType, Memory
 
     system = earl.loads(TEXT)
@@ -210,12 +211,12 @@ def test_a_finding_in_an_element_built_in_python_says_which_declaration_it_is_ab
     assert said == {
         (
             "EARL-R012",
-            "unknown primitive type `real` (in `a/a.cs`)",
+            "unknown primitive type `real` (in `y/m` of `a/a.cs`)",
             "the primitive types: boolean, int8, int16, int32, int64, uint8, uint16, uint32, uint64, int, float32, "
             "float64, double, string, bytes; a struct or alias is a `TypeReference`",
         ),
-        ("EARL-R013", "an array size must not be negative, here it is -1 (in `a/a.cs`)", None),
-        ("EARL-R018", "a FIFO holds at least one message, not 0 (in `a/a.cs`)", None),
+        ("EARL-R013", "an array size must not be negative, here it is -1 (in `z/m` of `a/a.cs`)", None),
+        ("EARL-R018", "a FIFO holds at least one message, not 0 (in `inp/ib` of `a/a.cs`)", None),
     }
 
 
@@ -480,3 +481,21 @@ def test_a_predicate_given_as_earl_text_is_told_to_be_built_not_made_a_string_li
     system.agents[0].subsystems[0].memories[0].initial_value = "ready"  # type: ignore[assignment]
     with pytest.raises(ModelTypeError, match=r"initial_value: .*write `Literal\('ready'\)`"):
         system.to_earl()
+
+
+def test_a_name_not_found_in_python_says_the_declaration_and_attribute_it_is_in() -> None:
+    """`reads[0] = ElementReference("cmdd", …)` said only ``EARL-R022 `counter/a.relay/ve` has no Input Buffer
+    `cmdd` ``, and `data_type = None` only the subsystem: a model built in Python has no line to point at."""
+    from earl import Memory
+
+    system = earl.load(Path(__file__).parent / "runtime_specs" / "counter")
+    relay = system.agents[0].subsystems[1]
+    store = next(f for f in relay.partial_transition_functions if f.name == "store")
+    store.reads[0] = ElementReference("commandd", Kind.INPUT_BUFFER)
+    relay.memories.append(Memory("extra", None))  # type: ignore[arg-type]
+    said = {d.message for d in check(system)}
+    assert (
+        "`counter/a.relay/ve` has no Input Buffer `commandd` (in reads[0] of `store/pf` of `counter/a.relay/ve`)"
+        in said
+    )
+    assert "NoneType is not a data type (in `extra/m` of `counter/a.relay/ve`)" in said

@@ -11,6 +11,7 @@ from __future__ import annotations
 import itertools
 import re
 from collections.abc import Iterable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -183,6 +184,17 @@ class Resolver:
             return
         self._said.add(key)
         self.diagnostics.append(Diagnostic(Severity.ERROR, message, location, code=code, hint=hint))
+
+    @contextmanager
+    def _within(self, element: str, attribute: str = "") -> Iterator[None]:
+        """Inside, a problem without a location (a model built in Python) says the element it is in, and
+        the attribute (`in reads[0] of `store/pf` of `worker/a.cs``), not only the subsystem."""
+        outer = self._place
+        self._place = f"{attribute} of {element} of {outer}" if attribute else f"{element} of {outer}"
+        try:
+            yield
+        finally:
+            self._place = outer
 
     def duplicate(self, what: str, location: SourceLocation | None, first: SourceLocation | None) -> None:
         where = f" (first declared at line {first.line})" if first is not None else ""
@@ -816,8 +828,9 @@ class Resolver:
                 names[element.name] = _Declared(element, family)
                 self._count_expanded(subsystems * _size(family), element.location)
                 if hasattr(element, "data_type"):
-                    self.data_type(element.data_type, scope, element.location)
-                    self.value_too_large(element.data_type, scope, element.location)
+                    with self._within(f"`{element.name}/{kind.value}`"):
+                        self.data_type(element.data_type, scope, element.location)
+                        self.value_too_large(element.data_type, scope, element.location)
         return table
 
     def _agent_body(self, table: _AgentTable) -> None:
@@ -833,13 +846,14 @@ class Resolver:
         owner = subsystem_name(agent.agent, subsystem)
         for buffer in subsystem.input_buffers:
             if buffer.queue is not None:
-                capacity = self.constant_integer(buffer.queue.capacity, scope, "a FIFO capacity")
-                if capacity is not None and capacity < 1:
-                    self.error(
-                        f"a FIFO holds at least one message, not {capacity}",
-                        buffer.queue.capacity.location,
-                        "EARL-R018",
-                    )
+                with self._within(f"`{buffer.name}/ib`"):
+                    capacity = self.constant_integer(buffer.queue.capacity, scope, "a FIFO capacity")
+                    if capacity is not None and capacity < 1:
+                        self.error(
+                            f"a FIFO holds at least one message, not {capacity}",
+                            buffer.queue.capacity.location,
+                            "EARL-R018",
+                        )
                 policies = buffer.queue.OVERFLOW_POLICIES
                 if buffer.queue.overflow not in policies:
                     # only a model built in Python can say this: the reader refuses it (EARL-S013)
@@ -857,48 +871,62 @@ class Resolver:
                 inner = scope
                 if memory.family is not None and declared is not None and declared.family is not None:
                     inner = {**scope, memory.family.index: declared.family}
-                self.expression(memory.initial_value, table, inner, owner, reads_allowed=False)
+                with self._within(f"`{memory.name}/m`", "the initial value"):
+                    self.expression(memory.initial_value, table, inner, owner, reads_allowed=False)
         for predicate in subsystem.primitive_predicates:
-            self.expression(
-                predicate.expression, table, scope, owner, computed_by_python=predicate.implementation is not None
-            )
+            with self._within(f"`{predicate.name}/pp`"):
+                self.expression(
+                    predicate.expression, table, scope, owner, computed_by_python=predicate.implementation is not None
+                )
         for function in subsystem.partial_transition_functions:
-            for reference in function.reads:
-                self.reference(
-                    reference,
-                    table,
-                    scope,
-                    owner,
-                    (Kind.INPUT_BUFFER, Kind.MEMORY_INPUT),
-                    "read by a Partial Transition Function",
-                    star=True,
-                )
-            for reference in function.writes:
-                self.reference(
-                    reference,
-                    table,
-                    scope,
-                    owner,
-                    (Kind.MEMORY_OUTPUT, Kind.OUTPUT_BUFFER),
-                    "written by a Partial Transition Function",
-                    star=True,
-                )
+            for position, reference in enumerate(function.reads):
+                with self._within(f"`{function.name}/pf`", f"reads[{position}]"):
+                    self.reference(
+                        reference,
+                        table,
+                        scope,
+                        owner,
+                        (Kind.INPUT_BUFFER, Kind.MEMORY_INPUT),
+                        "read by a Partial Transition Function",
+                        star=True,
+                    )
+            for position, reference in enumerate(function.writes):
+                with self._within(f"`{function.name}/pf`", f"writes[{position}]"):
+                    self.reference(
+                        reference,
+                        table,
+                        scope,
+                        owner,
+                        (Kind.MEMORY_OUTPUT, Kind.OUTPUT_BUFFER),
+                        "written by a Partial Transition Function",
+                        star=True,
+                    )
         stage_names: dict[str, Any] = {}
         for stage in subsystem.stage_sets:
             if stage.name in stage_names:
                 self.duplicate(f"stage `{stage.name}`", stage.location, stage_names[stage.name].location)
             stage_names[stage.name] = stage
-            for reference in stage.functions:
-                self.reference(reference, table, scope, owner, (Kind.PARTIAL_TRANSITION_FUNCTION,), "in a stage")
+            with self._within(f"stage `{stage.name}`"):
+                for reference in stage.functions:
+                    self.reference(reference, table, scope, owner, (Kind.PARTIAL_TRANSITION_FUNCTION,), "in a stage")
         for behaviour in subsystem.basic_behaviours:
-            for stage_functions in behaviour.transition_function.stages:
-                for reference in stage_functions:
-                    self.reference(
-                        reference, table, scope, owner, (Kind.PARTIAL_TRANSITION_FUNCTION,), "in a transition function"
-                    )
-            self.expression(behaviour.terminal_condition.expression, table, scope, owner)
+            behaviour_name = f"`{behaviour.name}/bb`"
+            with self._within(behaviour_name, "tf"):
+                for stage_functions in behaviour.transition_function.stages:
+                    for reference in stage_functions:
+                        self.reference(
+                            reference,
+                            table,
+                            scope,
+                            owner,
+                            (Kind.PARTIAL_TRANSITION_FUNCTION,),
+                            "in a transition function",
+                        )
+            with self._within(behaviour_name, "tc"):
+                self.expression(behaviour.terminal_condition.expression, table, scope, owner)
             if behaviour.error_condition is not None:
-                self.expression(behaviour.error_condition.expression, table, scope, owner)
+                with self._within(behaviour_name, "ec"):
+                    self.expression(behaviour.error_condition.expression, table, scope, owner)
         if subsystem.fsm is not None:
             self._fsm(subsystem.fsm, table, scope, owner)
         # the reader refuses such a duration; a model built in Python may hold one
@@ -920,8 +948,12 @@ class Resolver:
                     "EARL-R030",
                     did_you_mean(state.behaviour, behaviours) or f"declare `{state.behaviour}/bb {{ tf = … tc = … }}`",
                 )
-            for reference in [*state.obligatory, *state.optional]:
-                self.reference(reference, table, scope, owner, (Kind.INPUT_BUFFER,), "in a buffer group", star=True)
+            for group in ("obligatory", "optional"):
+                for position, reference in enumerate(getattr(state, group)):
+                    with self._within(f"state `{state.name}`", f"{group}[{position}]"):
+                        self.reference(
+                            reference, table, scope, owner, (Kind.INPUT_BUFFER,), "in a buffer group", star=True
+                        )
         if fsm.initial not in states:
             self.error(
                 f"the initial state `{fsm.initial}` is not a state of this FSM",
@@ -953,9 +985,11 @@ class Resolver:
                     transition.location,
                     "EARL-R033",
                 )
-            self.expression(transition.condition.expression, table, scope, owner)
-        for assumption in fsm.assumptions:
-            self.expression(assumption.expression, table, scope, owner)
+            with self._within(f"transition `{transition.name}/t`", "the condition"):
+                self.expression(transition.condition.expression, table, scope, owner)
+        for position, assumption in enumerate(fsm.assumptions):
+            with self._within("the FSM", f"assumptions[{position}]"):
+                self.expression(assumption.expression, table, scope, owner)
 
     # ------------------------------------------------------------------ references and expressions
     def reference(
