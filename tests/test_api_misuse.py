@@ -499,3 +499,21 @@ def test_a_name_not_found_in_python_says_the_declaration_and_attribute_it_is_in(
         in said
     )
     assert "NoneType is not a data type (in `extra/m` of `counter/a.relay/ve`)" in said
+
+
+def test_a_kind_given_as_its_text_becomes_the_kind_so_to_earl_writes_it_as_check_and_the_run_take_it() -> None:
+    """`ElementReference("command", "ib")` was taken by check, export and the run, but to_earl refused it
+    (`kind: expected Kind, got str 'ib'`); a text that is no kind is still named, with the kinds."""
+    from earl.model.validate import ModelTypeError
+
+    reference = ElementReference("command", "ib")  # type: ignore[arg-type]
+    assert reference.kind is Kind.INPUT_BUFFER and reference == ElementReference("command", Kind.INPUT_BUFFER)
+    system = earl.load(Path(__file__).parent / "runtime_specs" / "counter")
+    store = system.agents[0].subsystems[1].partial_transition_functions[0]
+    store.reads[0] = reference
+    assert earl.loads(system.to_earl()) == earl.load(Path(__file__).parent / "runtime_specs" / "counter")
+    store.reads[0] = ElementReference("command", "ibb")  # type: ignore[arg-type]
+    with pytest.raises(
+        ModelTypeError, match=r"reads\[0\]\.kind: expected Kind, got str 'ibb': .*its text, one of r, a"
+    ):
+        system.to_earl()

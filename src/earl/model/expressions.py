@@ -29,13 +29,24 @@ class ElementReference:
     """A name in the manual's notation: `manipulatorCommand/ib`, `windingCurrent[K]/mo`.
 
     `indices` select members of an indexed family; they are expressions over
-    parameters and index variables, or `Star` for all members.
+    parameters and index variables, or `Star` for all members.  `kind` is a `Kind`,
+    or its text (`"ib"`), which becomes that Kind.
     """
 
     name: str
     kind: Kind
     indices: tuple[Expression | Star, ...] = ()
     location: SourceLocation | None = location_field()
+
+    def __post_init__(self) -> None:
+        # `ElementReference("cmd", "ib")`: a kind given as the text the manual writes after the slash is that
+        # Kind. Kept as text it compared equal to the Kind (a StrEnum) in some places and not in others
+        # (`kind is Kind.INPUT_BUFFER`, `kind.value`): the checker and the run took it, `to_earl` refused
+        # it. A text that is no kind (`"ibb"`) stays as given, for the type check to name.
+        if self.kind.__class__ is not Kind and isinstance(self.kind, str):
+            kind = Kind._value2member_map_.get(self.kind)
+            if kind is not None:
+                object.__setattr__(self, "kind", kind)
 
     @property
     def is_family_wide(self) -> bool:

@@ -121,6 +121,10 @@ def _advice(value: object, expected: tuple[Any, ...]) -> str:
         return f': name the function as text, `"{module}:{name}"`'
     if "Predicate" in names and type(value).__module__ == "earl.model.expressions":
         return f": wrap the expression, `Predicate({type(value).__name__}(…))`"
+    if "Kind" in names:
+        from earl.model.kinds import Kind
+
+        return f": a Kind (`Kind.INPUT_BUFFER`) or its text, one of {', '.join(kind.value for kind in Kind)}"
     if isinstance(value, str) and names & {"PrimitiveType", "TypeReference"}:
         return f': write `PrimitiveType("{value}")` or `TypeReference("{value}")`'
     if isinstance(value, str) and "Literal" in names and _EXPRESSION_TEXT.search(value):
