@@ -699,3 +699,14 @@ def test_the_agent_view_of_manip_is_narrower_than_it_was(system: System) -> None
     svg = build_diagram(system, "agent", "manip/a").svg()
     width = re.search(r'<svg width="([\d.]+)pt"', svg)
     assert width is not None and float(width.group(1)) < 1550
+
+
+def test_a_diagram_built_in_python_renders_as_mermaid_where_the_view_has_it() -> None:
+    """`build_diagram(…).render("mermaid")` said `unknown Graphviz output format 'mermaid'`: the Mermaid
+    text is the one `earl diagram --format mermaid` writes; a view without one says which views have it."""
+    system = earl.load(EXAMPLE)
+    fsm = build_diagram(system, "fsm", "manip/a.cs")
+    assert fsm.render("mermaid").decode("utf-8") == mermaid_of(Subject(system), "fsm", "manip/a.cs")
+    assert build_diagram(system, "system").mermaid() == mermaid_of(Subject(system), "system", None)
+    with pytest.raises(ValueError, match="Mermaid draws the system and fsm views"):
+        build_diagram(system, "agent", "manip/a").render("mermaid")

@@ -10,7 +10,7 @@ every member is drawn (the system as `earl check` and the runtime see it).
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
 
 from earl.check import context_for
@@ -73,8 +73,15 @@ def build_diagram(
     expand: bool = False,
     parameters: Parameters | None = None,
 ) -> Diagram:
-    """The diagram `view` of `target`; raises TargetError when the target names nothing."""
-    return diagram_of(Subject(system, expand, parameters), view, target)
+    """The diagram `view` of `target`; raises TargetError when the target names nothing. The system and
+    fsm views also have Mermaid text: `diagram.render("mermaid")` or `diagram.mermaid()`."""
+    subject = Subject(system, expand, parameters)
+    diagram = diagram_of(subject, view, target)
+    if view in MERMAID_VIEWS:
+        from earl.render.mermaid import mermaid_of  # it imports this module
+
+        diagram = replace(diagram, mermaid_text=lambda: mermaid_of(subject, view, target))
+    return diagram
 
 
 def diagram_of(subject: Subject, view: str, target: str | None) -> Diagram:

@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field
 from functools import cached_property
 
 from earl.render.graphviz import fit_frame, run_dot
@@ -16,6 +17,9 @@ class Diagram:
     slug: str  # a file name stem, unique within one document
     #: The element names the diagram shows, so tests and tooltips know what to look for.
     names: tuple[str, ...] = ()
+    #: Its Mermaid text, made when asked (`build_diagram` gives one to the system and fsm views): the
+    #: same diagram as `earl diagram --format mermaid` writes, for Markdown on code hosts that draw it.
+    mermaid_text: Callable[[], str] | None = field(default=None, repr=False, compare=False)
 
     @cached_property
     def laid_out(self) -> str:
@@ -24,7 +28,19 @@ class Diagram:
         return fit_frame(self.dot)
 
     def render(self, output_format: str = "svg") -> bytes:
+        """The diagram as `svg` or `png` (drawn by Graphviz's `dot`), or as `mermaid` text (UTF-8)."""
+        if output_format == "mermaid":
+            return self.mermaid().encode("utf-8")
         return run_dot(self.laid_out, output_format)
+
+    def mermaid(self) -> str:
+        """The Mermaid text of the system and fsm views, as `build_diagram` makes them."""
+        if self.mermaid_text is None:
+            raise ValueError(
+                f"this {self.view} diagram has no Mermaid text: Mermaid draws the system and fsm views, "
+                "as build_diagram(system, view, target) makes them"
+            )
+        return self.mermaid_text()
 
     def svg(self) -> str:
         return self.render("svg").decode("utf-8")
