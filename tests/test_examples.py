@@ -2,7 +2,8 @@
 
 Every `system.earl` under examples/ loads and follows the manual's rules, every
 `.earl` file there is canonical, and every `earl` code block of docs/language.md
-is a complete specification that loads, checks without errors and is canonical.
+is a complete specification that loads, checks without errors and is canonical;
+docs/python-api.md's model built in Python runs as the page says.
 Facts the reference lists (keywords, primitive types, overflow policies, kind
 suffixes, diagnostic codes) are compared with the code they describe.
 """
@@ -206,3 +207,29 @@ def test_every_code_the_reference_mentions_exists() -> None:
     assert mentioned, "the reference names diagnostic codes"
     unknown = sorted(code for code in mentioned if code not in READING_CODES and code not in RULES)
     assert unknown == []
+
+
+# ---------------------------------------------------------------- docs/python-api.md
+
+
+def test_the_python_api_example_runs_as_a_script_and_says_what_the_page_says(tmp_path: Path) -> None:
+    """The page's model built in Python is run as its reader would run it, `python counting.py`: its
+    functions are named `"__main__:…"`, so it must run as a script, not be imported."""
+    import os
+    import subprocess
+    import sys
+
+    page = (ROOT / "docs" / "python-api.md").read_text(encoding="utf-8")
+    section = page.split("## Building a model in Python", 1)[1]
+    [code] = re.findall(r"^```python\n(.*?)^```", section.split("\n## ", 1)[0], re.DOTALL | re.MULTILINE)
+    script = tmp_path / "counting.py"
+    script.write_text(code, encoding="utf-8")
+    environment = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT / "src"), os.environ.get("PYTHONPATH", "")])}
+    done = subprocess.run(
+        [sys.executable, str(script)], cwd=tmp_path, env=environment, capture_output=True, text=True, timeout=300
+    )
+    assert done.returncode == 0, done.stderr
+    text = done.stdout.split("\n")
+    assert earl.loads("\n".join(text[:-3])).name == "counting"  # to_earl's text reads back
+    # the outputs the page's comments promise
+    assert text[-3:] == ["finished {'count': 3}", "{'last': 3} []", ""]
