@@ -517,3 +517,18 @@ def test_a_kind_given_as_its_text_becomes_the_kind_so_to_earl_writes_it_as_check
         ModelTypeError, match=r"reads\[0\]\.kind: expected Kind, got str 'ibb': .*its text, one of r, a"
     ):
         system.to_earl()
+
+
+def test_a_spec_whose_names_are_keywords_as_read_is_not_printed_again_to_see_that_they_read_back(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """`false/pp` and the control subsystem `cs` are in nearly every spec: a name read from text was read,
+    so reading a spec does not print it and parse it again for them (it doubled the time of every load)."""
+    import earl.lang.formatter
+
+    def refused(system: object) -> str:
+        raise AssertionError("printed while read")
+
+    monkeypatch.setattr(earl.lang.formatter, "format_system", refused)
+    system = earl.load(Path(__file__).parent.parent / "examples" / "pick_and_place")
+    assert not [d for d in check(system) if d.code == "EARL-R006"]

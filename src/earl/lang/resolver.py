@@ -1490,7 +1490,8 @@ def _declared_names(system: System) -> Iterator[tuple[object, str, SourceLocatio
             yield parameter.name, f"a parameter of `{agent.name}/a`", parameter.location, where
         for j, subsystem in enumerate(agent.subsystems):
             owner, held = f"{agent.name}/a.{subsystem.name}", f"{at}.subsystems[{j}]"
-            yield subsystem.name, f"a subsystem of `{agent.name}/a`", subsystem.location, f"{held}.name"
+            if subsystem.kind is not Kind.CONTROL_SUBSYSTEM:  # that one is written `cs`, whatever its name
+                yield subsystem.name, f"a subsystem of `{agent.name}/a`", subsystem.location, f"{held}.name"
             if subsystem.family is not None:
                 where = f"{held}.family.index"
                 yield subsystem.family.index, f"the family index of `{owner}`", subsystem.family.location, where
@@ -1522,7 +1523,9 @@ def unreadable_names(system: System) -> list[tuple[object, str, SourceLocation |
     if found:
         return found  # the text would not read back for these alone; keywords are asked once they are gone
     keywords = set(keyword_terminals().values())
-    suspects = [entry for entry in declared if entry[0] in keywords]
+    # a name read from text (it has a location) was read, so it reads back: a loaded spec is not printed
+    # and read again for its `false/pp`, as the manual names that predicate
+    suspects = [entry for entry in declared if entry[0] in keywords and entry[2] is None]
     if not suspects:
         return []
     from earl.diagnostics import EarlError

@@ -241,7 +241,10 @@ def explaining(root: object, path: str = "system") -> Iterator[None]:
     except ModelTypeError:
         raise
     except (AttributeError, TypeError, KeyError) as error:
-        raise explained(root, error, path) from error
+        said = explained(root, error, path)
+        if said is error:
+            raise  # no value of a wrong type: the error as it was, not chained to itself
+        raise said from error
 
 
 def root_path(element: object) -> str:
