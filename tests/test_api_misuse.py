@@ -459,6 +459,19 @@ def test_a_keyword_given_as_a_name_in_python_is_said_by_check_and_refused_by_to_
     system = earl.load(spec)
     system.agents[0].subsystems[0].memories.append(Memory("python", PrimitiveType("int")))
     assert earl.loads(system.to_earl()) == system
+    # beside one that does not read back, the one that does is not blamed (the parser stops at `period`)
+    system.agents[0].subsystems[0].memories.append(Memory("period", PrimitiveType("int")))
+    assert [d.message.split("`")[1] for d in check(system) if d.code == "EARL-R006"] == ["period"]
+    # the first memory: the parser stops a blank line below the line it says (`fifo` after the buffers)
+    system = earl.load(spec)
+    system.agents[0].subsystems[0].memories.insert(0, Memory("fifo", PrimitiveType("int")))
+    with pytest.raises(ModelNameError, match=r"memories\[0\]\.name: 'fifo'"):
+        system.to_earl()
+    system = earl.load(spec)
+    system.name = "système"
+    with pytest.raises(ModelNameError, match=r"'système' \(the system\) is no EARL name"):
+        system.to_earl()
+    system = earl.load(spec)
     system.name = "my system"
     with pytest.raises(ModelNameError, match=r"system\.name: 'my system' \(the system\) is no EARL name"):
         system.to_earl()

@@ -1519,7 +1519,7 @@ def unreadable_names(system: System) -> list[tuple[object, str, SourceLocation |
     declared = list(_declared_names(system))
     if system.name == "":
         declared = declared[1:]  # a system without a name is printed without its `system` line
-    found = [entry for entry in declared if not (isinstance(entry[0], str) and _NAME.fullmatch(entry[0]))]
+    found = [entry for entry in declared if not (isinstance(entry[0], str) and is_earl_name(entry[0]))]
     if found:
         return found  # the text would not read back for these alone; keywords are asked once they are gone
     keywords = set(keyword_terminals().values())
@@ -1539,13 +1539,25 @@ def unreadable_names(system: System) -> list[tuple[object, str, SourceLocation |
     try:
         parse_text(text)
     except EarlError as error:
-        location = error.diagnostics[0].location if error.diagnostics else None
+        diagnostic = error.diagnostics[0] if error.diagnostics else None
+        # the word the parser stopped at, as its message quotes it (`unexpected `fifo``, `found `link``):
+        # that suspect, not another keyword-named one on the same line (`python/m` reads back)
+        quoted = set(re.findall(r"`([^`]+)`", diagnostic.message)) if diagnostic is not None else set()
+        stopped_at = [entry for entry in suspects if entry[0] in quoted]
+        if stopped_at:
+            return stopped_at[:1]
+        location = diagnostic.location if diagnostic is not None else None
         lines = text.splitlines()
-        # the parser may place its error at the end of the token before the keyword (`… = 0.0` ⏎ `state/m`)
+        # the parser may place its error at the end of the token before the keyword (`… = 0.0` ⏎ ⏎ `state/m`)
         at = location.line - 1 if location is not None else len(lines)
-        near = "\n".join(lines[at : at + 2])
-        return [entry for entry in suspects if re.search(rf"(?<![\w]){entry[0]}(?![\w])", near)]
+        near = "\n".join(line for line in lines[at : at + 4] if line.strip())
+        return [entry for entry in suspects if re.search(rf"(?<![\w]){entry[0]}(?![\w])", near)][:1]
     return []
+
+
+def is_earl_name(text: str) -> bool:
+    """Whether `text` is written as an EARL name: a letter or `_`, then letters, digits and `_` (ASCII)."""
+    return _NAME.fullmatch(text) is not None
 
 
 def _size(family: IndexRange | None) -> int:

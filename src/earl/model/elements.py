@@ -592,7 +592,7 @@ class System:
     def to_earl(self) -> str:
         """This system as canonical `.earl` text (what `earl fmt` prints)."""
         from earl.lang.formatter import format_system  # the model itself imports no reader
-        from earl.lang.resolver import unreadable_names
+        from earl.lang.resolver import is_earl_name, unreadable_names
         from earl.model.validate import ModelNameError, explaining
 
         with explaining(self):  # a model built in Python with a wrong value: said at its path
@@ -601,7 +601,7 @@ class System:
             name, what, _, path = unreadable[0]
             why = (
                 "a keyword of EARL where it stands"
-                if isinstance(name, str) and name.isidentifier()
+                if isinstance(name, str) and is_earl_name(name)
                 else "no EARL name (a letter or `_`, then letters, digits and `_`)"
             )
             raise ModelNameError(f"{path}: {name!r} ({what}) is {why}: the text would not read back; rename it")
