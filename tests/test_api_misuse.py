@@ -545,3 +545,17 @@ def test_a_spec_whose_names_are_keywords_as_read_is_not_printed_again_to_see_tha
     monkeypatch.setattr(earl.lang.formatter, "format_system", refused)
     system = earl.load(Path(__file__).parent.parent / "examples" / "pick_and_place")
     assert not [d for d in check(system) if d.code == "EARL-R006"]
+
+
+def test_a_tuple_where_the_model_declares_a_list_is_drawn_and_exported() -> None:
+    """`system.agents = tuple(…)` checked, printed and ran, but drawing and the SysML export refused it
+    (expected a list, got tuple) once they checked the model's types first."""
+    from earl.export.sysml import export_sysml
+    from earl.render.build import build_diagram
+
+    system = earl.load(Path(__file__).parent / "runtime_specs" / "counter")
+    system.agents = tuple(system.agents)  # type: ignore[assignment]
+    subsystem = system.agents[0].subsystems[0]
+    subsystem.memories = tuple(subsystem.memories)  # type: ignore[assignment]
+    assert "counter/a" in build_diagram(system, "system").dot
+    assert "counter" in export_sysml(system)

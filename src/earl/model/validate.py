@@ -69,9 +69,9 @@ def _check(
         found.append(f"{path}: expected {_name(hint)}, got {_got(value)}{_advice(value, typing.get_args(hint))}")
         return
     if origin in (list, tuple, set, frozenset):
-        # `indices=[Name("K")]` for a tuple: every part of earl reads a list as well, and refusing it where
-        # a model is drawn or exported first would refuse what checks, prints and runs
-        accepted = (tuple, list) if origin is tuple else origin
+        # `indices=[Name("K")]` for a tuple, `agents=tuple(…)` for a list: every part of earl reads either,
+        # and refusing one where a model is drawn or exported first would refuse what checks, prints and runs
+        accepted = (tuple, list) if origin in (tuple, list) else origin
         if not isinstance(value, accepted):
             found.append(f"{path}: expected a {origin.__name__} ({_name(hint)}), got {_got(value)}")
             return
@@ -104,7 +104,7 @@ def _fits(value: object, hint: Any) -> bool:
     if origin is not None:
         if origin is typing.Literal:
             return value in typing.get_args(hint)
-        return isinstance(value, (tuple, list) if origin is tuple else origin)
+        return isinstance(value, (tuple, list) if origin in (tuple, list) else origin)
     if hint is float:
         return isinstance(value, int | float) and not isinstance(value, bool)
     if hint is int:
