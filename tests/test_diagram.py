@@ -710,3 +710,25 @@ def test_a_diagram_built_in_python_renders_as_mermaid_where_the_view_has_it() ->
     assert build_diagram(system, "system").mermaid() == mermaid_of(Subject(system), "system", None)
     with pytest.raises(ValueError, match="Mermaid draws the system and fsm views"):
         build_diagram(system, "agent", "manip/a").render("mermaid")
+
+
+@pytest.mark.parametrize("json_output", ["refused", "not json"])
+def test_a_graphviz_without_json_output_still_draws_the_diagram(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, system: System, json_output: str
+) -> None:
+    """The frame is fitted to the edge labels by one layout as JSON first; Graphviz before 2.40 has no JSON
+    output, and every SVG and `earl doc` failed with it ("Format: "json" not recognized")."""
+    import shutil
+
+    real = shutil.which("dot")
+    assert real is not None
+    answer = (
+        "echo 'Error: Format: \"json\" not recognized' >&2; exit 1"
+        if json_output == "refused"
+        else "echo 'not json'; exit 0"
+    )
+    wrapper = tmp_path / "dot"
+    wrapper.write_text(f'#!/bin/sh\nfor a in "$@"; do case "$a" in -Tjson) {answer};; esac; done\nexec {real} "$@"\n')
+    wrapper.chmod(0o755)
+    monkeypatch.setenv("EARL_DOT", str(wrapper))
+    assert "approach" in build_diagram(system, "fsm", "task/a.cs").svg()

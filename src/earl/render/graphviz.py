@@ -84,7 +84,14 @@ def fit_frame(source: str, attempts: int = 3) -> str:
         found = _FRAME_MARGIN.search(source)
         if found is None:
             return source
-        overflow = frame_overflow(json.loads(_dot(source, "json")))
+        try:
+            layout = json.loads(_dot(source, "json"))
+        except (GraphvizError, ValueError):
+            # a Graphviz without JSON output (before 2.40) or one that writes something else: the diagram
+            # is drawn as dot sizes its frame, rather than not at all (drawing it says what is wrong, if
+            # anything is)
+            return source
+        overflow = frame_overflow(layout)
         if overflow <= 0:
             return source
         margin = int(found.group(1)) + math.ceil(overflow) + 4
