@@ -732,3 +732,13 @@ def test_a_graphviz_without_json_output_still_draws_the_diagram(
     wrapper.chmod(0o755)
     monkeypatch.setenv("EARL_DOT", str(wrapper))
     assert "approach" in build_diagram(system, "fsm", "task/a.cs").svg()
+
+
+def test_the_notebook_s_system_diagram_has_its_mermaid_text(system: System) -> None:
+    """`diagram_for(system).render("mermaid")` said "this system diagram has no Mermaid text: Mermaid draws the
+    system and fsm views": only build_diagram attached it."""
+    from earl.render.jupyter import diagram_for
+
+    shown = diagram_for(system)
+    assert shown is not None
+    assert shown.render("mermaid").decode() == mermaid_of(Subject(system), "system", None)

@@ -10,6 +10,7 @@ machine, a BasicBehaviour its activity diagram, a data type its bdd.  Load it wi
 from __future__ import annotations
 
 import sys
+from dataclasses import replace
 from typing import Any
 
 from earl.model.elements import FSM, Agent, BasicBehaviour, Subsystem, System
@@ -34,9 +35,12 @@ def diagram_for(element: object) -> Diagram | None:
         refuse_wrong_types(element, root_path(element))  # a System is looked at by its Subject
     if isinstance(element, System):
         from earl.render.build import Subject
+        from earl.render.mermaid import mermaid_of
 
         subject = Subject(element)
-        return system_view(element, subject.agent_type, subject.placements)
+        drawn = system_view(element, subject.agent_type, subject.placements)
+        # as build_diagram gives it: the notebook's system diagram has its Mermaid text too
+        return replace(drawn, mermaid_text=lambda: mermaid_of(subject, "system", None))
     if isinstance(element, Agent):
         return agent_view(element)
     if isinstance(element, Subsystem):
