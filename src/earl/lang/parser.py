@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from bisect import bisect_left
+from collections.abc import Callable
 from functools import lru_cache
 from importlib import resources
 from typing import Any
@@ -232,13 +233,16 @@ _PART_LISTS = (
     "assumptions",
 )
 
-#: Per class: whether it carries comments, which of `_PART_LISTS` it has, whether it has an `fsm`.
-_SHAPES: dict[type, tuple[bool, tuple[str, ...], bool]] = {}
+#: Per class: whether it carries comments, which of `_PART_LISTS` it has, whether it has an `fsm`, and
+#: what else of it carries comments (a robot's members, the clauses of a subsystem, behaviour, FSM, state).
+_Shape = tuple[bool, tuple[str, ...], bool, Callable[[Any], list[Any]] | None]
+_SHAPES: dict[type, _Shape] = {}
 
 
-def _shape(cls: type) -> tuple[bool, tuple[str, ...], bool]:
+def _shape(cls: type) -> _Shape:
     fields = {f.name for f in getattr(cls, "__dataclass_fields__", {}).values()}
-    shape = ("comments" in fields, tuple(a for a in _PART_LISTS if a in fields), "fsm" in fields)
+    inner = next((found for kind, found in _INNER.items() if issubclass(cls, kind)), None)
+    shape = ("comments" in fields, tuple(a for a in _PART_LISTS if a in fields), "fsm" in fields, inner)
     _SHAPES[cls] = shape
     return shape
 
@@ -249,29 +253,15 @@ def _statements(declarations: list[Any]) -> list[Any]:
     stack = list(declarations)
     while stack:
         element = stack.pop()
-        carries, parts, has_fsm = _SHAPES.get(type(element)) or _shape(type(element))
+        carries, parts, has_fsm, inner = _SHAPES.get(type(element)) or _shape(type(element))
         if carries and element.location is not None:
             found.append(element)
         for attribute in parts:
             stack.extend(getattr(element, attribute) or ())
         if has_fsm and element.fsm is not None:
             stack.append(element.fsm)
-        if isinstance(element, Robot):
-            found.extend(_robot_members(element))
-        elif isinstance(element, Subsystem):
-            found.extend(_clauses(element, [("period", element.period_location)]))
-        elif isinstance(element, BasicBehaviour):
-            error = element.error_condition
-            clauses = [
-                ("tf", element.transition_function.location),
-                ("tc", element.terminal_condition.location),
-                ("ec", error.location if error is not None else None),
-            ]
-            found.extend(_clauses(element, clauses))
-        elif isinstance(element, FSM):
-            found.extend(_clauses(element, [("initial", element.initial_location)]))
-        elif isinstance(element, State):
-            found.extend(_clauses(element, _state_clauses(element)))
+        if inner is not None:
+            found.extend(inner(element))
     return found
 
 
@@ -287,6 +277,16 @@ def _state_clauses(state: State) -> list[tuple[str, SourceLocation | None]]:
         clauses.extend((f"{clause} {number}", location) for number, location in enumerate(lines.values()))
     clauses.append(("timeout 0", state.timeout_location))
     return clauses
+
+
+def _behaviour_clauses(behaviour: BasicBehaviour) -> list[_Clause]:
+    error = behaviour.error_condition
+    clauses = [
+        ("tf", behaviour.transition_function.location),
+        ("tc", behaviour.terminal_condition.location),
+        ("ec", error.location if error is not None else None),
+    ]
+    return _clauses(behaviour, clauses)
 
 
 class _Clause:
@@ -309,6 +309,16 @@ def _clauses(
     element: Subsystem | BasicBehaviour | FSM | State, clauses: list[tuple[str, SourceLocation | None]]
 ) -> list[_Clause]:
     return [_Clause(location, element.clause_comments, key) for key, location in clauses if location is not None]
+
+
+#: the things inside an element, besides its parts, that carry comments of their own
+_INNER: dict[type, Callable[[Any], list[Any]]] = {
+    Robot: lambda robot: _robot_members(robot),
+    Subsystem: lambda subsystem: _clauses(subsystem, [("period", subsystem.period_location)]),
+    BasicBehaviour: lambda behaviour: _behaviour_clauses(behaviour),
+    FSM: lambda fsm: _clauses(fsm, [("initial", fsm.initial_location)]),
+    State: lambda state: _clauses(state, _state_clauses(state)),
+}
 
 
 class _RobotMember:

@@ -11,7 +11,6 @@ from __future__ import annotations
 import itertools
 import re
 from collections.abc import Iterable, Iterator, Mapping, Sequence
-from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -156,6 +155,40 @@ class _AgentTable:
     declared_twice: set[tuple[str, Kind]] = field(default_factory=set)
 
 
+class _Place:
+    """Where the resolver is within an element (`reads[0] of `store/pf` of `worker/a.cs``), put in words only
+    when a problem without a location needs it: every element of every spec read is entered."""
+
+    __slots__ = ("attribute", "element", "outer")
+
+    def __init__(self, element: str, attribute: str, outer: str | _Place | None) -> None:
+        self.element = element
+        self.attribute = attribute
+        self.outer = outer
+
+    def __str__(self) -> str:
+        inner = f"{self.attribute} of {self.element}" if self.attribute else self.element
+        return f"{inner} of {self.outer}"
+
+
+class _Within:
+    """`with resolver._within(…)`: a class, not a generator, for it is entered for every element read."""
+
+    __slots__ = ("attribute", "element", "outer", "resolver")
+
+    def __init__(self, resolver: Resolver, element: str, attribute: str) -> None:
+        self.resolver = resolver
+        self.element = element
+        self.attribute = attribute
+
+    def __enter__(self) -> None:
+        self.outer = self.resolver._place
+        self.resolver._place = _Place(self.element, self.attribute, self.outer)
+
+    def __exit__(self, *_: object) -> None:
+        self.resolver._place = self.outer
+
+
 class Resolver:
     def __init__(self, system: System, overrides: Mapping[str, Value]) -> None:
         self.system = system
@@ -164,7 +197,7 @@ class Resolver:
         self._said: set[tuple[str, str, SourceLocation | None]] = set()
         self.types: dict[str, Any] = {}
         #: the declaration being resolved (`a/a.cs`), named by a message that has no location
-        self._place: str | None = None
+        self._place: str | _Place | None = None
         #: per named type: (structs nested, numbers/Booleans/strings in one value), once every type is read
         self._type_sizes: dict[str, tuple[int, int]] | None = None
         self.agents: dict[str, _AgentTable] = {}
@@ -176,7 +209,7 @@ class Resolver:
     def error(self, message: str, location: SourceLocation | None, code: str, hint: str | None = None) -> None:
         # An element of a family, or a link resolved from both of its ends, can meet the same problem
         # more than once: the reader is told once, at the place it was written.
-        if location is None and self._place is not None and self._place not in message:
+        if location is None and self._place is not None and str(self._place) not in message:
             # a model built in Python has no locations: the message says which element it is about
             message = f"{message} (in {self._place})"
         key = (code, message, location)
@@ -185,16 +218,10 @@ class Resolver:
         self._said.add(key)
         self.diagnostics.append(Diagnostic(Severity.ERROR, message, location, code=code, hint=hint))
 
-    @contextmanager
-    def _within(self, element: str, attribute: str = "") -> Iterator[None]:
+    def _within(self, element: str, attribute: str = "") -> _Within:
         """Inside, a problem without a location (a model built in Python) says the element it is in, and
         the attribute (`in reads[0] of `store/pf` of `worker/a.cs``), not only the subsystem."""
-        outer = self._place
-        self._place = f"{attribute} of {element} of {outer}" if attribute else f"{element} of {outer}"
-        try:
-            yield
-        finally:
-            self._place = outer
+        return _Within(self, element, attribute)
 
     def duplicate(self, what: str, location: SourceLocation | None, first: SourceLocation | None) -> None:
         where = f" (first declared at line {first.line})" if first is not None else ""
@@ -1522,10 +1549,14 @@ def unreadable_names(system: System) -> list[tuple[object, str, SourceLocation |
     found = [entry for entry in declared if not (isinstance(entry[0], str) and is_earl_name(entry[0]))]
     if found:
         return found  # the text would not read back for these alone; keywords are asked once they are gone
-    keywords = set(keyword_terminals().values())
     # a name read from text (it has a location) was read, so it reads back: a loaded spec is not printed
-    # and read again for its `false/pp`, as the manual names that predicate
-    suspects = [entry for entry in declared if entry[0] in keywords and entry[2] is None]
+    # and read again for its `false/pp`, as the manual names that predicate (nor is the grammar's table
+    # of keywords made for it, a second parser)
+    unread = [entry for entry in declared if entry[2] is None]
+    if not unread:
+        return []
+    keywords = set(keyword_terminals().values())
+    suspects = [entry for entry in unread if entry[0] in keywords]
     if not suspects:
         return []
     from earl.diagnostics import EarlError
