@@ -55,3 +55,29 @@ def test_a_ctrl_c_the_shell_has_earl_ignore_stays_ignored(tmp_path: Path) -> Non
             child.kill()
     assert child.returncode == 0, err
     assert (tmp_path / "site" / "index.html").is_file()
+
+
+def test_nohup_earl_run_outlives_its_terminal(tmp_path: Path) -> None:
+    """`nohup earl run …` ignores SIGHUP; earl's own stop handler replaced the ignore, and closing the
+    terminal stopped the run (exit 130) after all."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    counter = Path(__file__).parent / "runtime_specs" / "counter"
+    child = subprocess.Popen(
+        [sys.executable, "-m", "earl", "run", str(counter), "--duration", "2s", "--realtime", "--no-progress"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        preexec_fn=lambda: signal.signal(signal.SIGHUP, signal.SIG_IGN),
+    )
+    try:
+        time.sleep(1.0)  # in the run
+        child.send_signal(signal.SIGHUP)
+        out, err = child.communicate(timeout=60)
+    finally:
+        if child.poll() is None:
+            child.kill()
+    assert child.returncode == 0, err
+    assert b"ran 2.000 s" in out, out

@@ -434,8 +434,12 @@ class _StopRequest:
 
 @contextlib.contextmanager
 def handling_stop_signals(handler: Callable[..., None]) -> Iterator[None]:
-    """`handler` for every one of STOP_SIGNALS meanwhile; the previous handlers afterwards."""
-    previous = {number: signal.signal(number, handler) for number in STOP_SIGNALS}
+    """`handler` for every one of STOP_SIGNALS meanwhile; the previous handlers afterwards. A signal the
+    process was started to ignore stays ignored: `nohup earl run …` (SIGHUP) outlives its terminal, and a
+    background job of a script (SIGINT) is not stopped by the Ctrl-C meant for the script."""
+    previous = {
+        number: signal.signal(number, handler) for number in STOP_SIGNALS if signal.getsignal(number) != signal.SIG_IGN
+    }
     try:
         yield
     finally:
