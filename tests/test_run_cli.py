@@ -136,6 +136,30 @@ def test_a_trace_summary_of_something_else_is_a_clear_error(tmp_path: Path) -> N
     assert earl_cli("trace", "summary", str(tmp_path / "missing.mcap")).returncode == 2
 
 
+def test_a_bit_flipped_in_a_trace_is_damage_said_as_such_not_other_numbers(tmp_path: Path) -> None:
+    """The chunks' checksums were not checked: one bit flipped inside the compressed data gave a summary of
+    1.858 s for a run of 0.1 s, and exit 0. Other files say what they are: a directory, a file of another
+    kind, Python's own words for them no more."""
+    trace = tmp_path / "run.mcap"
+    assert earl_cli("run", str(SPECS / "counter"), "--duration", "100ms", "--trace", str(trace)).returncode == 0
+    data = bytearray(trace.read_bytes())
+    damaged = tmp_path / "damaged.mcap"
+    data[610] ^= 1  # inside the first chunk's compressed messages
+    damaged.write_bytes(bytes(data))
+    for command in (["trace", "summary"], ["plot"]):
+        extra = ["--signal", "counter/a.cs.count", "-o", str(tmp_path / "p.png")] if command == ["plot"] else []
+        result = earl_cli(*command, str(damaged), *extra)
+        assert result.returncode == 1, result.stdout
+        assert "is damaged: a checksum of its data does not match" in result.stderr, result.stderr
+    text = tmp_path / "notes.mcap"
+    text.write_text("a few\n")
+    said = earl_cli("trace", "summary", str(text)).stderr
+    assert "it does not begin as an MCAP file does" in said and "unpack" not in said
+    (tmp_path / "runs").mkdir()
+    directory = earl_cli("trace", "summary", str(tmp_path / "runs"))
+    assert directory.returncode == 2 and "is a directory, not a trace" in directory.stderr
+
+
 def test_a_damaged_trace_is_a_clear_error_for_summary_and_plot(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -19,7 +19,7 @@ def register(commands: Any) -> None:
         "trace",
         help="read an MCAP trace written by `earl run --trace`",
         description="Read a trace written by `earl run --trace FILE.mcap`.",
-        epilog="example:\n  earl trace summary run.mcap\n\nexit codes: 0 ok, 1 not a readable earl trace",
+        epilog="example:\n  earl trace summary run.mcap\n\nexit codes: 0 ok, 1 not a readable earl trace, 2 usage error (no such file)",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     actions = trace.add_subparsers(dest="action", metavar="ACTION", parser_class=type(trace))
@@ -65,7 +65,7 @@ def run_summary(arguments: argparse.Namespace) -> int:
 
     path = Path(arguments.file)
     if not path.is_file():
-        return usage_error(f"no such file: {arguments.file}")
+        return usage_error(_not_a_file(arguments.file))
     try:
         summary = summarise(path)
     except TraceError as error:
@@ -115,7 +115,7 @@ def run_plot(arguments: argparse.Namespace) -> int:
 
     path = Path(arguments.file)
     if not path.is_file():
-        return usage_error(f"no such file: {arguments.file}")
+        return usage_error(_not_a_file(arguments.file))
     problem = plot_output_problem(Path(arguments.output))
     if problem is not None:
         return usage_error(f"cannot write {arguments.output!r}: {problem}")
@@ -130,3 +130,10 @@ def run_plot(arguments: argparse.Namespace) -> int:
         sys.stderr.write(f"earl plot: {line}\n")
     print(f"wrote {arguments.output}")
     return EXIT_OK
+
+
+def _not_a_file(given: str) -> str:
+    """Why `given` is no trace to read: a directory is there, only not a file."""
+    if Path(given).is_dir():
+        return f"{given} is a directory, not a trace: name the .mcap file (earl run --trace FILE.mcap writes one)"
+    return f"no such file: {given}"

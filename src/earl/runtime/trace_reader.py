@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 import math
 import re
+import struct
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -19,7 +20,7 @@ from typing import Any
 from mcap.exceptions import EndOfFile, McapError
 from mcap.reader import make_reader
 from mcap.records import Channel, Message, Schema
-from mcap.stream_reader import StreamReader
+from mcap.stream_reader import CRCValidationError, StreamReader
 
 from earl.runtime.values import iter_leaves
 
@@ -63,7 +64,7 @@ def _messages(
     yielded = False
     try:
         with open(path, "rb") as stream:
-            reader = make_reader(stream)
+            reader = make_reader(stream, validate_crcs=True)  # a flipped bit is damage, not other numbers
             for _, channel, message in reader.iter_messages(topics=topics, log_time_order=False):
                 yielded = True
                 yield channel.topic, channel.metadata, message.log_time, json.loads(message.data)
@@ -99,7 +100,7 @@ def _records_up_to_the_cut(
     by its number as it is declared (before the channels that use it)."""
     channels: dict[int, Channel] = {}
     with open(path, "rb") as stream:
-        records = StreamReader(stream).records
+        records = StreamReader(stream, validate_crcs=True).records
         while True:
             try:
                 record = next(records)
@@ -124,6 +125,11 @@ def _nothing_readable(path: Path, error: BaseException) -> TraceError:
             start = stream.read(len(_MAGIC))
     except OSError:
         start = b""
+    if isinstance(error, CRCValidationError):
+        return TraceError(
+            f"{path} is damaged: a checksum of its data does not match what it holds (a bit changed on disk or "
+            "in a copy), before anything of it could be read"
+        )
     if start == _MAGIC:
         return TraceError(
             f"{path} is not a readable MCAP trace: it was cut short (or damaged) before its first whole "
@@ -134,9 +140,15 @@ def _nothing_readable(path: Path, error: BaseException) -> TraceError:
 
 def _unreadable(path: Path, error: BaseException) -> TraceError:
     """A damaged or foreign file: McapError, a decompressor's error, a record too long to allocate …"""
-    if not str(error):
+    if isinstance(error, CRCValidationError):
+        detail = "a checksum of its data does not match what it holds: a bit changed on disk or in a copy"
+    elif isinstance(error, json.JSONDecodeError | UnicodeDecodeError):
+        detail = "a message is not JSON text, as every message of an earl trace is: damaged, or another tool's file"
+    elif isinstance(error, struct.error) or "invalid magic" in str(error):
+        detail = "it does not begin as an MCAP file does: another kind of file, or one cut to a few bytes"
+    elif not str(error):
         detail = "it ends early" if isinstance(error, EOFError | EndOfFile) else type(error).__name__
-    elif isinstance(error, McapError | json.JSONDecodeError):
+    elif isinstance(error, McapError):
         detail = str(error)
     else:
         detail = f"{type(error).__name__}: {error}"
@@ -227,7 +239,7 @@ def _channels(path: Path) -> dict[str, tuple[dict[str, str], Any]]:
     failure: Exception | None = None
     try:
         with open(path, "rb") as stream:
-            summary = make_reader(stream).get_summary()
+            summary = make_reader(stream, validate_crcs=True).get_summary()
     except FileNotFoundError:
         raise TraceError(f"no such file: {path}") from None
     except Exception as error:  # as in `_messages`
