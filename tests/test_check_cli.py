@@ -13,6 +13,7 @@ import pytest
 
 from earl.check.registry import RULES
 from earl.cli.main import main
+from earl.lang.codes import READING_CODES
 
 EXAMPLE = Path(__file__).parent.parent / "examples" / "pick_and_place" / "system.earl"
 
@@ -240,10 +241,12 @@ def test_sarif_output(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> Non
     driver = only_run["tool"]["driver"]
     assert driver["name"] == "earl"
     rules = driver["rules"]
-    assert [rule["id"] for rule in rules] == sorted(RULES)
+    # the rules, then what reading a spec finds (S…, R…), which results name too
+    assert [rule["id"] for rule in rules] == sorted(RULES) + sorted(READING_CODES)
     for rule in rules:
         assert rule["name"].isidentifier()
-        assert rule["shortDescription"]["text"] == RULES[rule["id"]].title
+        described = RULES[rule["id"]].title if rule["id"] in RULES else READING_CODES[rule["id"]]
+        assert rule["shortDescription"]["text"] == described
         assert rule["defaultConfiguration"]["level"] in ("error", "warning", "note")
     assert len({rule["name"] for rule in rules}) == len(rules)
     results = only_run["results"]
@@ -257,6 +260,21 @@ def test_sarif_output(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> Non
     assert (region["startLine"], region["startColumn"]) == (20, 13)
     # SARIF's endColumn is the column after the region, as earl's end columns are
     assert (region["endLine"], region["endColumn"]) == (20, 13 + len("run -> other when go/pp"))
+
+
+def test_a_sarif_result_of_reading_names_a_rule_of_the_driver(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A syntax error (EARL-S…) or a name that does not resolve (EARL-R…) was a result whose rule the driver
+    did not describe: SARIF viewers showed it without one."""
+    spec = write(tmp_path, "system s\n\nagent/a {\n")
+    status, log = sarif(capsys, spec)
+    assert status == 1
+    (only_run,) = log["runs"]
+    rules = only_run["tool"]["driver"]["rules"]
+    (result,) = only_run["results"]
+    assert result["ruleId"].startswith("EARL-S")
+    assert rules[result["ruleIndex"]]["id"] == result["ruleId"]
 
 
 def test_sarif_names_a_relative_file_relative(
@@ -284,7 +302,7 @@ def test_sarif_output_of_a_clean_spec_still_describes_the_rules(
     status, log = sarif(capsys, write(tmp_path, CLEAN))
     assert status == 0
     assert log["runs"][0]["results"] == []
-    assert len(log["runs"][0]["tool"]["driver"]["rules"]) == len(RULES)
+    assert len(log["runs"][0]["tool"]["driver"]["rules"]) == len(RULES) + len(READING_CODES)
 
 
 # ---------------------------------------------------------------- exit codes

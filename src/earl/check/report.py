@@ -12,6 +12,7 @@ from typing import Any
 from earl import __version__
 from earl.check.registry import rules_by_code
 from earl.diagnostics import Diagnostic, Severity
+from earl.lang.codes import READING_CODES
 
 _SARIF_LEVEL = {Severity.ERROR: "error", Severity.WARNING: "warning", Severity.NOTE: "note"}
 
@@ -49,7 +50,8 @@ def artifact_uri(file: str) -> str:
 
 
 def as_sarif(diagnostics: Sequence[Diagnostic]) -> str:
-    """A SARIF 2.1.0 log with one run; every registered rule is described in the tool's driver."""
+    """A SARIF 2.1.0 log with one run; every registered rule, and every code of reading, is described in
+    the tool's driver."""
     rules = [
         {
             "id": rule.code,
@@ -60,6 +62,17 @@ def as_sarif(diagnostics: Sequence[Diagnostic]) -> str:
             "properties": {"manualReference": rule.reference},
         }
         for rule in rules_by_code()
+    ]
+    # what reading a spec finds before the rules apply (EARL-S…, EARL-R…): every result names a rule of the driver
+    rules += [
+        {
+            "id": code,
+            "name": "reading_" + code.removeprefix("EARL-").lower(),
+            "shortDescription": {"text": text},
+            "fullDescription": {"text": f"{text} (found while reading the spec; docs/rules.md)"},
+            "defaultConfiguration": {"level": "error"},
+        }
+        for code, text in sorted(READING_CODES.items())
     ]
     index = {rule["id"]: position for position, rule in enumerate(rules)}
     results: list[dict[str, Any]] = []
