@@ -121,6 +121,8 @@ def test_a_plot_that_cannot_be_written_is_a_usage_error_said_before_anything_run
         plot = earl_cli("plot", str(trace), "--signal", "counter/a.cs.count", "-o", str(output))
         assert plot.returncode == 2 and fragment in plot.stderr, plot.stderr
         assert "Traceback" not in plot.stderr
+    empty = earl_cli("plot", str(trace), "--signal", "", "-o", str(tmp_path / "p.png"))
+    assert empty.returncode == 2 and "--signal names no signal" in empty.stderr  # a usage error, not 1
     started = time.monotonic()
     run = earl_cli("run", str(SPECS / "counter"), "--duration", "1000s", "--plot", str(tmp_path / "x.txt"))
     assert run.returncode == 2 and "--plot" in run.stderr

@@ -119,6 +119,8 @@ def run_plot(arguments: argparse.Namespace) -> int:
     problem = plot_output_problem(Path(arguments.output))
     if problem is not None:
         return usage_error(f"cannot write {arguments.output!r}: {problem}")
+    if any(not signal.strip() for signal in arguments.signal):
+        return usage_error("--signal names no signal: write one as `agent/a.subsystem.memory`, e.g. manip/a.cs.count")
     try:
         left_out = plot_signals(path, arguments.signal, Path(arguments.output), arguments.title)
     except TraceError as error:
