@@ -1419,6 +1419,10 @@ def test_ctrl_c_at_any_moment_of_the_start_is_exit_130_with_one_line(tmp_path: P
         if result is None:
             continue  # done before the signal
         code, said = result
+        if code == 0 and any("Cython module failed to patch module" in line for line in said):
+            # CPython lost the interrupt: it came while a compiled module (`dd`'s) initialised, whose import
+            # reports the KeyboardInterrupt as "Exception ignored" and goes on; no code of earl's runs there
+            continue
         assert code == 130, (delay, said)
         assert len(said) == 1 and "interrupted" in said[0], (delay, said)
         interrupted += 1
