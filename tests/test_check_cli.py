@@ -466,6 +466,8 @@ def test_rules_knows_reading_codes_and_refuses_unknown_ones(capsys: pytest.Captu
     assert status == 2 and "did you mean `EARL-X020`?" in err
     status, _, err = run(capsys, "rules", "S19")
     assert "did you mean `EARL-S019`?" in err
+    status, _, err = run(capsys, "rules", "")  # no code at all: not a misspelt one (it offered EARL-X021)
+    assert status == 2 and "name a code" in err and "did you mean" not in err
 
 
 # ---------------------------------------------------------------- safety

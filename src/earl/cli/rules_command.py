@@ -28,7 +28,9 @@ def run(arguments: argparse.Namespace) -> int:
         for rule in rules_by_code():
             sys.stdout.write(f"{rule.code}  {rule.severity.value:<7}  {rule.title}  ({rule.reference})\n")
         return 0
-    code = arguments.code.upper()
+    code = arguments.code.strip().upper()
+    if not code:  # `earl rules ''`: no code, not a misspelt one
+        return usage_error("name a code, e.g. `earl rules E060`; `earl rules` alone lists the rules")
     if not code.startswith("EARL-"):
         code = f"EARL-{code}"
     if code in RULES:
