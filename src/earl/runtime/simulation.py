@@ -432,12 +432,9 @@ class _Guarded:
     def __init__(
         self, environment: object, location: SourceLocation | None = None, sources: SourceMap | None = None
     ) -> None:
-        advance = getattr(environment, "advance", None)
+        advance = _environment_method(environment, "advance", location, sources)
         if advance is None:
             return
-        if not callable(advance):
-            message = f"the environment's `advance` is a {type(advance).__name__}, not a method"
-            raise EarlError([Diagnostic(Severity.ERROR, message, location, code="EARL-X020")], sources)
 
         def guarded(seconds: float) -> None:
             try:
@@ -493,15 +490,24 @@ def _environment(
             ) from None
 
 
+def _environment_method(
+    environment: object, name: str, location: SourceLocation | None, sources: SourceMap | None
+) -> Callable[..., Any] | None:
+    """The environment's optional method `name` (`advance`, `bind`), None when it has none; EARL-X020 when
+    what it has under that name cannot be called."""
+    method = getattr(environment, name, None)
+    if method is not None and not callable(method):
+        message = f"the environment's `{name}` is a {type(method).__name__}, not a method"
+        raise EarlError([Diagnostic(Severity.ERROR, message, location, code="EARL-X020")], sources)
+    return method
+
+
 def _bind(environment: object, expanded: System, location: SourceLocation | None, sources: SourceMap) -> None:
     """The environment's `bind(system)`, if it has one: its chance to refuse, before the first iteration, a
-    system it cannot serve (a MuJoCo model without an actuator that a real effector is named after)."""
-    bind = getattr(environment, "bind", None)
+    system it cannot serve (a MuJoCo model whose timestep does not divide a real effector's period)."""
+    bind = _environment_method(environment, "bind", location, sources)
     if bind is None:
         return
-    if not callable(bind):
-        message = f"the environment's `bind` is a {type(bind).__name__}, not a method"
-        raise EarlError([Diagnostic(Severity.ERROR, message, location, code="EARL-X020")], sources)
     try:
         bind(expanded)
     except Exception as error:
