@@ -923,6 +923,48 @@ def test_a_plot_or_trace_into_a_directory_that_does_not_exist_is_refused_before_
     assert drawn.returncode == 2 and "the directory" in drawn.stderr and not missing.exists()
 
 
+@pytest.mark.parametrize("given", ["", " "])
+@pytest.mark.parametrize(
+    ("command", "said"),
+    [
+        (["plot", "run.mcap", "--signal", "counter/a.cs.count", "-o"], "-o names no file: name one, e.g. -o plot.png"),
+        (["export", "sysml", str(SPECS / "counter"), "-o"], "-o names no file: name one, e.g. -o model.sysml"),
+        (
+            ["diagram", str(SPECS / "counter"), "--view", "system", "-o"],
+            "-o names no file: name one, e.g. -o system.svg",
+        ),
+        (["doc", str(SPECS / "counter"), "-o"], "-o names no directory: name one, e.g. -o site/"),
+        (["run", str(SPECS / "counter"), "--duration", "20ms", "--trace"], "--trace names no file"),
+        (["run", str(SPECS / "counter"), "--duration", "20ms", "--signal", "counter/a.cs.count", "--plot"], "--plot"),
+    ],
+)
+def test_an_empty_output_is_a_usage_error_of_one_line_for_every_command(
+    tmp_path: Path, command: list[str], said: str, given: str
+) -> None:
+    """`-o ""` (`-o "$OUT"` with OUT unset) was the directory here to `earl doc`, which wrote its site
+    there, standard output to `earl diagram`, "a directory" to `earl plot` and `earl export`, and no
+    plot at all to `earl run --plot`: every command refuses it alike, before anything is written."""
+    (tmp_path / "run.mcap").write_bytes(b"")  # what `earl plot` reads is looked at after its -o
+    result = earl_cli(*command, given, cwd=tmp_path)
+    assert result.returncode == 2, result.stdout + result.stderr
+    assert result.stderr.splitlines() == [result.stderr.strip()] and result.stderr.startswith("earl: error: ")
+    assert said in result.stderr
+    assert [path.name for path in tmp_path.iterdir()] == ["run.mcap"]  # nothing written here
+
+
+def test_an_empty_spec_or_trace_is_named_as_such_not_as_a_directory(tmp_path: Path) -> None:
+    """`Path("")` is the directory here: an empty SPEC was "a directory without a system.earl"."""
+    for command in (["check", ""], ["export", "sysml", " "], ["doc", "", "-o", "site"]):
+        result = earl_cli(*command, cwd=tmp_path)
+        assert result.returncode == 2
+        assert result.stderr == "earl: error: SPEC is empty: name the .earl file, or a directory with a system.earl\n"
+    for command in (["plot", "", "--signal", "counter/a.cs.count"], ["trace", "summary", ""]):
+        result = earl_cli(*command, cwd=tmp_path)
+        assert result.returncode == 2
+        assert result.stderr.startswith("earl: error: FILE.mcap is empty: name the trace"), result.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_a_record_links_pattern_of_run_toml_that_matches_no_link_is_said(tmp_path: Path) -> None:
     spec = counter_copy(tmp_path)
     (spec.parent / "run.toml").write_text('record_links = ["filter,*", "counter/a:relay*"]\n')

@@ -23,12 +23,24 @@ class UsageError(Exception):
 
 
 def spec_path(text: str) -> Path:
+    if not text.strip():  # `earl check ""`, `earl run "$SPEC"` with SPEC unset: Path("") is the directory here
+        raise UsageError("SPEC is empty: name the .earl file, or a directory with a system.earl")
     path = locate_spec(Path(text))
     if not path.exists():
         raise UsageError(f"no such file: {text}")
     if path.is_dir():
         raise UsageError(f"{text} is a directory without a system.earl; name the .earl file")
     return path
+
+
+def output_path(text: str, option: str, example: str, what: str = "file") -> Path:
+    """The path an output option names. An empty one (`-o ""`,
+    `-o "$OUT"` with OUT unset) names nothing, as one of spaces does: Path("") is the current
+    directory, which one command took for standard output and another for the place to write, so
+    every command refuses it alike, as a usage error, before anything is read."""
+    if not text.strip():
+        raise UsageError(f"{option} names no {what}: name one, e.g. {option} {example}")
+    return Path(text)
 
 
 def parse_parameter(text: str) -> tuple[str, ParameterValue]:

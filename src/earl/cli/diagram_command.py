@@ -7,7 +7,14 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from earl.cli.common import UsageError, parse_parameters, refuse_to_overwrite_inputs, spec_path, usage_error
+from earl.cli.common import (
+    UsageError,
+    output_path,
+    parse_parameters,
+    refuse_to_overwrite_inputs,
+    spec_path,
+    usage_error,
+)
 from earl.cli.output import print_diagnostics
 from earl.diagnostics import EarlError
 from earl.lang.loader import load
@@ -34,7 +41,7 @@ examples:
   earl diagram examples/pick_and_place --view activity --target manip/a.cs.jointMove/bb -o act.svg
   earl diagram examples/pick_and_place --view agent --target manip/a --expand --param N=3 -o manip3.svg
 
-exit codes: 0 drawn, 1 the spec cannot be read, 2 usage error (bad target, Graphviz missing)
+exit codes: 0 drawn, 1 the spec cannot be read, 2 usage error (bad target, an empty or unwritable -o, Graphviz missing)
 """
 
 
@@ -82,6 +89,8 @@ def run(arguments: argparse.Namespace) -> int:
     try:
         path = spec_path(arguments.spec)
         parameters = parse_parameters(arguments.param)
+        if arguments.output is not None:  # an empty -o is refused, not taken for standard output
+            output_path(arguments.output, "-o", "system.svg")
         chosen = output_format(arguments)
         if chosen == "mermaid" and arguments.view not in MERMAID_VIEWS:
             raise UsageError(

@@ -4,11 +4,17 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 from typing import Any
 
 from earl.check import check
-from earl.cli.common import UsageError, parse_parameters, refuse_to_overwrite_inputs, spec_path, usage_error
+from earl.cli.common import (
+    UsageError,
+    output_path,
+    parse_parameters,
+    refuse_to_overwrite_inputs,
+    spec_path,
+    usage_error,
+)
 from earl.cli.output import print_diagnostics
 from earl.diagnostics import EarlError, Severity, SourceMap
 from earl.export.sysml import LIBRARY_FILE, export_sysml, library_text
@@ -46,7 +52,7 @@ def run(arguments: argparse.Namespace) -> int:
     try:
         path = spec_path(arguments.spec)
         parameters = parse_parameters(arguments.param)
-        output = None if arguments.output is None else Path(arguments.output)
+        output = None if arguments.output is None else output_path(arguments.output, "-o", "model.sysml")
         if output is not None and not output.parent.is_dir():
             raise UsageError(f"cannot write {output}: no such directory {output.parent}")
         if output is not None and output.is_dir():

@@ -21,7 +21,16 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 from rich.text import Text
 
-from earl.cli.common import UsageError, brief, fault_kinds, parse_parameters, spec_path, table_console, usage_error
+from earl.cli.common import (
+    UsageError,
+    brief,
+    fault_kinds,
+    output_path,
+    parse_parameters,
+    spec_path,
+    table_console,
+    usage_error,
+)
 from earl.cli.output import print_diagnostics
 from earl.diagnostics import EarlError
 from earl.transport.deployment import DeploymentError
@@ -342,6 +351,10 @@ def check_options(arguments: argparse.Namespace) -> CheckedOptions:
 
     path = spec_path(arguments.spec)
     parameters = parse_parameters(arguments.param)
+    # an empty one was no trace (`--trace ""`: "Is a directory" after the spec was read) or no plot at all
+    for option, given, example in (("--trace", arguments.trace, "run.mcap"), ("--plot", arguments.plot, "plot.png")):
+        if given is not None:
+            output_path(given, option, example)
     try:
         settings = read_run_settings(path)
     except ValueError as error:

@@ -9,7 +9,7 @@ from typing import Any
 
 from rich.table import Table
 
-from earl.cli.common import brief, fault_kinds, table_console, usage_error
+from earl.cli.common import UsageError, brief, fault_kinds, output_path, table_console, usage_error
 
 EXIT_OK, EXIT_FAILED = 0, 1
 
@@ -116,13 +116,17 @@ def run_plot(arguments: argparse.Namespace) -> int:
     path = Path(arguments.file)
     if not path.is_file():
         return usage_error(_not_a_file(arguments.file))
-    problem = plot_output_problem(Path(arguments.output))
+    try:
+        output = output_path(arguments.output, "-o", "plot.png")
+    except UsageError as error:
+        return usage_error(str(error))
+    problem = plot_output_problem(output)
     if problem is not None:
         return usage_error(f"cannot write {arguments.output!r}: {problem}")
     if any(not signal.strip() for signal in arguments.signal):
         return usage_error("--signal names no signal: write one as `agent/a.subsystem.memory`, e.g. manip/a.cs.count")
     try:
-        left_out = plot_signals(path, arguments.signal, Path(arguments.output), arguments.title)
+        left_out = plot_signals(path, arguments.signal, output, arguments.title)
     except TraceError as error:
         sys.stderr.write(f"earl plot: {error}\n")
         return EXIT_FAILED
@@ -136,6 +140,8 @@ def run_plot(arguments: argparse.Namespace) -> int:
 
 def _not_a_file(given: str) -> str:
     """Why `given` is no trace to read: a directory is there, only not a file."""
+    if not given.strip():  # Path("") is the directory here
+        return "FILE.mcap is empty: name the trace (earl run --trace FILE.mcap writes one)"
     if Path(given).is_dir():
         return f"{given} is a directory, not a trace: name the .mcap file (earl run --trace FILE.mcap writes one)"
     return f"no such file: {given}"
