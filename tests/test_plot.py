@@ -19,6 +19,10 @@ def write_trace(path: Path, states: list[tuple[float, str]], messages: list[tupl
     with open(path, "wb") as stream:
         writer = Writer(stream)
         writer.start()
+        # the run's start, which makes the file an earl trace
+        run_schema = writer.register_schema("earl.Run", "jsonschema", json.dumps({"type": "object"}).encode())
+        run = writer.register_channel("/earl/run", "json", run_schema)
+        writer.add_message(run, 0, json.dumps({"event": "start", "seed": 0}).encode(), 0)
         fsm_schema = writer.register_schema("Fsm", "jsonschema", json.dumps({"type": "object"}).encode())
         fsm = writer.register_channel("s/a.cs/fsm", "json", fsm_schema, {"subsystem": "s/a.cs"})
         link_schema = writer.register_schema("Cmd", "jsonschema", json.dumps(schema).encode())

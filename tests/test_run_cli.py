@@ -138,6 +138,43 @@ def test_a_trace_summary_of_something_else_is_a_clear_error(tmp_path: Path) -> N
     assert earl_cli("trace", "summary", str(tmp_path / "missing.mcap")).returncode == 2
 
 
+def write_another_tool_s_mcap(path: Path, encoding: str, data: bytes, topic: str = "/odom") -> None:
+    """An MCAP file as another tool writes one: its own schema, one channel, five messages."""
+    from mcap.writer import Writer
+
+    with open(path, "wb") as stream:
+        writer = Writer(stream)
+        writer.start()
+        schema = writer.register_schema("nav.Odometry", "jsonschema" if encoding == "json" else "protobuf", b"{}")
+        channel = writer.register_channel(topic, encoding, schema)
+        for step in range(5):
+            writer.add_message(channel, step * 1000, data, step * 1000)
+        writer.finish()
+
+
+@pytest.mark.parametrize(("encoding", "data"), [("json", b'{"x": 1.5}'), ("protobuf", b"\x08\x96\x01")])
+def test_an_mcap_file_of_another_tool_is_said_not_to_be_an_earl_trace_by_summary_and_plot(
+    tmp_path: Path, encoding: str, data: bytes
+) -> None:
+    """`earl plot` said "`/odom.x` does not start with a subsystem of this trace (none)", and of a file
+    whose messages are not JSON `earl trace summary` said that a message is not JSON: both say what
+    the file is, in the same words, exit 1."""
+    other = tmp_path / "other.mcap"
+    write_another_tool_s_mcap(other, encoding, data)
+    said = (
+        f"{other} is an MCAP file but not an earl trace: it has no /earl/run topic (its topics: /odom); "
+        "`earl run --trace FILE.mcap` writes one"
+    )
+    summary = earl_cli("trace", "summary", str(other))
+    assert summary.returncode == 1
+    assert summary.stderr == f"earl trace: {said}\n"
+    for named in ("/odom.x", "counter/a.cs.count"):
+        plot = earl_cli("plot", str(other), "--signal", named, "-o", str(tmp_path / "p.png"))
+        assert plot.returncode == 1
+        assert plot.stderr == f"earl plot: {said}\n"
+    assert not (tmp_path / "p.png").exists()
+
+
 def test_a_bit_flipped_in_a_trace_is_damage_said_as_such_not_other_numbers(tmp_path: Path) -> None:
     """The chunks' checksums were not checked: one bit flipped inside the compressed data gave a summary of
     1.858 s for a run of 0.1 s, and exit 0. Other files say what they are: a directory, a file of another

@@ -44,7 +44,7 @@ def register(commands: Any) -> None:
         "is member 1 of windingCurrent[K in 1..6]), brackets after an array an element counted\n"
         "from 0 (currentJointPos[0] is its first); [*] is every member or element.",
         epilog="example:\n  earl plot run.mcap --signal manip/a.cs.windingCurrent[1] -o current.png\n\n"
-        "exit codes: 0 written, 1 the trace lacks a signal or is unreadable, 2 usage error",
+        "exit codes: 0 written, 1 the file is not a readable earl trace or lacks a signal, 2 usage error",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     plot.add_argument("file", metavar="FILE.mcap")

@@ -12,7 +12,7 @@ import json
 import math
 import re
 import struct
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -161,16 +161,47 @@ def _not_from_earl(path: Path, topic: str) -> TraceError:
     )
 
 
+#: the topic of the run's start and end, which every trace earl writes has
+RUN_TOPIC = "/earl/run"
+
+
+def _not_an_earl_trace(path: Path, topics: Iterable[str]) -> TraceError:
+    """Said alike by `earl trace` and `earl plot` of an MCAP file another tool wrote."""
+    found = sorted(set(topics))
+    listed = ", ".join(found[:5]) + (f" and {len(found) - 5} more" if len(found) > 5 else "")
+    return TraceError(
+        f"{path} is an MCAP file but not an earl trace: it has no {RUN_TOPIC} topic "
+        f"({f'its topics: {listed}' if found else 'it has no topics'}); `earl run --trace FILE.mcap` writes one"
+    )
+
+
+def _indexed_topics(path: Path) -> set[str] | None:
+    """The topics of a file's summary section, read without its messages; None when it has none (cut
+    short) or cannot be read, which reading its messages then says."""
+    try:
+        with open(path, "rb") as stream:
+            summary = make_reader(stream, validate_crcs=True).get_summary()
+    except Exception:  # as in `_messages`: whatever a damaged file provokes
+        return None
+    return None if summary is None else {channel.topic for channel in summary.channels.values()}
+
+
 def summarise(path: Path) -> TraceSummary:
+    # another tool's file is said to be one before its messages are read: they need not be JSON
+    indexed = _indexed_topics(path)
+    if indexed is not None and RUN_TOPIC not in indexed:
+        raise _not_an_earl_trace(path, indexed)
     summariser = _Summariser()
     cut: list[bool] = []
+    seen: set[str] = set()
     for topic, metadata, time, data in _messages(path, cut=cut):
+        seen.add(topic)
         try:
             summariser.add(topic, metadata, time, data)
         except (KeyError, TypeError, ValueError, AttributeError):
             raise _not_from_earl(path, topic) from None
     if not summariser.seen_run:
-        raise TraceError(f"{path} is an MCAP file but not an earl trace (it has no /earl/run topic)")
+        raise _not_an_earl_trace(path, seen)
     summary = summariser.summary()
     summary.cut = bool(cut)
     return summary
@@ -356,6 +387,8 @@ def read_signals(path: Path, names: list[str]) -> Signals:
     The file is read once, whatever the number of signals: a trace of a long run is large.
     """
     channels = _channels(path)
+    if RUN_TOPIC not in channels:  # before its signals are looked for: another tool's file has none
+        raise _not_an_earl_trace(path, channels)
     available = {topic: metadata for topic, (metadata, _) in channels.items()}
     subsystems = sorted({t[: -len("/fsm")] for t in available if t.endswith("/fsm")}, key=len, reverse=True)
     wanted: dict[str, tuple[str, str]] = {}  # topic -> (subsystem, prefix of its leaves)
