@@ -7,9 +7,11 @@ import math
 from pathlib import Path
 from typing import Any
 
+import pytest
 from mcap.writer import Writer
 
-from earl.runtime.trace_reader import read_signals
+from earl.runtime.signal_syntax import signal_syntax_error
+from earl.runtime.trace_reader import TraceError, read_signals
 
 SECOND = 1_000_000_000
 
@@ -154,3 +156,43 @@ def test_the_help_of_signal_says_how_a_family_and_an_array_are_indexed() -> None
     assert "x[1] of a family is member 1, v[0] of an array its first element" in said
     run = build_parser()._subparsers._group_actions[0].choices["run"]  # type: ignore[union-attr]
     assert "x[1] of a family is member 1, v[0] of an array its first element" in " ".join(run.format_help().split())
+
+
+@pytest.mark.parametrize(
+    "signal",
+    [
+        "manip/a.cs.windingCurrent[1]",
+        "manip/a.cs.currentJointPos[*]",
+        "manip/a.motorController[1]/ve.motorControllerState.currentMotorPos",
+        "manip/a.cs.manipulatorCommand.jointPosSetpoint[0]",
+        "eye[K]/rr.blocked",  # a family's index variable: the lookup says to name its members
+        "w[1]/a.cs.out[2].x",
+    ],
+)
+def test_the_signals_the_docs_write_are_well_formed(signal: str) -> None:
+    assert signal_syntax_error(signal) is None
+
+
+def test_a_malformed_signal_is_said_with_its_control_characters_escaped_and_the_caret_under_the_spot() -> None:
+    """A signal is echoed in the message: a terminal's escape in it is shown, not obeyed, and the caret
+    counts the characters as shown."""
+    error = signal_syntax_error("s/a.cs.cmd\x1b[31m")
+    assert error is not None
+    assert str(error).splitlines() == [
+        "`s/a.cs.cmd\\x1b[31m` is malformed at character 11: `\\x1b` after `cmd`: a signal's names are joined "
+        "by `.` and `/`, and indexed in brackets, `[1]`",
+        "  s/a.cs.cmd\\x1b[31m",
+        "  " + " " * 10 + "^",
+    ]
+
+
+def test_read_signals_refuses_a_malformed_signal_and_a_subsystem_alone_saying_which(tmp_path: Path) -> None:
+    """From Python too: `read_signals` (and `plot_signals`) say what is wrong with the name."""
+    trace = tmp_path / "t.mcap"
+    write_trace(trace, [(0.0, "idle")], [(0.1, {"ready": True})], GOAL)
+    with pytest.raises(TraceError, match=r"`s/a\.cs\.cmd\[` is malformed at character 12"):
+        read_signals(trace, ["s/a.cs.cmd["])
+    with pytest.raises(
+        TraceError, match=r"`s/a\.cs` names a subsystem: .* e\.g\. `s/a\.cs\.cmd` \(the trace has `cmd`\)"
+    ):
+        read_signals(trace, ["s/a.cs"])

@@ -81,6 +81,78 @@ def test_plot_of_a_signal_the_trace_lacks_says_how_to_record_it(tmp_path: Path) 
     assert (tmp_path / "z.png").is_file()
 
 
+def test_a_signal_naming_a_subsystem_alone_or_a_misspelt_value_is_told_what_the_trace_has(tmp_path: Path) -> None:
+    """`counter/a.cs` was said not to "start with a subsystem of this trace (counter/a.cs, …)", the list
+    naming it: it is a subsystem, and a signal goes on to one of its values, which are listed."""
+    recorded, unrecorded = tmp_path / "memory.mcap", tmp_path / "links.mcap"
+    run = ["run", str(SPECS / "counter"), "--duration", "50ms", "--trace"]
+    assert earl_cli(*run, str(recorded), "--record-memory", "all").returncode == 0
+    assert earl_cli(*run, str(unrecorded)).returncode == 0
+    png = tmp_path / "p.png"
+    alone = earl_cli("plot", str(recorded), "--signal", "counter/a.cs", "-o", str(png))
+    assert alone.returncode == 1
+    assert alone.stderr == (
+        "earl plot: `counter/a.cs` names a subsystem: a signal goes on to its memory or output buffer, "
+        "e.g. `counter/a.cs.count` (the trace has `count`, `sent`)\n"
+    )
+    # without its memory: what its links sent, and how to record the rest
+    links = earl_cli("plot", str(unrecorded), "--signal", "counter/a.cs", "-o", str(png))
+    assert links.returncode == 1
+    assert "(the trace has `count`); its memory is not in this trace (`earl run --record-memory counter/a.cs`" in (
+        links.stderr
+    )
+    misspelt = earl_cli("plot", str(recorded), "--signal", "counter/a.cs.cuont", "-o", str(png))
+    assert misspelt.returncode == 1 and "did you mean `count`?" in misspelt.stderr, misspelt.stderr
+    unknown = earl_cli("plot", str(recorded), "--signal", "counter/a.relay/ve.zzz", "-o", str(png))
+    assert unknown.returncode == 1 and "(the trace has `back`, `forward`, `last`, `lost`)" in unknown.stderr
+    assert not png.exists()
+    # `earl run --plot` lists them the same way, from the spec
+    before = earl_cli(
+        "run", str(SPECS / "counter"), "--duration", "50ms", "--plot", str(png), "--signal", "counter/a.cs"
+    )
+    assert before.returncode == 2 and "e.g. `counter/a.cs.count` (it has `count`, `sent`)" in before.stderr
+
+
+@pytest.mark.parametrize(
+    ("signal_name", "column", "said"),
+    [
+        ("x[", 3, "the signal ends where an index belongs: a whole number, as in `x[1]`, or `*`"),
+        ("counter/a.cs.count[", 20, "the signal ends where an index belongs"),
+        ("counter/a.cs.count[1", 21, "the signal ends where the `]` closing `[` belongs"),
+        ("counter/a.cs.count[-1]", 20, "`-` where an index belongs"),
+        ("counter/a.cs.", 14, "the signal ends after `.`, where a name belongs"),
+        ("counter/a.cs..count", 14, "`.` after `.`, where a name belongs"),
+        ("counter/a.cs.count ", 19, "a space after `count`"),
+        ("counter/a.cs.count]", 19, "`]` after `count`"),
+        ("/odom.x", 1, "`/` where the first name belongs: a signal starts with its agent's, as in `manip/a.cs.count`"),
+    ],
+)
+def test_a_malformed_signal_is_a_usage_error_pointing_at_the_spot(
+    tmp_path: Path, signal_name: str, column: int, said: str
+) -> None:
+    """`x[` was "does not start with a subsystem of this trace" (exit 1), `counter/a.cs.count[` "had no
+    value in this run": a signal not written as one is a usage error that shows where it goes wrong."""
+    trace = tmp_path / "run.mcap"
+    assert earl_cli("run", str(SPECS / "counter"), "--duration", "20ms", "--trace", str(trace)).returncode == 0
+    plot = earl_cli("plot", str(trace), "--signal", signal_name, "-o", str(tmp_path / "p.png"))
+    assert plot.returncode == 2, plot.stderr
+    lines = plot.stderr.splitlines()
+    assert lines[0].startswith(f"earl: error: --signal `{signal_name}` is malformed at character {column}: {said}")
+    assert lines[1:] == [f"  {signal_name}", "  " + " " * (column - 1) + "^"]
+    # `earl run --plot` says the same before the run, of --signal and of run.toml's `plot`
+    started = time.monotonic()
+    run = ["run", str(SPECS / "counter"), "--duration", "1000s", "--plot", str(tmp_path / "p.png")]
+    refused = earl_cli(*run, "--signal", signal_name)
+    assert refused.returncode == 2 and refused.stderr == plot.stderr
+    spec = counter_copy(tmp_path)
+    (spec.parent / "run.toml").write_text(f"plot = [{signal_name!r}]\n".replace("'", '"'))
+    from_settings = earl_cli("run", str(spec.parent), "--duration", "1000s", "--plot", str(tmp_path / "p.png"))
+    assert from_settings.returncode == 2
+    assert from_settings.stderr.startswith(f"earl: error: run.toml's plot: `{signal_name}` is malformed at")
+    assert time.monotonic() - started < 30  # before the run
+    assert not (tmp_path / "p.png").exists()
+
+
 def test_run_plot_records_the_memory_it_draws_and_refuses_a_signal_the_system_lacks(tmp_path: Path) -> None:
     png = tmp_path / "sent.png"
     # `sent` is memory: recorded for the plot without --record-memory
@@ -168,7 +240,7 @@ def test_an_mcap_file_of_another_tool_is_said_not_to_be_an_earl_trace_by_summary
     summary = earl_cli("trace", "summary", str(other))
     assert summary.returncode == 1
     assert summary.stderr == f"earl trace: {said}\n"
-    for named in ("/odom.x", "counter/a.cs.count"):
+    for named in ("odom.x", "counter/a.cs.count"):
         plot = earl_cli("plot", str(other), "--signal", named, "-o", str(tmp_path / "p.png"))
         assert plot.returncode == 1
         assert plot.stderr == f"earl plot: {said}\n"

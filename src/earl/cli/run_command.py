@@ -370,10 +370,16 @@ def check_options(arguments: argparse.Namespace) -> CheckedOptions:
         raise UsageError("--plot needs signals: name them with --signal, or `plot = [...]` in run.toml")
     if arguments.plot:
         from earl.runtime.plot import plot_output_problem
+        from earl.runtime.signal_syntax import signal_text_problem
 
         problem = plot_output_problem(Path(arguments.plot))
         if problem is not None:  # said now, not after a run of minutes
             raise UsageError(f"--plot {arguments.plot!r}: {problem}")
+        origin = "--signal" if from_command_line else "run.toml's plot:"
+        for signal in signals or []:
+            malformed = signal_text_problem(signal)
+            if malformed is not None:
+                raise UsageError(f"{origin} {malformed}")
     arguments.signal = signals
     if arguments.plot and not arguments.trace:
         arguments.trace = str(Path(arguments.plot).with_suffix(".mcap"))

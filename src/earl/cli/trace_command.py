@@ -44,7 +44,8 @@ def register(commands: Any) -> None:
         "is member 1 of windingCurrent[K in 1..6]), brackets after an array an element counted\n"
         "from 0 (currentJointPos[0] is its first); [*] is every member or element.",
         epilog="example:\n  earl plot run.mcap --signal manip/a.cs.windingCurrent[1] -o current.png\n\n"
-        "exit codes: 0 written, 1 the file is not a readable earl trace or lacks a signal, 2 usage error",
+        "exit codes: 0 written, 1 the file is not a readable earl trace or lacks a signal, 2 usage error\n"
+        "(no such file, a malformed signal, an empty or unwritable -o)",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     plot.add_argument("file", metavar="FILE.mcap")
@@ -111,6 +112,7 @@ def run_summary(arguments: argparse.Namespace) -> int:
 
 def run_plot(arguments: argparse.Namespace) -> int:
     from earl.runtime.plot import plot_output_problem, plot_signals
+    from earl.runtime.signal_syntax import signal_text_problem
     from earl.runtime.trace_reader import TraceError
 
     path = Path(arguments.file)
@@ -123,8 +125,11 @@ def run_plot(arguments: argparse.Namespace) -> int:
     problem = plot_output_problem(output)
     if problem is not None:
         return usage_error(f"cannot write {arguments.output!r}: {problem}")
-    if any(not signal.strip() for signal in arguments.signal):
-        return usage_error("--signal names no signal: write one as `agent/a.subsystem.memory`, e.g. manip/a.cs.count")
+    for signal in arguments.signal:
+        # a signal not written as one is a usage error, not one the trace lacks
+        malformed = signal_text_problem(signal)
+        if malformed is not None:
+            return usage_error(f"--signal {malformed}")
     try:
         left_out = plot_signals(path, arguments.signal, output, arguments.title)
     except TraceError as error:

@@ -55,7 +55,8 @@ def what_to_record(expanded: System, signals: list[str]) -> tuple[list[str], lis
                 *sorted({m.name for m in subsystems[signal].memories}),
                 *sorted({o.name for o in subsystems[signal].output_buffers}),
             ]
-            example = f", e.g. `{signal}.{named[0]}`" if named else ""
+            listed = ", ".join(f"`{name}`" for name in dict.fromkeys(named))
+            example = f", e.g. `{signal}.{named[0]}` (it has {listed})" if named else ""
             raise ValueError(f"`{signal}` names a subsystem: a signal goes on to its memory or output buffer{example}")
         if owner is None:
             family = re.match(r"(.+?)\[(\*|[A-Za-z_]\w*)\](/[a-z]+)\.(.+)", signal)

@@ -22,6 +22,8 @@ from mcap.reader import make_reader
 from mcap.records import Channel, Message, Schema
 from mcap.stream_reader import CRCValidationError, StreamReader
 
+from earl.diagnostics import did_you_mean
+from earl.runtime.signal_syntax import signal_syntax_error
 from earl.runtime.values import iter_leaves
 
 
@@ -394,7 +396,28 @@ def read_signals(path: Path, names: list[str]) -> Signals:
     wanted: dict[str, tuple[str, str]] = {}  # topic -> (subsystem, prefix of its leaves)
     owners: list[tuple[str, str, str]] = []  # (name, subsystem, name inside the subsystem)
     for name in names:
+        malformed = signal_syntax_error(name)
+        if malformed is not None:
+            raise TraceError(str(malformed))
         subsystem = next((s for s in subsystems if name.startswith(s + ".")), None)
+        if subsystem is None and name in subsystems:
+            # the subsystem alone: it is in the trace, but a signal is one of its values
+            elements = _elements_in(name, channels)
+            if not elements:
+                raise TraceError(
+                    f"`{name}` names a subsystem: a signal goes on to its memory or output buffer, and the trace "
+                    f"holds no value of it: record its memory with `--record-memory {name}`"
+                )
+            listed = ", ".join(f"`{element}`" for element in elements)
+            unrecorded = (
+                f"; its memory is not in this trace (`earl run --record-memory {name}` records it)"
+                if f"{name}/memory" not in channels
+                else ""
+            )
+            raise TraceError(
+                f"`{name}` names a subsystem: a signal goes on to its memory or output buffer, "
+                f"e.g. `{name}.{elements[0]}` (the trace has {listed}){unrecorded}"
+            )
         if subsystem is None:
             raise TraceError(
                 f"`{name}` does not start with a subsystem of this trace ({', '.join(sorted(subsystems)) or 'none'})"
@@ -529,7 +552,10 @@ def read_signals(path: Path, names: list[str]) -> Signals:
                     "trace when a link leaves it (and `--record-links` keeps that link)"
                 )
             else:
-                hint = "check the name against the spec"
+                elements = _elements_in(subsystem, channels)
+                hint = did_you_mean(element, [signal_element(e) for e in elements]) or (
+                    f"check the name against the spec (the trace has {', '.join(f'`{e}`' for e in elements)})"
+                )
             raise TraceError(f"the trace has no values for `{name}`; {hint}")
         series.extend(sorted(matched, key=lambda item: _natural(item.name)))
     bands = {
@@ -542,6 +568,22 @@ def read_signals(path: Path, names: list[str]) -> Signals:
     if not series:
         raise TraceError(f"no signal has a value in this trace: {'; '.join(leaf_hints)}")
     return Signals(series, bands, end, empty, bool(cut))
+
+
+def _elements_in(subsystem: str, channels: dict[str, tuple[dict[str, str], Any]]) -> list[str]:
+    """What a signal of `subsystem` can go on to in this trace: its recorded memory and the output
+    buffers whose links are recorded, a family written `name[*]`."""
+    names: list[str] = []
+    memory = channels.get(f"{subsystem}/memory")
+    properties = memory[1].get("properties") if memory is not None and isinstance(memory[1], dict) else None
+    if isinstance(properties, dict):
+        names += [str(key) for key in properties]
+    for topic, (metadata, _) in channels.items():
+        source = metadata.get("source", "")
+        if topic.startswith("link/") and source.startswith(subsystem + "."):
+            names.append(source[len(subsystem) + 1 :])
+    shown = (signal_element(name) + ("[*]" if "[" in name else "") for name in names)
+    return sorted(dict.fromkeys(shown), key=_natural)
 
 
 def signal_element(name: str) -> str:

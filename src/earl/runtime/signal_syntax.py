@@ -1,0 +1,94 @@
+"""The written form of a signal (`manip/a.cs.windingCurrent[1]`), checked before it is looked up.
+
+A signal is names joined by `/` and `.`, each name followed by any number of indices in brackets:
+
+    signal := NAME step*          step := "/" NAME | "." NAME | "[" index "]"
+    index  := digits | "*" | NAME (a family's index variable, said by the lookup to be no member)
+
+Names are the spec's (`[A-Za-z_][A-Za-z0-9_]*`). Whether the names are those of a subsystem and its
+memory or output buffer is the lookup's question; this module says only where the text itself goes
+wrong, so that `x[` is named a malformed signal rather than a subsystem the trace lacks.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+from earl.diagnostics import escape_controls
+
+_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+_INDEX = re.compile(r"[0-9]+|\*|[A-Za-z_][A-Za-z0-9_]*")
+
+
+@dataclass(frozen=True)
+class SignalSyntaxError:
+    """Where a signal's text goes wrong (`at`, counted from 0) and what is wrong there."""
+
+    signal: str
+    at: int
+    problem: str
+
+    def __str__(self) -> str:
+        """`\\`x[\\` is malformed at character 3: …` and the signal again with a caret under the spot."""
+        shown = escape_controls(self.signal)
+        column = len(escape_controls(self.signal[: self.at]))
+        return f"`{shown}` is malformed at character {column + 1}: {self.problem}\n  {shown}\n  {' ' * column}^"
+
+
+def signal_text_problem(signal: str) -> str | None:
+    """What is wrong with a signal as given on the command line or in run.toml, said after the option
+    that gave it (`--signal …`), or None: one that is empty, or not written as a signal is."""
+    if not signal.strip():
+        return "names no signal: write one as `agent/a.subsystem.memory`, e.g. manip/a.cs.count"
+    malformed = signal_syntax_error(signal)
+    return None if malformed is None else str(malformed)
+
+
+def signal_syntax_error(signal: str) -> SignalSyntaxError | None:
+    """The first place where `signal` is not written as a signal is, or None when it is."""
+    at = 0
+    while True:
+        name = _NAME.match(signal, at)
+        if name is None:
+            where = (
+                f"after `{signal[at - 1]}`, where a name belongs"
+                if at
+                else "where the first name belongs: a signal starts with its agent's, as in `manip/a.cs.count`"
+            )
+            return SignalSyntaxError(signal, at, f"{_found(signal, at)} {where}")
+        last, at = name.group(), name.end()  # the name that brackets after it index, for the examples
+        while at < len(signal) and signal[at] == "[":
+            index = _INDEX.match(signal, at + 1)
+            if index is None:
+                return SignalSyntaxError(
+                    signal,
+                    at + 1,
+                    f"{_found(signal, at + 1)} where an index belongs: a whole number, as in `{last}[1]`, "
+                    f"or `*` for every member or element, `{last}[*]`",
+                )
+            if not signal.startswith("]", index.end()):
+                return SignalSyntaxError(
+                    signal, index.end(), f"{_found(signal, index.end())} where the `]` closing `[` belongs"
+                )
+            at = index.end() + 1
+        if at == len(signal):
+            return None
+        if signal[at] not in "./":
+            return SignalSyntaxError(
+                signal,
+                at,
+                f"{_found(signal, at)} after `{signal[name.start() : at]}`: a signal's names are joined by `.` and `/`, "
+                "and indexed in brackets, `[1]`",
+            )
+        at += 1
+
+
+def _found(signal: str, at: int) -> str:
+    """What stands at `at`, in words: the end, a space, or the character itself."""
+    if at >= len(signal):
+        return "the signal ends"
+    character = signal[at]
+    if character.isspace():
+        return "a space" if character == " " else f"`{escape_controls(character)}` (white space)"
+    return f"`{escape_controls(character)}`"
