@@ -1061,6 +1061,27 @@ def test_an_empty_output_is_a_usage_error_of_one_line_for_every_command(
     assert [path.name for path in tmp_path.iterdir()] == ["run.mcap"]  # nothing written here
 
 
+ZENOH_PROCESS = ["--agents", "counter/a", "--transport", "zenoh"]
+
+
+@pytest.mark.parametrize(
+    ("command", "said"),
+    [
+        (["run", str(SPECS / "pendulum"), "--environment", ""], "--environment names no environment: name one as"),
+        (["run", str(SPECS / "counter"), *ZENOH_PROCESS, "--deployment", ""], "--deployment names no file"),
+        (["run", str(SPECS / "counter"), *ZENOH_PROCESS, "--zenoh-config", " "], "--zenoh-config names no file"),
+        (["launch", str(SPECS / "counter"), "--deployment", ""], "--deployment names no file: name one, e.g."),
+        (["diagram", str(SPECS / "counter"), "--view", "fsm", "--target", ""], "--target names no element"),
+    ],
+)
+def test_an_empty_option_is_not_taken_for_the_option_left_out(tmp_path: Path, command: list[str], said: str) -> None:
+    """`--environment ""` ran run.toml's environment, `--deployment ""` read the deploy.toml beside the
+    spec (or said it was missing), `--target ""` was "`` is not a target: `` should look like …"."""
+    result = earl_cli(*command, cwd=tmp_path)
+    assert result.returncode == 2, result.stdout + result.stderr
+    assert result.stderr.startswith(f"earl: error: {said}") and len(result.stderr.splitlines()) == 1, result.stderr
+
+
 def test_an_empty_spec_or_trace_is_named_as_such_not_as_a_directory(tmp_path: Path) -> None:
     """`Path("")` is the directory here: an empty SPEC was "a directory without a system.earl"."""
     for command in (["check", ""], ["export", "sysml", " "], ["doc", "", "-o", "site"]):

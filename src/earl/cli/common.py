@@ -33,8 +33,8 @@ def spec_path(text: str) -> Path:
     return path
 
 
-def output_path(text: str, option: str, example: str, what: str = "file") -> Path:
-    """The path an output option names. An empty one (`-o ""`,
+def named_path(text: str, option: str, example: str, what: str = "file") -> Path:
+    """The path an option names (an output, a file to read). An empty one (`-o ""`,
     `-o "$OUT"` with OUT unset) names nothing, as one of spaces does: Path("") is the current
     directory, which one command took for standard output and another for the place to write, so
     every command refuses it alike, as a usage error, before anything is read."""

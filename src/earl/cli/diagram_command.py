@@ -9,7 +9,7 @@ from typing import Any
 
 from earl.cli.common import (
     UsageError,
-    output_path,
+    named_path,
     parse_parameters,
     refuse_to_overwrite_inputs,
     spec_path,
@@ -90,7 +90,9 @@ def run(arguments: argparse.Namespace) -> int:
         path = spec_path(arguments.spec)
         parameters = parse_parameters(arguments.param)
         if arguments.output is not None:  # an empty -o is refused, not taken for standard output
-            output_path(arguments.output, "-o", "system.svg")
+            named_path(arguments.output, "-o", "system.svg")
+        if arguments.target is not None and not arguments.target.strip():
+            raise UsageError("--target names no element: name one, e.g. --target manip/a.cs")
         chosen = output_format(arguments)
         if chosen == "mermaid" and arguments.view not in MERMAID_VIEWS:
             raise UsageError(

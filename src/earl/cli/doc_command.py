@@ -6,7 +6,7 @@ import argparse
 from typing import Any
 
 from earl.check import check
-from earl.cli.common import UsageError, output_path, parse_parameters, spec_path, usage_error
+from earl.cli.common import UsageError, named_path, parse_parameters, spec_path, usage_error
 from earl.cli.output import print_diagnostics
 from earl.diagnostics import EarlError, Severity, SourceMap
 from earl.lang.loader import load
@@ -54,7 +54,7 @@ def run(arguments: argparse.Namespace) -> int:
     try:
         path = spec_path(arguments.spec)
         parameters = parse_parameters(arguments.param)
-        output = output_path(arguments.output, "-o", "site/", "directory")
+        output = named_path(arguments.output, "-o", "site/", "directory")
         if output.exists() and not output.is_dir():
             raise UsageError(f"{arguments.output} exists and is not a directory")
         dot_program()  # before reading anything: without Graphviz there is no document to write

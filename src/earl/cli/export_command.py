@@ -9,7 +9,7 @@ from typing import Any
 from earl.check import check
 from earl.cli.common import (
     UsageError,
-    output_path,
+    named_path,
     parse_parameters,
     refuse_to_overwrite_inputs,
     spec_path,
@@ -52,7 +52,7 @@ def run(arguments: argparse.Namespace) -> int:
     try:
         path = spec_path(arguments.spec)
         parameters = parse_parameters(arguments.param)
-        output = None if arguments.output is None else output_path(arguments.output, "-o", "model.sysml")
+        output = None if arguments.output is None else named_path(arguments.output, "-o", "model.sysml")
         if output is not None and not output.parent.is_dir():
             raise UsageError(f"cannot write {output}: no such directory {output.parent}")
         if output is not None and output.is_dir():

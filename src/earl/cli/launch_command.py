@@ -31,6 +31,7 @@ from earl.cli.common import (
     STATUS_VARIABLE,
     SUPERVISOR_VARIABLE,
     UsageError,
+    named_path,
     spec_path,
     usage_error,
 )
@@ -96,6 +97,8 @@ def run(arguments: argparse.Namespace) -> int:
 
     try:
         path = spec_path(arguments.spec)
+        if arguments.deployment is not None:  # an empty one is not the default deploy.toml
+            named_path(arguments.deployment, "--deployment", "deploy.toml")
     except UsageError as error:
         return usage_error(str(error))
     deployment_path = Path(arguments.deployment) if arguments.deployment else path.parent / DEPLOYMENT_FILE

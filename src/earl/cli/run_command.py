@@ -25,7 +25,7 @@ from earl.cli.common import (
     UsageError,
     brief,
     fault_kinds,
-    output_path,
+    named_path,
     parse_parameters,
     spec_path,
     table_console,
@@ -351,10 +351,18 @@ def check_options(arguments: argparse.Namespace) -> CheckedOptions:
 
     path = spec_path(arguments.spec)
     parameters = parse_parameters(arguments.param)
-    # an empty one was no trace (`--trace ""`: "Is a directory" after the spec was read) or no plot at all
-    for option, given, example in (("--trace", arguments.trace, "run.mcap"), ("--plot", arguments.plot, "plot.png")):
+    # an empty one was no trace (`--trace ""`: "Is a directory" after the spec was read), no plot at all, or
+    # the default deployment or configuration, as if the option had not been given
+    for option, given, example in (
+        ("--trace", arguments.trace, "run.mcap"),
+        ("--plot", arguments.plot, "plot.png"),
+        ("--deployment", arguments.deployment, "deploy.toml"),
+        ("--zenoh-config", arguments.zenoh_config, "zenoh.json5"),
+    ):
         if given is not None:
-            output_path(given, option, example)
+            named_path(given, option, example)
+    if arguments.environment is not None and not arguments.environment.strip():  # was run.toml's, unsaid
+        raise UsageError("--environment names no environment: name one as MODULE:FACTORY, or `none` for none")
     try:
         settings = read_run_settings(path)
     except ValueError as error:

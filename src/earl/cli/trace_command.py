@@ -9,7 +9,7 @@ from typing import Any
 
 from rich.table import Table
 
-from earl.cli.common import UsageError, brief, fault_kinds, output_path, table_console, usage_error
+from earl.cli.common import UsageError, brief, fault_kinds, named_path, table_console, usage_error
 
 EXIT_OK, EXIT_FAILED = 0, 1
 
@@ -119,7 +119,7 @@ def run_plot(arguments: argparse.Namespace) -> int:
     if not path.is_file():
         return usage_error(_not_a_file(arguments.file))
     try:
-        output = output_path(arguments.output, "-o", "plot.png")
+        output = named_path(arguments.output, "-o", "plot.png")
     except UsageError as error:
         return usage_error(str(error))
     problem = plot_output_problem(output)
