@@ -196,3 +196,18 @@ def test_read_signals_refuses_a_malformed_signal_and_a_subsystem_alone_saying_wh
         TraceError, match=r"`s/a\.cs` names a subsystem: .* e\.g\. `s/a\.cs\.cmd` \(the trace has `cmd`\)"
     ):
         read_signals(trace, ["s/a.cs"])
+
+
+def test_another_tool_s_topics_are_listed_escaped_when_its_file_is_said_to_be_no_earl_trace(tmp_path: Path) -> None:
+    other = tmp_path / "other.mcap"
+    with open(other, "wb") as stream:
+        writer = Writer(stream)
+        writer.start()
+        schema = writer.register_schema("Odometry", "jsonschema", b"{}")
+        channel = writer.register_channel("/odom\x1b[2J", "json", schema)
+        writer.add_message(channel, 0, b"{}", 0)
+        writer.finish()
+    with pytest.raises(TraceError) as caught:
+        read_signals(other, ["s/a.cs.x"])
+    assert "not an earl trace: it has no /earl/run topic (its topics: /odom\\x1b[2J)" in str(caught.value)
+    assert "\x1b" not in str(caught.value)

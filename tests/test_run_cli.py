@@ -124,7 +124,11 @@ def test_a_signal_naming_a_subsystem_alone_or_a_misspelt_value_is_told_what_the_
         ("counter/a.cs..count", 14, "`.` after `.`, where a name belongs"),
         ("counter/a.cs.count ", 19, "a space after `count`"),
         ("counter/a.cs.count]", 19, "`]` after `count`"),
-        ("/odom.x", 1, "`/` where the first name belongs: a signal starts with its agent's, as in `manip/a.cs.count`"),
+        (
+            "/odom.x",
+            1,
+            "`/` where the first name belongs: a signal starts with its agent's name, as in `manip/a.cs.count`",
+        ),
     ],
 )
 def test_a_malformed_signal_is_a_usage_error_pointing_at_the_spot(

@@ -22,7 +22,7 @@ _INDEX = re.compile(r"[0-9]+|\*|[A-Za-z_][A-Za-z0-9_]*")
 
 
 @dataclass(frozen=True)
-class SignalSyntaxError:
+class MalformedSignal:
     """Where a signal's text goes wrong (`at`, counted from 0) and what is wrong there."""
 
     signal: str
@@ -30,7 +30,7 @@ class SignalSyntaxError:
     problem: str
 
     def __str__(self) -> str:
-        """`\\`x[\\` is malformed at character 3: …` and the signal again with a caret under the spot."""
+        """The spot and what is wrong there, then the signal again with a caret under the spot."""
         shown = escape_controls(self.signal)
         column = len(escape_controls(self.signal[: self.at]))
         return f"`{shown}` is malformed at character {column + 1}: {self.problem}\n  {shown}\n  {' ' * column}^"
@@ -45,7 +45,7 @@ def signal_text_problem(signal: str) -> str | None:
     return None if malformed is None else str(malformed)
 
 
-def signal_syntax_error(signal: str) -> SignalSyntaxError | None:
+def signal_syntax_error(signal: str) -> MalformedSignal | None:
     """The first place where `signal` is not written as a signal is, or None when it is."""
     at = 0
     while True:
@@ -54,28 +54,28 @@ def signal_syntax_error(signal: str) -> SignalSyntaxError | None:
             where = (
                 f"after `{signal[at - 1]}`, where a name belongs"
                 if at
-                else "where the first name belongs: a signal starts with its agent's, as in `manip/a.cs.count`"
+                else "where the first name belongs: a signal starts with its agent's name, as in `manip/a.cs.count`"
             )
-            return SignalSyntaxError(signal, at, f"{_found(signal, at)} {where}")
+            return MalformedSignal(signal, at, f"{_found(signal, at)} {where}")
         last, at = name.group(), name.end()  # the name that brackets after it index, for the examples
         while at < len(signal) and signal[at] == "[":
             index = _INDEX.match(signal, at + 1)
             if index is None:
-                return SignalSyntaxError(
+                return MalformedSignal(
                     signal,
                     at + 1,
                     f"{_found(signal, at + 1)} where an index belongs: a whole number, as in `{last}[1]`, "
                     f"or `*` for every member or element, `{last}[*]`",
                 )
             if not signal.startswith("]", index.end()):
-                return SignalSyntaxError(
+                return MalformedSignal(
                     signal, index.end(), f"{_found(signal, index.end())} where the `]` closing `[` belongs"
                 )
             at = index.end() + 1
         if at == len(signal):
             return None
         if signal[at] not in "./":
-            return SignalSyntaxError(
+            return MalformedSignal(
                 signal,
                 at,
                 f"{_found(signal, at)} after `{signal[name.start() : at]}`: a signal's names are joined by `.` and `/`, "

@@ -22,7 +22,7 @@ from mcap.reader import make_reader
 from mcap.records import Channel, Message, Schema
 from mcap.stream_reader import CRCValidationError, StreamReader
 
-from earl.diagnostics import did_you_mean
+from earl.diagnostics import did_you_mean, escape_controls
 from earl.runtime.signal_syntax import signal_syntax_error
 from earl.runtime.values import iter_leaves
 
@@ -169,7 +169,7 @@ RUN_TOPIC = "/earl/run"
 
 def _not_an_earl_trace(path: Path, topics: Iterable[str]) -> TraceError:
     """Said alike by `earl trace` and `earl plot` of an MCAP file another tool wrote."""
-    found = sorted(set(topics))
+    found = sorted({escape_controls(topic) for topic in topics})  # another tool's names: shown, not obeyed
     listed = ", ".join(found[:5]) + (f" and {len(found) - 5} more" if len(found) > 5 else "")
     return TraceError(
         f"{path} is an MCAP file but not an earl trace: it has no {RUN_TOPIC} topic "
@@ -553,8 +553,9 @@ def read_signals(path: Path, names: list[str]) -> Signals:
                 )
             else:
                 elements = _elements_in(subsystem, channels)
+                has = f" (the trace has {', '.join(f'`{e}`' for e in elements)})" if elements else ""
                 hint = did_you_mean(element, [signal_element(e) for e in elements]) or (
-                    f"check the name against the spec (the trace has {', '.join(f'`{e}`' for e in elements)})"
+                    f"check the name against the spec{has}"
                 )
             raise TraceError(f"the trace has no values for `{name}`; {hint}")
         series.extend(sorted(matched, key=lambda item: _natural(item.name)))
