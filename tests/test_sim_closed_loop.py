@@ -96,7 +96,9 @@ class Bench:
         self.plant.advance(t / 1000.0)
         finger = n + 1
         for k in range(1, n + 2):  # drives
-            ctx = self._context(f"drive{k}", 0.001, joint=k)
+            # named as the run names them: the environment maps the drives by name (map_actuator)
+            drive = "grip/a.fingerDrive/re" if k == finger else f"manip/a.motor[{k}]/re"
+            ctx = self._context(drive, 0.001, joint=k, K=k)
             out = Outputs("appliedCurrent")
             inputs = Inputs(motorCommand=self.received["drive"][k])
             (motor.apply_finger_current if k == finger else motor.apply_current)(inputs, out, ctx)

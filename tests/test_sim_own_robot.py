@@ -8,6 +8,7 @@ import shutil
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -109,7 +110,7 @@ def test_an_environment_whose_advance_is_no_method_is_said_at_run_toml_s_line(tm
     copy = pendulum_copy(
         tmp_path,
         "swinging/environment.py",
-        old='    return MujocoPlant.from_file(MODEL, seed=seed, keyframe="start")',
+        old='    plant = MujocoPlant.from_file(MODEL, seed=seed, keyframe="start")',
         new="    return type('World', (), {'advance': 0.001})()",
     )
     with pytest.raises(EarlError) as refused:
@@ -138,24 +139,64 @@ def spec_line(copy: Path, text: str) -> int:
     return 1 + next(number for number, line in enumerate(lines) if line.strip().startswith(text))
 
 
-def test_an_actuator_missing_from_the_model_is_a_fault_naming_it_not_a_refusal_of_the_system(tmp_path: Path) -> None:
-    """No convention of names tells a missing actuator from a family numbered otherwise (`motor[K in 0..N-1]/re`
-    driving `motor1`…), so the run starts, and the effector's fault names the actuator and the model's."""
+def test_an_actuator_missing_from_the_model_is_refused_before_the_run_naming_effector_actuator_and_model(
+    tmp_path: Path,
+) -> None:
+    """The environment maps motor[K]/re to `motor{K}`: the model without `motor2` would fault in every
+    iteration of motor[2]/re (and exit 0), so the run is refused before it starts, with what exists."""
+    copy = pendulum_copy(tmp_path, old='<motor name="motor2"', new='<motor name="motr2"')
+    xml = copy / "pendulum.xml"  # its encoder goes too: an encoder of no actuator is refused when the plant is built
+    text = xml.read_text(encoding="utf-8")
+    xml.write_text(text.replace(next(x for x in text.splitlines(True) if "encoder.motor2" in x), ""), encoding="utf-8")
+    result = earl_cli("run", str(copy), "--duration", "10ms", cwd=copy)
+    assert result.returncode == 1, result.stdout
+    assert "nothing was executed" in result.stderr and "iterations" not in result.stdout
+    assert result.stderr.splitlines()[0] == (
+        "error[EARL-X021]: `arm/a.motor[2]/re` acts on the actuator `motor2` (map_actuator('arm/a.motor[K]/re', "
+        f"'motor{{K}}')), but {copy / 'pendulum.xml'} has no actuator named so; its actuators: motor1, motr2"
+    )
+    assert f" --> system.earl:{spec_line(copy, 'motor[K in 1..J]/re {')}:5" in result.stderr
+    assert "= hint: did you mean `motr2`?" in result.stderr
+
+
+def test_an_encoder_missing_from_the_model_is_refused_before_the_run(tmp_path: Path) -> None:
     copy = pendulum_copy(tmp_path)
     xml = copy / "pendulum.xml"
     text = xml.read_text(encoding="utf-8")
-    for gone in ('    <motor name="motor2"', '    <numeric name="earl.encoder.motor2"'):
-        line = next(line for line in text.splitlines(keepends=True) if line.startswith(gone))
-        text = text.replace(line, "")
-    xml.write_text(text, encoding="utf-8")
+    line = next(line for line in text.splitlines(keepends=True) if "earl.encoder.motor2" in line)
+    xml.write_text(text.replace(line, ""), encoding="utf-8")
     result = earl_cli("run", str(copy), "--duration", "10ms", cwd=copy)
-    assert "EARL-X021" not in result.stderr
-    said = result.stdout + result.stderr
-    assert "fault" in said and "motor2" in said, said
+    assert result.returncode == 1, result.stdout
+    assert result.stderr.splitlines()[0] == (
+        "error[EARL-X021]: `arm/a.motor[2]/re` reads the encoder of `motor2` (map_actuator('arm/a.motor[K]/re', "
+        f"'motor{{K}}', encoder=True)), but {xml} declares none for it; the encoders it declares: motor1"
+    )
+    assert (
+        '= hint: add <numeric name="earl.encoder.motor2" data="GEAR COUNTS"/> to its <custom> section' in result.stderr
+    )
 
 
-def test_effectors_whose_code_names_the_actuators_otherwise_are_not_held_to_their_own_names(tmp_path: Path) -> None:
-    copy = pendulum_copy(tmp_path, "swinging/motor.py", old='f"motor{', new='f"drive{')
+def test_a_map_that_misnames_the_family_is_refused_once(tmp_path: Path) -> None:
+    # `J` is the spec's number of joints, not the family's index: the map would name motor[2]/re alone
+    copy = pendulum_copy(tmp_path, "swinging/environment.py", old='"arm/a.motor[K]/re"', new='"arm/a.motor[J]/re"')
+    with pytest.raises(EarlError) as refused:
+        earl.simulate(earl.load(copy))
+    [diagnostic] = refused.value.diagnostics
+    assert diagnostic.code == "EARL-X021"
+    assert "`J` is no index of the family `arm/a.motor[K]/re` (it is a parameter, J = 2)" in diagnostic.message
+    copy = pendulum_copy(
+        tmp_path / "typo", "swinging/environment.py", old='"arm/a.motor[K]/re"', new='"arm/a.motr[K]/re"'
+    )
+    with pytest.raises(EarlError) as refused:
+        earl.simulate(earl.load(copy))
+    [diagnostic] = refused.value.diagnostics
+    assert diagnostic.message.startswith("the environment maps `arm/a.motr[K]/re` to `motor{K}`, but the system has no")
+    assert diagnostic.hint == "did you mean `arm/a.motor[K]/re`?"
+
+
+def test_maps_that_name_the_actuators_otherwise_run_without_a_fault(tmp_path: Path) -> None:
+    """The check is the lookup the effectors make during the run: whatever the names, a map that finds them runs."""
+    copy = pendulum_copy(tmp_path, "swinging/environment.py", old='"motor{K}"', new='"drive{K}"')
     xml = copy / "pendulum.xml"
     renamed = xml.read_text(encoding="utf-8").replace('"motor', '"drive').replace("encoder.motor", "encoder.drive")
     xml.write_text(renamed, encoding="utf-8")
@@ -168,7 +209,7 @@ def test_an_environment_s_own_bind_may_refuse_the_system(tmp_path: Path) -> None
     copy = pendulum_copy(
         tmp_path,
         "swinging/environment.py",
-        old='    return MujocoPlant.from_file(MODEL, seed=seed, keyframe="start")',
+        old='    plant = MujocoPlant.from_file(MODEL, seed=seed, keyframe="start")',
         new=(
             '    plant = MujocoPlant.from_file(MODEL, seed=seed, keyframe="start")\n'
             "    def bind(system: Any) -> None:\n"
@@ -209,5 +250,39 @@ def test_a_timestep_that_divides_the_periods_runs(tmp_path: Path) -> None:
         # the run advances its environment to the time it reached, 10.5 ms: 21 steps of 0.5 ms
         assert simulation.environment.time == pytest.approx(0.0105)  # type: ignore[attr-defined]
         assert simulation.faults == []
+    finally:
+        simulation.close()
+
+
+def test_a_sensor_a_subsystem_is_mapped_to_is_checked_before_the_run_and_read_during_it(tmp_path: Path) -> None:
+    copy = pendulum_copy(
+        tmp_path,
+        old="  <custom>",
+        new='  <sensor>\n    <jointpos name="angle1" joint="shoulder"/>\n    <jointpos name="angel2" joint="elbow"/>\n'
+        "  </sensor>\n  <custom>",
+    )
+    environment = copy / "swinging" / "environment.py"
+    text = environment.read_text(encoding="utf-8")
+    mapped = '    plant.map_sensor("arm/a.motor[K]/re", "angle{K}")\n    return plant'
+    environment.write_text(text.replace("    return plant", mapped), encoding="utf-8")
+    with pytest.raises(EarlError) as refused:
+        earl.simulate(earl.load(copy))
+    [diagnostic] = refused.value.diagnostics
+    assert diagnostic.code == "EARL-X021"
+    assert diagnostic.message == (
+        "`arm/a.motor[2]/re` acts on the sensor `angle2` (map_sensor('arm/a.motor[K]/re', 'angle{K}')), but "
+        f"{copy / 'pendulum.xml'} has no sensor named so; its sensors: angle1, angel2"
+    )
+    assert diagnostic.hint == "did you mean `angel2`?"
+    xml = copy / "pendulum.xml"
+    xml.write_text(xml.read_text(encoding="utf-8").replace('"angel2"', '"angle2"'), encoding="utf-8")
+    simulation = earl.simulate(earl.load(copy))
+    try:
+        simulation.advance_to(0.01)
+        plant: Any = simulation.environment
+        assert simulation.faults == []
+        # what the lookup found for each member, and the sensor's reading: the joint's angle
+        assert plant.sensor_of(simulation.scheduler.network.by_name["arm/a.motor[2]/re"].context) == "angle2"
+        assert plant.sensor("angle2") == (pytest.approx(plant.joint_position("elbow")),)
     finally:
         simulation.close()

@@ -76,6 +76,10 @@ class PickAndPlaceEnvironment:
         initial = park_configuration(n) if start is None else list(start)
         xml = arm.workcell_mjcf(n, self.box_start, scene.TARGET_XY, initial)
         self.plant = MujocoPlant.from_xml(xml, seed=seed, keyframe="initial")
+        # what each drive acts on (arm.actuator_name: joint k's motor is `motork`), checked by `bind` before the
+        # run and asked by the drives' functions (motor.py) during it
+        self.plant.map_actuator("manip/a.motor[K]/re", "motor{joint}", encoder=True)
+        self.plant.map_actuator("grip/a.fingerDrive/re", arm.FINGER_ACTUATOR, encoder=True)
         self.operator_stop_at = operator_stop_at
         if driver_fault is not None:
             joint, at = driver_fault
@@ -93,7 +97,8 @@ class PickAndPlaceEnvironment:
     # ------------------------------------------------------------ the runtime's side
 
     def bind(self, system: Any) -> None:
-        """The workcell checks, before the first iteration, that it has every drive the spec's motors act on."""
+        """The workcell checks, before the first iteration, that it has every drive (and encoder) the spec's
+        motors are mapped to, and a timestep that divides their period."""
         self.plant.bind(system)
 
     def advance(self, time: float) -> None:

@@ -8,10 +8,7 @@ driver reports a fault.
 
 from __future__ import annotations
 
-import functools
 from typing import Any
-
-from earl.sim import arm
 
 
 class NoPlant(RuntimeError):
@@ -39,31 +36,18 @@ def _plant(context: Any) -> Any:
     return environment.plant
 
 
-def _apply(actuator: str, inputs: Any, outputs: Any, context: Any) -> None:
-    outputs.appliedCurrent = _plant(context).set_input(actuator, float(inputs.motorCommand.windingCurrent))
-
-
-def _read(actuator: str, outputs: Any, context: Any) -> None:
-    plant = _plant(context)
-    outputs.encoderReading = {"motorPos": plant.encoder(actuator), "driverFault": plant.driver_fault(actuator)}
-
-
-@functools.cache
-def _actuator(joint: int) -> str:
-    return arm.actuator_name(joint)
-
-
 def apply_current(inputs: Any, outputs: Any, context: Any) -> None:
-    _apply(_actuator(context.parameters["joint"]), inputs, outputs, context)
+    """The actuator is the one the environment mapped this drive to (`map_actuator`), which `bind` checked."""
+    plant = _plant(context)
+    outputs.appliedCurrent = plant.set_input(plant.actuator_of(context), float(inputs.motorCommand.windingCurrent))
 
 
 def read_encoder(inputs: Any, outputs: Any, context: Any) -> None:
-    _read(_actuator(context.parameters["joint"]), outputs, context)
+    plant = _plant(context)
+    actuator = plant.actuator_of(context)
+    outputs.encoderReading = {"motorPos": plant.encoder(actuator), "driverFault": plant.driver_fault(actuator)}
 
 
-def apply_finger_current(inputs: Any, outputs: Any, context: Any) -> None:
-    _apply(arm.FINGER_ACTUATOR, inputs, outputs, context)
-
-
-def read_finger_encoder(inputs: Any, outputs: Any, context: Any) -> None:
-    _read(arm.FINGER_ACTUATOR, outputs, context)
+# the finger's drive is mapped to the gripper's actuator: the same functions serve it
+apply_finger_current = apply_current
+read_finger_encoder = read_encoder

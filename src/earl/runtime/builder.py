@@ -8,7 +8,6 @@ be imported, a subsystem that could never wait (no period and nothing obligatory
 from __future__ import annotations
 
 import zlib
-from collections.abc import Mapping
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -41,6 +40,7 @@ from earl.runtime.engine import (
 )
 from earl.runtime.events import Recorder
 from earl.runtime.names import agent_name, indexed, reference_key
+from earl.runtime.parameters import agent_parameters, subsystem_parameters
 from earl.runtime.predicates import (
     CompiledPredicate,
     PredicateCompileError,
@@ -108,7 +108,6 @@ def build_network(
     types = TypeSystem(system)
     network = Network(types)
     problems: list[Diagnostic] = []
-    system_parameters = {p.name: _value(p.value) for p in system.parameters}
     bound: dict[str, UserFunction] = {}
     #: modules that cannot be imported: what was said of each, at the first line naming it, and the lines naming it
     unimportable: dict[str, _Unimportable] = {}
@@ -118,10 +117,7 @@ def build_network(
         for agent in system.agents:
             if agents is not None and agent_name(agent) not in agents and agent.name not in agents:
                 continue
-            agent_parameters = dict(system_parameters)
-            if agent.family is not None and agent.index is not None:
-                agent_parameters[agent.family.index] = agent.index
-            agent_parameters.update({p.name: _value(p.value) for p in agent.parameters})
+            inherited = agent_parameters(system, agent)
             for subsystem in agent.subsystems:
                 wrong = duration_problems(subsystem)
                 if wrong:  # a model built in Python, where the reader's S012 never looked
@@ -137,7 +133,7 @@ def build_network(
                     continue
                 try:
                     engine = _engine(
-                        agent, subsystem, len(network.engines), agent_parameters, types, recorder, environment, seed
+                        agent, subsystem, len(network.engines), inherited, types, recorder, environment, seed
                     )
                     _behaviour(engine, subsystem, types, bound, _Problems(problems, unimportable))
                 except (ValueTypeError, PredicateCompileError) as error:
@@ -261,7 +257,7 @@ def _engine(
     agent: Agent,
     subsystem: Subsystem,
     order: int,
-    agent_parameters: Mapping[str, Any],
+    inherited: dict[str, Any],
     types: TypeSystem,
     recorder: Recorder,
     environment: object,
@@ -270,10 +266,7 @@ def _engine(
     import numpy
 
     name = subsystem_name(agent, subsystem)
-    parameters = dict(agent_parameters)
-    if subsystem.family is not None and subsystem.index is not None:
-        parameters[subsystem.family.index] = subsystem.index
-    parameters.update({p.name: _value(p.value) for p in subsystem.parameters})
+    parameters = subsystem_parameters(inherited, subsystem)
     period = None if subsystem.period is None else to_nanoseconds(subsystem.period.seconds)
     # one stream per subsystem, so that adding a subsystem does not change another's numbers
     entropy = [seed, zlib.crc32(name.encode())]

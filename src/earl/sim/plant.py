@@ -19,10 +19,10 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import mujoco
 import numpy as np
@@ -123,8 +123,15 @@ class MujocoPlant:
             mujoco.mj_resetDataKeyframe(model, self.data, key)
         mujoco.mj_forward(model, self.data)
         self.encoders = self._read_encoders()
+        self._sensors = {model.sensor(i).name: i for i in range(model.nsensor)}
+        #: what the environment said each real effector or receptor acts on (`map_actuator`, `map_sensor`)
+        self._maps: list[_Map] = []
+        #: (subsystem name as `context.subsystem`, kind) -> the name resolved from its map, once
+        self._resolved: dict[tuple[str, str], str] = {}
         self._faults: dict[str, float] = {}
         self._steps = 0
+        #: the step the sensor readings were last computed at (mj_forward has run at 0)
+        self._sensed_at = 0
         self._closers: list[Callable[[], None]] = []
         self._frame_hooks: list[tuple[float, _FrameHook]] = []
         self._next_frame: list[float] = []
@@ -211,14 +218,164 @@ class MujocoPlant:
         """Refuse, before the first iteration, a system whose real effectors and receptors the model cannot
         serve (the runtime calls it with the system as it runs; docs/simulation.md says what is checked):
         the timestep must divide their periods, so that the plant is stepped to each of their instants
-        exactly.
+        exactly; and the model must have the actuator (encoder, sensor) each is mapped to (`map_actuator`).
 
-        The names of the model's objects they act on are not checked: their code gives them
-        (`set_input(arm.actuator_name(joint), …)`), and no convention of names (`motor[2]/re` on `motor2`)
-        tells a missing actuator from a family numbered otherwise (`motor[K in 0..N-1]/re` on `motor1…`)."""
-        problems = self._unmet_periods(_real_families(system))
+        No convention of names is checked (`motor[2]/re` on `motor2` would refuse a family numbered
+        otherwise, `motor[K in 0..N-1]/re` on `motor1…`): only the maps, by the lookup `actuator_of` makes
+        during the run, with the parameters each subsystem is given then. A name its code writes itself
+        (`set_input("motor3", …)`) is not checked."""
+        problems = self._unmet_periods(_real_families(system)) + self._unmet_maps(system)
         if problems:
             raise EarlError(problems)
+
+    # ------------------------------------------------------------ what each real effector and receptor acts on
+
+    def map_actuator(self, subsystem: str, actuator: str, *, encoder: bool = False) -> None:
+        """Say which actuator the real effector `subsystem` acts on, so that a missing one is refused before
+        the run (`bind`) instead of failing in every iteration; its functions ask `actuator_of(context)`.
+
+        `subsystem` is named as the run names it, a family with its index: `arm/a.motor[K]/re`;
+        `actuator` is the model's name, with the subsystem's parameters in braces: `motor{K}`
+        (`context.parameters`: the family's index, its own `param`s, the agent's and the system's).
+        `encoder=True`: it reads that actuator's encoder too, which the model must declare."""
+        self._add_map(_Map(subsystem, "actuator", actuator))
+        if encoder:
+            self._add_map(_Map(subsystem, "encoder", actuator))
+
+    def map_sensor(self, subsystem: str, sensor: str) -> None:
+        """Say which of the model's `<sensor>`s the real receptor (or effector) `subsystem` reads, as
+        `map_actuator` does for an actuator; its functions ask `sensor_of(context)` and read `sensor(name)`."""
+        self._add_map(_Map(subsystem, "sensor", sensor))
+
+    def actuator_of(self, context: Any) -> str:
+        """The actuator `map_actuator` gave the running subsystem (`context`, as its functions get it)."""
+        return self._name_of(context.subsystem, context.parameters, "actuator")
+
+    def sensor_of(self, context: Any) -> str:
+        """The sensor `map_sensor` gave the running subsystem."""
+        return self._name_of(context.subsystem, context.parameters, "sensor")
+
+    def _add_map(self, new: _Map) -> None:
+        if not isinstance(new.template, str) or not isinstance(new.subsystem, str):
+            raise PlantError(
+                f"map_{new.kind}(subsystem, {new.kind}) takes two strings, e.g. ('arm/a.motor[K]/re', 'motor{{K}}')"
+            )
+        self._maps = [old for old in self._maps if (old.subsystem, old.kind) != (new.subsystem, new.kind)] + [new]
+        self._resolved.clear()
+
+    def _map_of(self, subsystem: str, parameters: Mapping[str, Any], kind: str) -> _Map | None:
+        """The map of `kind` that names the subsystem: the first declared, when several do."""
+        return next((m for m in self._maps if m.kind == kind and m.matches(subsystem, parameters)), None)
+
+    def _name_of(self, subsystem: str, parameters: Mapping[str, Any], kind: str) -> str:
+        """The model's name a subsystem acts on, from its map: the one lookup of the run and of `bind`."""
+        name = self._resolved.get((subsystem, kind))
+        if name is None:
+            found = self._map_of(subsystem, parameters, kind)
+            if found is None:
+                raise PlantError(
+                    f"no {kind} is mapped for `{subsystem}`: the environment says which one it acts on with "
+                    f"plant.map_{'sensor' if kind == 'sensor' else 'actuator'}('{_family_of(subsystem)}', …)"
+                )
+            name = self._resolved[(subsystem, kind)] = found.name_for(subsystem, parameters)
+        return name
+
+    def _known(self, kind: str) -> list[str]:
+        if kind == "sensor":
+            return list(self._sensors)
+        return list(self.encoders) if kind == "encoder" else self.actuator_names()
+
+    def _unmet_maps(self, system: System) -> list[Diagnostic]:
+        """Each map's subsystems whose actuator (encoder, sensor) the model lacks, found by `_name_of`, the
+        lookup their functions make during the run, with the parameters they are given then; and each map
+        that names no real effector or receptor of the system."""
+        members = _real_members(system)
+        self._resolved.clear()
+        problems: list[Diagnostic] = []
+        said: set[str] = set()  # a map that names no subsystem is said once, not for its actuator and encoder
+        for found in self._maps:
+            mapped = [member for member in members if found.matches(member.shown, member.parameters)]
+            if found.subsystem in said:
+                continue
+            if not mapped:
+                # a map for a subsystem of another system may do no harm; one close to a name of this one is a slip
+                names = list(dict.fromkeys([member.family for member in members] + [m.shown for m in members]))
+                if did_you_mean(found.subsystem, names) is not None:
+                    said.add(found.subsystem)
+                    problems.append(self._maps_nothing(found, names))
+                continue
+            wrong = [letter for letter in found.letters() if letter not in mapped[0].indices]
+            if wrong:
+                said.add(found.subsystem)
+                problems.append(self._not_an_index(found, mapped[0], wrong[0]))
+                continue
+            missing: list[tuple[_Member, str]] = []
+            taken: set[str] = set()  # found by other members: no suggestion for a missing one
+            for member in mapped:
+                if self._map_of(member.shown, member.parameters, found.kind) is not found:
+                    continue  # an earlier map names it: the lookup takes that one, and it is checked there
+                try:
+                    name = self._name_of(member.shown, member.parameters, found.kind)
+                except PlantError as error:
+                    problems.append(Diagnostic(Severity.ERROR, str(error), member.location, code="EARL-X021"))
+                    break
+                if name not in self._known(found.kind):
+                    missing.append((member, name))
+                else:
+                    taken.add(name)
+            if missing:
+                problems.append(self._lacks(found, missing, taken))
+        return problems
+
+    def _lacks(self, found: _Map, missing: list[tuple[_Member, str]], taken: set[str]) -> Diagnostic:
+        known = self._known(found.kind)
+        names = ", ".join(f"`{name}`" for _, name in missing)
+        who = ", ".join(f"`{member.shown}`" for member, _ in missing)
+        what = "an encoder" if found.kind == "encoder" else f"{found.kind}"
+        where = self.origin.name
+        exist = ", ".join(known) or "none"
+        said = (
+            f"{who} {'act' if len(missing) > 1 else 'acts'} on the {found.kind} {names} "
+            f"(map_{found.kind if found.kind != 'encoder' else 'actuator'}('{found.subsystem}', '{found.template}'"
+            f"{', encoder=True' if found.kind == 'encoder' else ''})), but {where} has no {what} named so; "
+            f"its {found.kind}s: {exist}"
+        )
+        if found.kind == "encoder":
+            said = (
+                f"{who} {'read' if len(missing) > 1 else 'reads'} the encoder of {names} (map_actuator("
+                f"'{found.subsystem}', '{found.template}', encoder=True)), but {where} declares none for "
+                f"{'them' if len(missing) > 1 else 'it'}; the encoders it declares: {exist}"
+            )
+        suggestion = did_you_mean(missing[0][1], [name for name in known if name not in taken])
+        hint = (
+            f'add <numeric name="{ENCODER_PREFIX}{missing[0][1]}" data="GEAR COUNTS"/> to its <custom> section'
+            if found.kind == "encoder"
+            else suggestion
+            or f"add it to the model's <{'sensor' if found.kind == 'sensor' else 'actuator'}> section, or correct the map"
+        )
+        return Diagnostic(Severity.ERROR, said, missing[0][0].location, code="EARL-X021", hint=hint)
+
+    def _maps_nothing(self, found: _Map, names: list[str]) -> Diagnostic:
+        families = [name for name in names if "[" not in name or not name.rsplit("[", 1)[1][0].isdigit()]
+        return Diagnostic(
+            Severity.ERROR,
+            f"the environment maps `{found.subsystem}` to `{found.template}`, but the system has "
+            f"no real effector or receptor of that name (it has: {', '.join(families) or 'none'})",
+            None,
+            code="EARL-X021",
+            hint=did_you_mean(found.subsystem, names),
+        )
+
+    def _not_an_index(self, found: _Map, member: _Member, letter: str) -> Diagnostic:
+        return Diagnostic(
+            Severity.ERROR,
+            f"the environment maps `{found.subsystem}` to `{found.template}`, but `{letter}` is no "
+            f"index of the family `{member.family}` (it is a parameter, {letter} = {member.parameters[letter]}): "
+            f"the map would name `{member.shown}` alone",
+            member.location,
+            code="EARL-X021",
+            hint=f"name the family by its index, `{member.family}`, or one member by its number, `{member.shown}`",
+        )
 
     def _unmet_periods(self, families: dict[str, list[_Member]]) -> list[Diagnostic]:
         """The real effectors and receptors whose period is no whole number of the model's steps: the plant
@@ -338,6 +495,21 @@ class MujocoPlant:
             ) from None
         return encoder.read(float(self._qpos[encoder.joint_address]))
 
+    def sensor(self, name: str) -> tuple[float, ...]:
+        """The reading of the model's `<sensor>` named `name` now, its numbers as a tuple (one for a jointpos)."""
+        try:
+            index = self._sensors[name]
+        except KeyError:
+            raise PlantError(
+                f"the model has no sensor named `{name}` (it has: {', '.join(self._sensors) or 'none'})"
+            ) from None
+        if self._sensed_at != self._steps:
+            # mj_step computes the sensors before it integrates: they would be a step behind the state
+            mujoco.mj_forward(self.model, self.data)
+            self._sensed_at = self._steps
+        start = int(self.model.sensor_adr[index])
+        return tuple(float(v) for v in self.data.sensordata[start : start + int(self.model.sensor_dim[index])])
+
     def joint_position(self, joint: str) -> float:
         """The true joint position (for tests and plots; a controller reads encoders)."""
         return float(self.data.joint(self._joint(joint)).qpos[0])
@@ -421,15 +593,64 @@ class _Member:
     location: SourceLocation | None
     #: nanoseconds; None: it runs when a message wakes it
     period: int | None
+    #: its family as the run names it (`arm/a.motor[K]/re`), or its own name
+    family: str = ""
+    #: `context.parameters` of its functions
+    parameters: Mapping[str, Any] = field(default_factory=dict)
+    #: the indices of its family and its agent's family (`K` of `motor[K in 1..N]/re`)
+    indices: frozenset[str] = frozenset()
+
+
+@dataclass(frozen=True)
+class _Map:
+    """`map_actuator('arm/a.motor[K]/re', 'motor{K}')`: the subsystems it names and the model's name of each."""
+
+    subsystem: str
+    #: "actuator", "encoder" or "sensor"
+    kind: str
+    template: str
+
+    def letters(self) -> list[str]:
+        """The names in brackets (`K` of `arm/a.motor[K]/re`), each replaced by its parameter's value to match."""
+        return re.findall(r"\[([A-Za-z_]\w*)\]", self.subsystem)
+
+    def matches(self, subsystem: str, parameters: Mapping[str, Any]) -> bool:
+        """`arm/a.motor[K]/re` names `arm/a.motor[2]/re` when its K is 2 (each `[NAME]` by its parameter)."""
+
+        def index(found: re.Match[str]) -> str:
+            value = parameters.get(found[1])
+            return found[0] if value is None else f"[{value}]"
+
+        return re.sub(r"\[([A-Za-z_]\w*)\]", index, self.subsystem) == subsystem
+
+    def name_for(self, subsystem: str, parameters: Mapping[str, Any]) -> str:
+        try:
+            return self.template.format_map(parameters)
+        except (KeyError, IndexError, ValueError, AttributeError) as error:
+            shown = ", ".join(parameters) or "none"
+            raise PlantError(
+                f"the {self.kind} `{self.template}` mapped for `{subsystem}` cannot be written from its parameters "
+                f"({type(error).__name__}: {error}); in braces go the names of its parameters: {shown}"
+            ) from None
 
 
 def _real_families(system: System) -> dict[str, list[_Member]]:
     """The real effectors and receptors, by family (`arm/a.motor[K]/re`; one that is no family by its own name)."""
+    families: dict[str, list[_Member]] = {}
+    for member in _real_members(system):
+        families.setdefault(member.family, []).append(member)
+    return families
+
+
+def _real_members(system: System) -> list[_Member]:
+    """The real effectors and receptors of the (expanded) system, each with the parameters its functions get."""
     from earl.model.kinds import Kind
     from earl.model.text import subsystem_name
+    from earl.runtime.parameters import agent_parameters, subsystem_parameters
 
-    families: dict[str, list[_Member]] = {}
+    members: list[_Member] = []
     for agent in system.agents:
+        inherited = agent_parameters(system, agent)
         for subsystem in agent.subsystems:
             if subsystem.kind not in (Kind.REAL_EFFECTOR, Kind.REAL_RECEPTOR):
                 continue
@@ -439,9 +660,15 @@ def _real_families(system: System) -> dict[str, list[_Member]]:
             if index and subsystem.family is not None:  # `arm/a.motor[2]/re` is a member of `arm/a.motor[K]/re`
                 family = shown.rsplit("[", 1)[0] + f"[{subsystem.family.index}]/{subsystem.kind}"
             period = None if subsystem.period is None else round(subsystem.period.seconds * 1e9)
-            member = _Member(shown, subsystem.location, period)
-            families.setdefault(family, []).append(member)
-    return families
+            parameters = subsystem_parameters(inherited, subsystem)
+            indices = frozenset(f.index for f in (agent.family, subsystem.family) if f is not None)
+            members.append(_Member(shown, subsystem.location, period, family, parameters, indices))
+    return members
+
+
+def _family_of(subsystem: str) -> str:
+    """`arm/a.motor[2]/re` → `arm/a.motor[K]/re`, for a message that shows how a map names it."""
+    return re.sub(r"\[\d+\](?=/\w+$)", "[K]", subsystem)
 
 
 def _shown_time(nanoseconds: int) -> str:

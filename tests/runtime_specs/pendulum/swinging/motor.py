@@ -3,7 +3,7 @@ from typing import Any
 
 def drive(inputs: Any, outputs: Any, context: Any) -> None:
     plant = context.environment
-    actuator = f"motor{context.parameters['K']}"  # motor[2]/re drives the model's `motor2`
+    actuator = plant.actuator_of(context)  # motor[2]/re: `motor2`, as the environment mapped it
     plant.set_input(actuator, inputs.current)  # amperes, limited to the actuator's ctrlrange
     outputs.reading = plant.encoder(actuator)  # motor shaft, rad, in whole encoder counts
 
