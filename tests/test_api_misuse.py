@@ -559,3 +559,56 @@ def test_a_tuple_where_the_model_declares_a_list_is_drawn_and_exported() -> None
     subsystem.memories = tuple(subsystem.memories)  # type: ignore[assignment]
     assert "counter/a" in build_diagram(system, "system").dot
     assert "counter" in export_sysml(system)
+
+
+class _NoTime:
+    def advance(self) -> None: ...
+
+
+class _BindsNothing:
+    def bind(self) -> None: ...
+
+
+class _ClosesWithWhat:
+    def close(self, viewer: object) -> None: ...
+
+
+class _Fits:
+    """Methods as earl calls them, with defaults and *args: all of these fit."""
+
+    def __init__(self) -> None:
+        self.times: list[float] = []
+
+    def bind(self, system: object, strict: bool = True) -> None: ...
+
+    def advance(self, *times: float) -> None:
+        self.times.extend(times)
+
+    def close(self, reason: str = "") -> None: ...
+
+
+@pytest.mark.parametrize(
+    ("environment", "said"),
+    [
+        (_NoTime(), "the environment's `advance()` cannot be called as earl calls it, advance(time): too many"),
+        (_BindsNothing(), "the environment's `bind()` cannot be called as earl calls it, bind(system): too many"),
+        (_ClosesWithWhat(), "the environment's `close(viewer)` cannot be called as earl calls it, close(): missing"),
+    ],
+)
+def test_an_environment_object_whose_methods_earl_cannot_call_is_refused_before_the_run(
+    environment: object, said: str
+) -> None:
+    """Not a TypeError traceback at the first instant (advance), or once the run is over (close)."""
+    with pytest.raises(EarlError) as refused:
+        earl.simulate(earl.loads(TEXT), environment=environment)
+    [diagnostic] = refused.value.diagnostics
+    assert diagnostic.code == "EARL-X020"
+    assert diagnostic.message.startswith(said)
+    assert diagnostic.hint is not None and diagnostic.hint.startswith("define it as `def ")
+
+
+def test_an_environment_object_whose_methods_fit_runs() -> None:
+    environment = _Fits()
+    with earl.simulate(earl.loads(TEXT), environment=environment) as simulation:
+        simulation.advance_to(0.02)
+    assert environment.times[-1] == pytest.approx(0.02)

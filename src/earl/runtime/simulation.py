@@ -13,6 +13,7 @@ state lives in the subsystem engines this object owns.
 from __future__ import annotations
 
 import contextlib
+import inspect
 import math
 import numbers
 import tomllib
@@ -131,6 +132,7 @@ class Simulation:
         #: where the environment is named (run.toml's line), for what is said of it before the run
         self._environment_named = _environment_named(system, settings, environment)
         self.environment = _environment(environment, self.expanded, seed, directories, *self._environment_named)
+        _refuse_unfit_methods(self.environment, *self._environment_named)
         _bind(self.environment, self.expanded, *self._environment_named)
         self.statistics = StatisticsRecorder()
         self._faults = _FaultList()
@@ -500,6 +502,45 @@ def _environment_method(
         message = f"the environment's `{name}` is a {type(method).__name__}, not a method"
         raise EarlError([Diagnostic(Severity.ERROR, message, location, code="EARL-X020")], sources)
     return method
+
+
+#: the environment's optional methods, each with what earl passes it (docs/runtime.md, "The environment")
+_ENVIRONMENT_CALLS = {"bind": ("system",), "advance": ("time",), "close": ()}
+
+
+def _refuse_unfit_methods(environment: object, location: SourceLocation | None, sources: SourceMap) -> None:
+    """Before the run, EARL-X020 for an environment method earl could not call as it will (`advance()`
+    without the time): it would raise a TypeError at the first instant, or `close` only at the end."""
+    if environment is None:
+        return
+    problems = []
+    for name, arguments in _ENVIRONMENT_CALLS.items():
+        method = _environment_method(environment, name, location, sources)
+        if method is None:
+            continue
+        try:
+            signature = inspect.signature(method)
+        except (TypeError, ValueError):  # a builtin or extension method that does not say: called as it is
+            continue
+        try:
+            signature.bind(*arguments)
+        except TypeError as error:
+            shown = f"{name}({', '.join(arguments)})"
+            # as written, without annotations: `advance()`, `close(viewer)`
+            written = ", ".join(
+                str(p.replace(annotation=inspect.Parameter.empty)) for p in signature.parameters.values()
+            )
+            problems.append(
+                Diagnostic(
+                    Severity.ERROR,
+                    f"the environment's `{name}({written})` cannot be called as earl calls it, {shown}: {error}",
+                    location,
+                    code="EARL-X020",
+                    hint=f"define it as `def {name}(self{''.join(', ' + a for a in arguments)})`",
+                )
+            )
+    if problems:
+        raise EarlError(problems, sources)
 
 
 def _bind(environment: object, expanded: System, location: SourceLocation | None, sources: SourceMap) -> None:
