@@ -120,10 +120,12 @@ def calculate_position(inputs: Any, outputs: Any, context: Any) -> None:
     """currentJointPos and currentOperationalPos from the motor controllers' encoder readings.
 
     Before the first reading nothing is written: memory keeps its initial value, which is not reported.
+    The robot model is built then all the same: the first iteration is the one a real-time run makes
+    before its clock starts, and building it (MuJoCo compiling the robot's XML) takes milliseconds.
     """
+    model = robot_model(_joints(context))
     if _no_reading_yet(context):
         return
-    model = robot_model(_joints(context))
     q = model.motor_to_joint(_measured_motor_positions(inputs, model.n))
     pose = model.forward(q)
     outputs.currentJointPos = q
