@@ -41,7 +41,10 @@ def test_the_base_patrols_its_route_going_around_the_post_without_touching_anyth
         statistics = simulation.statistics.subsystems["base/a.cs"]
         assert simulation.state_of("coordinator/a.cs").state == "done"
         assert simulation.faults == []
-        assert statistics.transitions.get("drive,avoidObstacle", 0) >= 1  # the post was in the way
+        # the post was in the way, and the FSM does not chatter passing it: it went drive -> avoidObstacle
+        # -> drive 10 times in 8 s, each time driveToGoal/pf turned straight back at the post (or it sat at
+        # the edge of the scan filter's view)
+        assert 1 <= statistics.transitions.get("drive,avoidObstacle", 0) <= 2
         assert simulation.environment.least_clearance > 0.1
         pose = simulation.state_of("base/a.cs").memory["pose"]
         assert math.hypot(pose["x"], pose["y"]) < 0.15  # home, by its own odometry

@@ -1,7 +1,7 @@
 """`base/a.cs`: odometry, goal following, obstacle avoidance and the emergency stop of the base.
 
 Each function is one partial transition function of the spec; the FSM (system.earl) chooses which
-run: `drive` steers to the goal, `avoidObstacle` turns away from what is ahead while creeping on,
+run: `drive` steers to the goal, `avoidObstacle` turns away from what is near ahead while creeping on,
 `emergencyStop` brakes until the coordinator asks to resume.
 """
 
@@ -76,10 +76,26 @@ def drive_to_goal(inputs: Any, outputs: Any, context: Any) -> None:
 
 
 def avoid(inputs: Any, outputs: Any, context: Any) -> None:
-    """Turn away from the nearest obstacle ahead and creep on, until the path is clear."""
-    bearing = inputs.obstacles.nearestBearing
-    away = -1.0 if bearing >= 0.0 else 1.0
-    outputs.desiredTwist = _twist(AVOID_SPEED, away * AVOID_TURN)
+    """Turn away from an obstacle near ahead and creep on; once none is, go straight on past it.
+
+    It also says whether the way to the goal is clear (goalWayClear/m, which pathClear/pp reads): with
+    the post on the straight line to the goal, leaving as soon as nothing was near ahead made driveToGoal
+    turn straight back at it, and the FSM went drive -> avoidObstacle -> drive ten times in 8 s."""
+    obstacles, pose, goal = inputs.obstacles, inputs.pose, inputs.currentGoal
+    parameters = context.parameters
+    near = parameters["AVOID_DISTANCE"] + parameters["CLEARANCE_MARGIN"]
+    if obstacles.nearestDistance < near:
+        away = -1.0 if obstacles.nearestBearing >= 0.0 else 1.0
+        outputs.desiredTwist = _twist(AVOID_SPEED, away * AVOID_TURN)
+    else:
+        outputs.desiredTwist = _twist(AVOID_SPEED, 0.0)
+    # the scan filter's sector (0 straight ahead, counter-clockwise) that the goal's direction lies in
+    sectors = parameters["SECTORS"]
+    width = math.tau / sectors
+    bearing = math.atan2(goal.y - pose.y, goal.x - pose.x) - pose.theta
+    sector = math.floor((bearing + width / 2.0) % math.tau / width) % sectors
+    distance = math.hypot(goal.x - pose.x, goal.y - pose.y)
+    outputs.goalWayClear = obstacles.sectorDistance[sector] > min(near, distance)
 
 
 def hold(inputs: Any, outputs: Any, context: Any) -> None:
