@@ -192,6 +192,8 @@ def test_a_map_that_misnames_the_family_is_refused_once(tmp_path: Path) -> None:
     [diagnostic] = refused.value.diagnostics
     assert diagnostic.message.startswith("the environment maps `arm/a.motr[K]/re` to `motor{K}`, but the system has no")
     assert diagnostic.hint == "did you mean `arm/a.motor[K]/re`?"
+    # at no line of the spec: said at run.toml's, which names the environment
+    assert diagnostic.location is not None and diagnostic.location.file.endswith("run.toml")
 
 
 def test_maps_that_name_the_actuators_otherwise_run_without_a_fault(tmp_path: Path) -> None:

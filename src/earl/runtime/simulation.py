@@ -558,6 +558,9 @@ def _bind(environment: object, expanded: System, location: SourceLocation | None
             with contextlib.suppress(Exception):
                 close()
         if isinstance(error, EarlError):  # located by the environment, at the spec's lines
+            for diagnostic in error.diagnostics:
+                # what is at no line of the spec (a map of the environment's own) is said where it is named
+                diagnostic.location = diagnostic.location or location
             raise EarlError(error.diagnostics, sources) from None
         message = f"the environment does not fit the system: {exception_text(error)}"
         raise EarlError([Diagnostic(Severity.ERROR, message, location, code="EARL-X021")], sources) from None
