@@ -55,6 +55,7 @@ from earl.check.expression_types import BOOLEAN, ExpressionTyper
 from earl.check.registry import Finding, rule
 from earl.check.rules_behaviour import followable_definitions
 from earl.diagnostics import Severity
+from earl.held_signals import stop_signals_held
 from earl.model.elements import FSM, Agent, Assumption, State, Subsystem, Transition
 from earl.model.expressions import (
     BooleanOperation,
@@ -80,15 +81,19 @@ def _import_dd_without_networkx() -> ModuleType:
     quietly when it is missing; importing it takes a quarter of a second of every `earl check`
     and `earl run`. Only dd's own import sees it missing: the entry is removed again, so user
     code that imports networkx later gets it as usual.
+
+    A stop signal (Ctrl-C) is held back until the import is done: CPython would lose it inside the
+    initialisation of dd's Cython module (earl/held_signals.py).
     """
     absent = "networkx" not in sys.modules
     if absent:
         sys.modules["networkx"] = None  # type: ignore[assignment]  # makes `import networkx` raise ImportError
     try:
-        try:
-            return importlib.import_module("dd.cudd")
-        except ImportError:
-            return importlib.import_module("dd.autoref")
+        with stop_signals_held():
+            try:
+                return importlib.import_module("dd.cudd")
+            except ImportError:
+                return importlib.import_module("dd.autoref")
     finally:
         if absent and "networkx" in sys.modules and sys.modules["networkx"] is None:
             del sys.modules["networkx"]
