@@ -232,8 +232,9 @@ def test_a_peer_with_another_data_type_is_refused_with_both_types_named(
     common = ["--transport", "zenoh", "--deployment", str(deploy), "--duration", "2s"]
     receiver = run(processes, tmp_path / "receiver.log", [str(PINGPONG), *common, "--agents", "receiver/a"])
     sender = run(processes, tmp_path / "sender.log", [str(other), *common, "--agents", "sender/a"])
-    assert sender.finish(60) == 0, sender.output
-    assert receiver.finish(60) == 0, receiver.output
+    # the run goes on, and fails at its end: the link's messages were lost (the sender is told by the receiver)
+    assert sender.finish(60) == 1, sender.output
+    assert receiver.finish(60) == 1, receiver.output
     theirs = PING.replace("double[2]", "double[3]")
     output = receiver.output
     assert f"refused a message of `{theirs}` from sender/a; receiver/a.cs ping/ib expects `{PING}`" in output
@@ -248,6 +249,48 @@ def test_a_peer_with_another_data_type_is_refused_with_both_types_named(
         f"earl run: link sender,receiver: receiver/a.cs refuses this process's messages of `{theirs}`: its ping/ib "
         f"expects `{PING}`" in sender.output
     ), sender.output
+    # each names the lost links as it ends (the receiver's echo of its first iteration is refused too)
+    for said, lost in ((output, f"sender,receiver ({refused} refused here)"), (sender.output, SENDER_TOLD)):
+        last = said.splitlines()[-1]
+        assert last.startswith("earl run: the link") and lost in last, said
+        assert last.endswith(
+            " lost messages of another data type: the processes run different specifications (exit code 1)"
+        )
+
+
+#: how a sender whose receiver refused its pings names the link, told by the receiver
+SENDER_TOLD = "sender,receiver (receiver/a.cs refused this process's)"
+
+
+def test_a_launch_whose_processes_disagree_on_a_data_type_reports_both_failed(tmp_path: Path) -> None:
+    """A process given `--param N=3` in its `args` sends pings of `double[3]` where the other expects
+    `double[2]`: both run to their end, name the lost link, and `earl launch` reports them failed, exit 1."""
+    spec = tmp_path / "pingpong"
+    shutil.copytree(PINGPONG, spec)
+    system = spec / "system.earl"
+    system.write_text(
+        system.read_text()
+        .replace("system pingPong\n", "system pingPong\n\nparam N: int = 2\n")
+        .replace("stamp: double[2]", "stamp: double[N]")
+    )
+    sender = spec / "pingpong" / "sender.py"
+    sender.write_text(
+        sender.read_text().replace(
+            "(context.time, float(count))", "(context.time, float(count)) + (0.0,) * (context.parameters['N'] - 2)"
+        )
+    )
+    deploy = deployment(tmp_path, [(["sender/a"], False), (["receiver/a"], False)])
+    deploy.write_text(
+        deploy.read_text().replace("environment = false\n", 'environment = false\nargs = ["--param", "N=3"]\n', 1)
+    )
+    command = [sys.executable, "-m", "earl.cli.main", "launch", str(spec), "--deployment", str(deploy)]
+    result = subprocess.run([*command, "--duration", "2s"], capture_output=True, text=True, timeout=120, check=False)
+    output = result.stdout
+    assert result.returncode == 1, output + result.stderr
+    lost = {line[:12]: line for line in output.splitlines() if "lost messages of another data type" in line}
+    assert "sender,receiver (" in lost["[receiver/a]"] and SENDER_TOLD in lost["[sender/a  ]"], output
+    assert "[receiver/a] failed with exit code 1" in output and "[sender/a  ] failed with exit code 1" in output
+    assert "Traceback" not in output + result.stderr
 
 
 def test_peers_that_run_different_specifications_say_so_and_their_links_still_carry_messages(
@@ -356,7 +399,7 @@ def test_malformed_bytes_injected_on_a_link_key_are_counted_and_dropped(
             publisher.put(payload)
         valid = ours + msgpack.packb({"count": 7, "stamp": [0.5, 7.0], "note": None})
         publisher.put(valid)
-        assert receiver.finish(60) == 0, receiver.output
+        assert receiver.finish(60) == 1, receiver.output  # a message refused is a message lost
     finally:
         session.close()  # type: ignore[no-untyped-call]
     output = receiver.output
@@ -366,6 +409,7 @@ def test_malformed_bytes_injected_on_a_link_key_are_counted_and_dropped(
     assert (
         "link sender,receiver (earl/pingPong/sender,receiver): 1 received, 5 malformed (dropped), 1 refused" in output
     )
+    assert "earl run: the link sender,receiver (1 refused here) lost messages of another data type" in output
     assert "Traceback" not in output
 
 

@@ -841,6 +841,10 @@ def test_run_help_teaches_with_examples() -> None:
         "or the --plot or run.toml's report asked for failed at the end (the run and its trace are whole)"
         in " ".join(result.stdout.split())
     )
+    # as docs/distributed.md says it
+    assert "with --transport zenoh also when a link's messages were refused for another data type" in " ".join(
+        result.stdout.split()
+    )
 
 
 @pytest.fixture(autouse=True)

@@ -64,7 +64,9 @@ exit codes: 0 the run completed (or the spec's code called sys.exit(0)), 1 inval
             the run could not start, its trace could not be written (a full disk), the
             environment failed, the spec's code called sys.exit with a failure, or the --plot
             or run.toml's report asked for failed at the end (the run and its trace are
-            whole), 2 usage error, 130 interrupted (the trace is closed and readable)
+            whole); with --transport zenoh also when a link's messages were refused for
+            another data type (the run goes on, and names the links at its end),
+            2 usage error, 130 interrupted (the trace is closed and readable)
 """
 
 
@@ -574,10 +576,13 @@ def _execute(
         print(f"earl run: {failed} (the run reached {simulation.time:.3f} s)", file=sys.stderr)
         return EXIT_FAILED
     _summary(simulation, wall, arguments)
+    #: messages of a link refused for another data type (here, or by a receiver that said so): data lost
+    lost = False
     if simulation.transport is not None:
-        from earl.transport.process import print_link_statistics
+        from earl.transport.process import print_link_statistics, say_refused_links
 
         print_link_statistics(simulation.transport)
+        lost = say_refused_links(simulation.transport)
     plotted = _plot(arguments, console) if arguments.plot else True
     # a report that fails is a run that did not give what it was asked for, as a plot not drawn is
     reported = _report(simulation, report, report_name, path, console) if report is not None else True
@@ -595,9 +600,9 @@ def _execute(
             f"earl run: the spec's code called sys.exit({'' if status is None else repr(status)}) at "
             f"{simulation.time:.3f} s; the run stopped there" + (" and the trace is closed" if arguments.trace else "")
         )
-        return EXIT_OK if status in (None, 0) and delivered else EXIT_FAILED
-    # a plot asked for and not drawn (as `earl plot` says it), or a report that failed
-    return EXIT_OK if delivered else EXIT_FAILED
+        return EXIT_OK if status in (None, 0) and delivered and not lost else EXIT_FAILED
+    # a plot asked for and not drawn (as `earl plot` says it), a report that failed, a link refused
+    return EXIT_OK if delivered and not lost else EXIT_FAILED
 
 
 def _advance(

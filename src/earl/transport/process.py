@@ -13,6 +13,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+from earl.diagnostics import escape_controls
 from earl.model.elements import System
 from earl.model.expand import expand
 from earl.model.kinds import Kind
@@ -165,3 +166,15 @@ def print_link_statistics(transport: ZenohTransport) -> None:
         if statistics.direction == "in":
             line += f", {statistics.malformed} malformed (dropped), {statistics.refused} refused (type mismatch)"
         print(line, flush=True)
+
+
+def say_refused_links(transport: ZenohTransport) -> bool:
+    """One closing line on standard error naming the links whose messages were refused for another data
+    type, here or by their receiver: the run lost them, and fails (exit code 1). Whether there were any."""
+    refused = [f"{link} ({where})" for link, where in transport.refused_links().items()]
+    if not refused:
+        return False
+    links = f"the link {refused[0]}" if len(refused) == 1 else f"the links {', '.join(refused[:-1])} and {refused[-1]}"
+    said = f"earl run: {links} lost messages of another data type: the processes run different specifications"
+    log(escape_controls(said + " (exit code 1)"))  # a receiver's name is a peer's words: it may forge no line
+    return True

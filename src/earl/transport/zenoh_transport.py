@@ -263,7 +263,8 @@ class ZenohTransport:
         self._lost: set[str] = set()  # peers seen, then gone (scheduler's thread)
         self._alive_changed = threading.Condition()
         self._descriptions: dict[str, str] = {}  # fingerprint hex -> description, for the types queryable
-        self._refusals_said: set[str] = set()  # links whose receivers said they refuse our messages
+        #: links whose receivers said they refuse our messages, and which subsystem refuses them
+        self._refused_by: dict[str, str] = {}
         self._declared: list[Any] = []
         self._tokens: list[zenoh.LivelinessToken] = []
         self._types: TypeSystem | None = None
@@ -507,9 +508,9 @@ class ZenohTransport:
             link, receiver, buffer, expects = (str(asked[k]) for k in ("link", "receiver", "buffer", "expects"))
         except Exception:  # an older peer, or one that says nothing: its own report is the one
             return
-        if link in self._refusals_said:
+        if link in self._refused_by:
             return
-        self._refusals_said.add(link)
+        self._refused_by[link] = receiver
         message = escape_controls(  # a peer's words: none may forge a line of this process's output
             f"earl run: link {link}: {receiver} refuses this process's messages of `{ours}`: its {buffer}/ib "
             f"expects `{expects}` — the two processes run different specifications"
@@ -550,6 +551,18 @@ class ZenohTransport:
         threading.Thread(target=ask, name="earl-type-query", daemon=True).start()
 
     # ---------------------------------------------------------------- the end
+    def refused_links(self) -> dict[str, str]:
+        """The links whose messages were refused for another data type (lost), and where: `52 refused here`
+        on the receiving side, `receiver/a.cs refused this process's` on a sending side its receiver told."""
+        refused = {
+            statistics.link: f"{statistics.refused} refused here"
+            for statistics in self.statistics
+            if statistics.direction == "in" and statistics.refused
+        }
+        for link, receiver in list(self._refused_by.items()):  # a copy: Zenoh's threads may still add one
+            refused.setdefault(link, f"{receiver} refused this process's")
+        return refused
+
     def close(self) -> None:
         session = self.session
         if session is None:  # never opened (the run could not be set up): nothing was declared
