@@ -525,6 +525,31 @@ def launch_command(deploy: Path, duration: str) -> list[str]:
     return [*program, str(PINGPONG), "--deployment", str(deploy), "--duration", duration]
 
 
+def test_processes_listening_on_one_port_of_ipv4_and_ipv6_loopback_exchange_messages(tmp_path: Path) -> None:
+    """`tcp/127.0.0.1:P` and `tcp/[::1]:P` are two sockets: the deployment was refused as naming one endpoint."""
+    with socket.socket(socket.AF_INET6) as probe:
+        try:
+            probe.bind(("::1", 0))
+        except OSError:
+            pytest.skip("this host has no IPv6 loopback")
+    for _ in range(5):  # a port free on both loopbacks
+        port = free_ports(1)[0]
+        with socket.socket(socket.AF_INET6) as probe, contextlib.suppress(OSError):
+            probe.bind(("::1", port))
+            break
+    deploy = tmp_path / "deploy.toml"
+    deploy.write_text(
+        f'[[process]]\nagents = ["sender/a"]\nlisten = "tcp/127.0.0.1:{port}"\n\n'
+        f'[[process]]\nagents = ["receiver/a"]\nlisten = "tcp/[::1]:{port}"\n'
+    )
+    result = subprocess.run(launch_command(deploy, "1s"), capture_output=True, text=True, timeout=120, check=False)
+    output = result.stdout
+    assert result.returncode == 0, output + result.stderr
+    for label, link in (("[receiver/a]", "sender,receiver"), ("[sender/a  ]", "receiver,sender")):
+        closing = next(line for line in output.splitlines() if line.startswith(f"{label} link {link} ("))
+        assert int(closing.split("): ", 1)[1].split(" ", 1)[0]) > 50, output
+
+
 def test_launch_whose_reader_goes_away_stops_every_process(tmp_path: Path) -> None:
     """`earl launch … | head -1`: the output is closed, so the processes are stopped, not left to block."""
     deploy = deployment(tmp_path, [(["sender/a"], False), (["receiver/a"], False)])

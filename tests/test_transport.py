@@ -237,7 +237,28 @@ def test_an_environment_that_would_run_twice_or_apart_from_its_effectors_is_refu
         ),
         (
             "[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:7'\n[[process]]\nagents = ['b']\nlisten = 'tcp/localhost:7'\n",
-            "`tcp/localhost:7` is the same endpoint as process 1's",
+            "`tcp/localhost:7` and process 1's `tcp/127.0.0.1:7` cannot both listen on port 7 (`localhost` is "
+            "127.0.0.1 or ::1, as this host resolves it)",
+        ),
+        (
+            "[[process]]\nagents = ['a']\nlisten = 'tcp/[::1]:7'\n[[process]]\nagents = ['b']\nlisten = 'tcp/localhost:7'\n",
+            "`tcp/localhost:7` and process 1's `tcp/[::1]:7` cannot both listen on port 7 (`localhost` is",
+        ),
+        (
+            "[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:7'\n[[process]]\nagents = ['b']\nlisten = 'tcp/0.0.0.0:7'\n",
+            "cannot both listen on port 7 (`0.0.0.0` listens on every IPv4 address of this host)",
+        ),
+        (
+            "[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:7'\n[[process]]\nagents = ['b']\nlisten = 'tcp/[::]:7'\n",
+            "cannot both listen on port 7 (`[::]` listens on every address of this host, IPv4 too)",
+        ),
+        (
+            "[[process]]\nagents = ['a']\nlisten = 'tcp/[0:0:0:0:0:0:0:1]:7'\n[[process]]\nagents = ['b']\nlisten = 'tcp/[::1]:7'\n",
+            "`tcp/[::1]:7` is the same endpoint as process 1's",
+        ),
+        (
+            "[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:7'\n[[process]]\nagents = ['b']\nlisten = 'tls/127.0.0.1:7'\n",
+            "`tls/127.0.0.1:7` is the same endpoint as process 1's",  # both bind TCP port 7
         ),
         (
             "[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:7451'\n[[process]]\nagents = ['b']\nlisten = 'tcp/127.0.0.1:07451'\n",
@@ -265,6 +286,23 @@ def test_a_bad_deployment_file_is_one_located_sentence(tmp_path: Path, text: str
         read_deployment(path)
     assert str(error.value).startswith(str(path))
     assert fragment in str(error.value)
+
+
+@pytest.mark.parametrize(
+    ("first", "second"),
+    [
+        ("tcp/127.0.0.1:7451", "tcp/[::1]:7451"),  # IPv4 and IPv6 each have their own port 7451
+        ("tcp/0.0.0.0:7451", "tcp/[::1]:7451"),
+        ("tcp/127.0.0.1:7451", "udp/127.0.0.1:7451"),  # a TCP port and a UDP port
+        ("tcp/127.0.0.1:7451", "tcp/127.0.0.2:7451"),
+    ],
+)
+def test_listeners_on_different_sockets_of_one_port_are_two_endpoints(tmp_path: Path, first: str, second: str) -> None:
+    path = tmp_path / "deploy.toml"
+    path.write_text(
+        f"[[process]]\nagents = ['a']\nlisten = '{first}'\n[[process]]\nagents = ['b']\nlisten = '{second}'\n"
+    )
+    assert [process.listen for process in read_deployment(path).processes] == [first, second]
 
 
 @settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])

@@ -32,6 +32,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from earl.diagnostics import did_you_mean
+from earl.transport.listeners import Listener, clash, listener
 
 LOCAL_HOSTS = frozenset({"localhost", "127.0.0.1", "::1"})
 
@@ -242,18 +243,6 @@ def _launch_option(arg: str) -> str | None:
     return next((option for option in LAUNCH_SETS if option.startswith(written)), None)
 
 
-def _endpoint_key(endpoint: str) -> tuple[str, str, str]:
-    """An endpoint as a listener sees it: `localhost`, `127.0.0.1` and `[::1]` are the same host."""
-    protocol, _, address = endpoint.partition("/")
-    host, _, port = address.split("#", 1)[0].split("?", 1)[0].rpartition(":")
-    host = host.strip("[]")
-    if host in LOCAL_HOSTS or host in {"0.0.0.0", "::"}:
-        host = "this host"
-    if _is_port_number(port):
-        port = str(int(port))  # `017451` is port 17451
-    return (protocol, host, port) if port else (protocol, address, "")
-
-
 def read_deployment(path: Path) -> Deployment:
     try:
         text = path.read_text(encoding="utf-8")
@@ -277,7 +266,8 @@ def read_deployment(path: Path) -> Deployment:
         raise DeploymentError(f"{path}: no `[[process]]` table; each names its `agents` and `listen` endpoint")
     processes: list[ProcessGroup] = []
     seen_agents: dict[str, int] = {}
-    seen_endpoints: dict[tuple[str, str, str], int] = {}
+    #: each process's `listen` endpoint so far, and the socket it binds
+    seen_endpoints: list[tuple[int, str, Listener]] = []
     for number, table in enumerate(tables, start=1):
         where = f"{path}: process {number}"
         listed: set[str] = set()
@@ -305,12 +295,19 @@ def read_deployment(path: Path) -> Deployment:
         problem = endpoint_problem(listen)
         if problem is not None:
             raise DeploymentError(f"{where}: `listen = {listen!r}`: {problem}")
-        key = _endpoint_key(listen)
-        if key in seen_endpoints:
-            raise DeploymentError(
-                f"{where}: `{listen}` is the same endpoint as process {seen_endpoints[key]}'s; give each its own port"
-            )
-        seen_endpoints[key] = number
+        this = listener(listen)
+        for other_number, other, bound in seen_endpoints:
+            why = clash(this, bound)
+            if why == "":
+                raise DeploymentError(
+                    f"{where}: `{listen}` is the same endpoint as process {other_number}'s; give each its own port"
+                )
+            if why is not None:
+                raise DeploymentError(
+                    f"{where}: `{listen}` and process {other_number}'s `{other}` cannot both listen on port "
+                    f"{this.port} ({why}); give each its own port"
+                )
+        seen_endpoints.append((number, listen, this))
         environment = table.get("environment")
         host = table.get("host", "localhost")
         args = table.get("args", [])
