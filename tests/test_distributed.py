@@ -29,6 +29,7 @@ PINGPONG = SPECS / "pingpong"
 PICK_AND_PLACE = Path(__file__).parent.parent / "examples" / "pick_and_place"
 MOBILE_ROBOT = Path(__file__).parent.parent / "examples" / "mobile_robot"
 PING = "struct Ping{count:int,stamp:double[2],note:string?}"
+EARL_RUN = [sys.executable, "-m", "earl.cli.main", "run"]
 
 
 def free_ports(count: int) -> list[int]:
@@ -806,6 +807,10 @@ def test_a_process_that_fails_before_its_run_starts_stops_the_launch_at_once(
     assert "[sender/a  ] earl run: sender/a over Zenoh" not in output  # its errors came first
     if failure == "a port held by another":
         assert "Address already in use" in output
+        # the receiver, connecting to that port, which never answers, stops itself in order and in time: its
+        # Zenoh session waited 10 s for the connection under way, and the launch killed it after 5 s
+        assert "[receiver/a] earl run: interrupted before the run started" in output
+        assert "did not stop within" not in output
     else:
         assert "EARL-X00" in output
     assert "Traceback" not in output
@@ -880,6 +885,40 @@ def test_wait_for_peers_0_starts_at_once_and_a_missing_deployment_file_is_a_usag
         [*command, "--deployment", str(tmp_path / "none.toml")], capture_output=True, text=True, timeout=120
     )
     assert missing.returncode == 2 and "none.toml does not exist" in missing.stderr
+
+
+def test_a_session_that_waits_to_close_for_a_connection_that_never_answers_says_so(tmp_path: Path) -> None:
+    """With the user's Zenoh configuration (its own open_timeout), a connect endpoint held by a program that
+    never speaks Zenoh keeps the session from closing until the connection times out: the process says why
+    it waits, then ends in order."""
+    held, listen = free_ports(2)
+    config = tmp_path / "zenoh.json5"
+    config.write_text(
+        json.dumps(
+            {
+                "mode": "peer",
+                "scouting": {"multicast": {"enabled": False}},
+                "listen": {"endpoints": [f"tcp/127.0.0.1:{listen}"]},
+                "connect": {"endpoints": [f"tcp/127.0.0.1:{held}"]},
+                "transport": {"unicast": {"open_timeout": 4000}},
+            }
+        )
+    )
+    with socket.socket() as holder:
+        holder.bind(("127.0.0.1", held))
+        holder.listen()  # connections are accepted by the system, and never answered
+        started = time.monotonic()
+        options = ["--agents", "receiver", "--duration", "0.2s", "--wait-for-peers", "0", "--no-progress"]
+        result = subprocess.run(
+            [*EARL_RUN, str(PINGPONG), "--transport", "zenoh", "--zenoh-config", str(config), *options],
+            capture_output=True,
+            text=True,
+            timeout=60,
+            check=False,
+        )
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert "earl run: the Zenoh session is still closing: it waits for a connection it is opening" in result.stderr
+    assert time.monotonic() - started < 20
 
 
 def test_a_deployment_named_with_a_zenoh_config_is_read_and_checked(tmp_path: Path) -> None:

@@ -52,6 +52,21 @@ RETRY_INITIAL_MS = 100
 RETRY_MAX_MS = 1000
 
 
+#: how long Zenoh waits for a peer to answer as it opens a connection (ms; Zenoh's default is 10 s): closing
+#: the session waits for an attempt under way, so that a process whose connect endpoint is a port held by a
+#: program that never speaks Zenoh took that long to stop, and `earl launch` killed it after its 5 s of grace.
+#: Unanswered, the attempt is retried (connect/retry), so a slow peer is still reached.
+OPEN_TIMEOUT_MS = 2000
+
+
+#: seconds a session may take to close before the process says why it waits
+CLOSE_SAID_AFTER = 1.0
+SLOW_CLOSE = (
+    "earl run: the Zenoh session is still closing: it waits for a connection it is opening to answer or time out "
+    "(Zenoh's transport/unicast/open_timeout); a connect endpoint may be held by a program that does not speak Zenoh"
+)
+
+
 #: seconds between saying an agent finished and withdrawing its liveliness token, as a run closes
 FINISHED_LEAD = 0.05
 
@@ -68,6 +83,7 @@ def default_config(listen: list[str], connect: list[str]) -> zenoh.Config:
         config.insert_json5("scouting/multicast/enabled", "false")
         config.insert_json5("listen/endpoints", json.dumps(listen))
         config.insert_json5("connect/endpoints", json.dumps(connect))
+        config.insert_json5("transport/unicast/open_timeout", json.dumps(OPEN_TIMEOUT_MS))
         config.insert_json5(
             "connect/retry",
             json.dumps(
@@ -580,5 +596,13 @@ class ZenohTransport:
             with contextlib.suppress(Exception):  # already gone with the session
                 token.undeclare()  # type: ignore[no-untyped-call]
         self._tokens.clear()
-        with contextlib.suppress(Exception):  # closing twice, or Zenoh already shut down at interpreter exit
-            session.close()  # type: ignore[no-untyped-call]
+        # Zenoh's close waits for a connection it is still opening (a connect endpoint held by a program that
+        # never answers): said when it takes long, rather than a process that seems to hang as it stops
+        slow = threading.Timer(CLOSE_SAID_AFTER, self.log, args=(SLOW_CLOSE,))
+        slow.daemon = True
+        slow.start()
+        try:
+            with contextlib.suppress(Exception):  # closing twice, or Zenoh already shut down at interpreter exit
+                session.close()  # type: ignore[no-untyped-call]
+        finally:
+            slow.cancel()
