@@ -525,4 +525,18 @@ def commented_systems(draw: DrawFn) -> System:
             carrier.comments.leading = draw(_leading_comments())
         if draw(st.booleans()):
             carrier.comments.trailing = draw(_comment_texts)
+        if _written_over_lines(carrier) and draw(st.booleans()):
+            carrier.comments.after = draw(_comment_texts)  # after its `}`
+    for declaration in system.order:
+        # a blank line a person left between two fields of a struct, to group them
+        for later in declaration.fields[1:] if isinstance(declaration, StructType) else ():
+            if draw(st.booleans()):
+                later.comments.leading.insert(0, "")
     return system
+
+
+def _written_over_lines(carrier: Any) -> bool:
+    """A block that `earl fmt` writes with its `}` on a line of its own."""
+    if isinstance(carrier, StructType):
+        return bool(carrier.fields)
+    return isinstance(carrier, Agent | Subsystem | BasicBehaviour | FSM)

@@ -255,7 +255,7 @@ x/a {
         // end of the control subsystem
     }
     // end of the agent
-}  // not this one: after the `}`, it goes to what follows
+}  // after the `}`: about the agent, and kept there
 
 r/r {
     x/a
@@ -277,7 +277,7 @@ def test_a_comment_that_ends_a_block_stays_in_it(tmp_path: Path, capsys: pytest.
         ("            // the error condition to come", "        }"),
         ("            // TODO: a way out", "        }"),
         ("        // end of the control subsystem", "    }"),
-        ("    // end of the agent", "}"),
+        ("    // end of the agent", "}  // after the `}`: about the agent, and kept there"),
         ("    // the robot's other agents", "}"),
     ]:
         lines = formatted.splitlines()
@@ -285,7 +285,7 @@ def test_a_comment_that_ends_a_block_stays_in_it(tmp_path: Path, capsys: pytest.
     assert (
         "            * -> r when f/pp  // from every state  // however it was reached\n            // TODO" in formatted
     )
-    assert "// not this one: after the `}`, it goes to what follows\nr/r {" in formatted
+    assert "    // end of the agent\n}  // after the `}`: about the agent, and kept there\n\nr/r {" in formatted
     again = tmp_path / "again.earl"
     again.write_text(formatted)
     assert main(["fmt", "--check", str(again)]) == 0
@@ -381,3 +381,62 @@ def test_a_comment_on_a_later_line_of_a_clause_ends_that_clause_s_line() -> None
     assert "            tf = {f/pf} then {g/pf}  // the second stage sends\n" in formatted
     assert "            tc = p/pp or q/pp  // the reverse case\n            ec = not p/pp\n" in formatted
     assert earl.loads(formatted, "s.earl").to_earl() == formatted
+
+
+MEMBER_GROUPS = """\
+system s
+
+struct Pose {
+    x: double
+    y: double
+
+
+    // the orientation
+    yaw: double
+    pitch: double
+
+    // to come: roll
+}
+
+arm/r {
+    shoulder/a
+    elbow/a
+
+    wrist/a
+    link shoulder,elbow  // the first joint
+
+    // between the agents
+    link elbow,wrist
+}
+"""
+
+
+def test_fmt_keeps_a_blank_line_that_groups_a_robot_s_members_or_a_struct_s_fields(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`earl fmt` dropped every blank line inside `name/r { … }` and `struct … { … }`, so members a person had
+    grouped ran together; blank lines in a row are one, as elsewhere."""
+    path = tmp_path / "groups.earl"
+    path.write_text(MEMBER_GROUPS)
+    assert main(["fmt", str(path)]) == 0
+    formatted = capsys.readouterr().out
+    assert formatted == MEMBER_GROUPS.replace("    y: double\n\n\n", "    y: double\n\n")
+    again = tmp_path / "again.earl"
+    again.write_text(formatted)
+    assert main(["fmt", "--check", str(again)]) == 0
+
+
+def test_a_comment_after_a_closing_brace_stays_after_it_whatever_the_layout(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`r/r { a/a }  // c` gave the comment to the robot's first line, the same comment after a `}` written on
+    a line of its own went to the next declaration: both now stay after the `}` of the block they follow."""
+    one_line = "system s\n\nstruct S { a: int }  // the struct\n\nr/r { a/a }  // the robot\n\nparam N: int = 1\n"
+    over_lines = (
+        "system s\n\nstruct S {\n    a: int\n}  // the struct\n\nr/r {\n    a/a\n}  // the robot\n\nparam N: int = 1\n"
+    )
+    for text in (one_line, over_lines):
+        path = tmp_path / "closed.earl"
+        path.write_text(text)
+        assert main(["fmt", str(path)]) == 0
+        assert capsys.readouterr().out == over_lines

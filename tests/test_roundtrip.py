@@ -111,9 +111,10 @@ def test_comments_stay_with_their_elements(system: System) -> None:
     assert read.comments.leading == system.comments.leading
     assert read.comments.closing == system.comments.closing
     for written, kept in zip(comment_carriers(system), comment_carriers(read), strict=True):
-        assert (kept.comments.leading, kept.comments.trailing) == (
+        assert (kept.comments.leading, kept.comments.trailing, kept.comments.after) == (
             written.comments.leading,
             written.comments.trailing,
+            written.comments.after,
         ), type(written).__name__
     assert read.to_earl() == text
 

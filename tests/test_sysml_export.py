@@ -499,6 +499,20 @@ def test_a_comment_that_closes_a_block_is_in_the_element_s_doc() -> None:
     assert "vim" not in export_sysml(earl.loads(text + "// vim: set ft=earl:\n", "closing.earl"))
 
 
+def test_a_comment_after_a_block_s_closing_brace_is_in_that_element_s_doc() -> None:
+    """`}  // the agent's end` went to the next declaration's doc (the robot's here); it is about the block it
+    follows, however the block is laid out."""
+    for agent in (
+        "x/a {\n    cs {\n        period 10 ms\n    }\n}  // the agent's end\n",
+        "x/a { cs { period 10 ms } }  // the agent's end\n",
+    ):
+        text = f"system closing\n\n{agent}\nr/r {{\n    x/a\n}}\n"
+        exported = export_sysml(earl.loads(text, "closing.earl"))
+        agent_doc = re.search(r"part <'x/a'> x_a : EARL::Agent :> agents \{\s*doc\s*/\*(.*?)\*/", exported, re.DOTALL)
+        assert agent_doc is not None and "the agent's end" in agent_doc.group(1), exported
+        assert exported.count("the agent's end") == 1
+
+
 _OPTIONAL_ARRAYS = """system opt
 
 type Row = double[3]

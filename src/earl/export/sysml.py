@@ -105,13 +105,18 @@ def _comment_lines(comments: Comments | None, closing: bool = True) -> list[str]
     the element only the block next to it counts: one that a blank line parts from it heads a section
     of the file (an imported file's header above its first declaration), not the element. `closing`:
     with those that close the element's block (`// end of the arm's limits` before its `}`), written
-    about it too; not the system's, which end the file (`// vim: set ft=earl:`)."""
+    about it too, as is the one after its `}`; not the system's, which end the file (`// vim: set ft=earl:`)."""
     if comments is None:
         return []
     leading = list(comments.leading)
     if "" in leading:
         leading = leading[len(leading) - leading[::-1].index("") :]  # after the last blank line
-    blocks = [leading, [comments.trailing] if comments.trailing else [], comments.closing if closing else []]
+    blocks = [
+        leading,
+        [comments.trailing] if comments.trailing else [],
+        comments.closing if closing else [],
+        [comments.after] if comments.after else [],
+    ]
     result: list[str] = []
     for block in blocks:
         paragraph: list[str] = []
@@ -851,7 +856,7 @@ def _comments_by_location(system: System) -> dict[SourceLocation, Comments]:
         ]
         own = robot.comments
         if robot.location is not None:
-            table[robot.location] = Comments(list(own.leading), own.trailing, [*at_members, *own.closing])
+            table[robot.location] = Comments(list(own.leading), own.trailing, [*at_members, *own.closing], own.after)
     for agent in system.agents:
         keep(agent)
         for element in [*agent.parameters, *agent.links]:

@@ -54,24 +54,32 @@ class _Printer:
         if self.lines and self.lines[-1] != "":
             self.lines.append("")
 
-    def line(self, depth: int, text: str, comments: Comments | None = None) -> None:
+    def line(self, depth: int, text: str, comments: Comments | None = None, closed: bool = False) -> None:
+        """A line of code after its leading comments, ending with its own; `closed`: a block written on this
+        one line, so the comment that followed its `}` ends the line too."""
         if comments is not None:
             for comment in comments.leading:
                 self.comment(depth, comment)
             if comments.trailing:
                 text = f"{text}  {comments.trailing.rstrip()}"
+            if closed and comments.after:
+                text = f"{text}  {comments.after.rstrip()}"
         self.lines.append(f"{INDENT * depth}{text}")
 
     def comment(self, depth: int, comment: str) -> None:
-        """A whole-line comment; "" is the blank line that kept it apart from what follows."""
+        """A whole-line comment; "" is the blank line that kept it apart from what follows (one, however
+        many are asked for in a row)."""
         comment = comment.rstrip()  # trailing space, and the `\r` a CRLF file leaves in a comment
-        self.lines.append(f"{INDENT * depth}{comment}" if comment else "")
+        if comment:
+            self.lines.append(f"{INDENT * depth}{comment}")
+        else:
+            self.blank()
 
     def close(self, depth: int, comments: Comments) -> None:
-        """A block's `}`, after the comments that ended its body."""
+        """A block's `}`, after the comments that ended its body, and with the comment written after it."""
         for comment in comments.closing:
             self.comment(depth + 1, comment)
-        self.line(depth, "}")
+        self.line(depth, "}" + (f"  {comments.after.rstrip()}" if comments.after else ""))
 
     def text(self) -> str:
         while self.lines and self.lines[-1] == "":
@@ -196,7 +204,7 @@ def _parameter(printer: _Printer, depth: int, parameter: Parameter) -> None:
 
 def _struct(printer: _Printer, struct: StructType) -> None:
     if not struct.fields and not struct.comments.closing:
-        printer.line(0, f"struct {struct.name} {{}}", struct.comments)
+        printer.line(0, f"struct {struct.name} {{}}", struct.comments, closed=True)
         return
     printer.line(0, f"struct {struct.name} {{", struct.comments)
     for field in struct.fields:
@@ -354,7 +362,7 @@ def _state(printer: _Printer, depth: int, state: State) -> None:
     if not any(_has_comments(c) for c in said.values()) and not state.comments.closing:
         if group:
             text += " { " + "  ".join(group) + " }"
-        printer.line(depth, text, state.comments)
+        printer.line(depth, text, state.comments, closed=True)
         return
     # a body with comments in it is written a clause a line, each clause with the comments of the lines
     # it was written on

@@ -6,6 +6,7 @@ from bisect import bisect_left
 from collections.abc import Callable
 from functools import lru_cache
 from importlib import resources
+from itertools import pairwise
 from typing import Any
 
 from lark import Lark, Token
@@ -20,7 +21,7 @@ from earl.lang.transformer import ElementBuilder, ParsedFile, SpecificationSynta
 from earl.model.elements import FSM, Agent, BasicBehaviour, Robot, State, Subsystem
 from earl.model.location import Comments, SourceLocation
 from earl.model.text import robot_member_keys
-from earl.model.types import StructType
+from earl.model.types import Field, StructType
 
 #: Larger files are refused before parsing.  The benchmark's thousand agents, written out in
 #: full, take 5 MB and some 4–5 s of CPU to read (benchmarks/results/parse.json); a file much
@@ -182,6 +183,7 @@ def parse_text(text: str, path: str = "<text>", sources: SourceMap | None = None
         parsed.header_comments = _with_blank_lines([c for c in comments if (c.line or 1) <= header_line], header_line)
         comments = [c for c in comments if (c.line or 1) > header_line]
     parsed.closing_comments = attach_comments(parsed.declarations, comments, path, text)
+    keep_blank_lines_between_members(parsed.declarations, text)
     return parsed
 
 
@@ -347,6 +349,68 @@ def _member_locations(robot: Robot) -> list[SourceLocation | None]:
 _BLOCKS: tuple[type, ...] = (StructType, Robot, Agent, Subsystem, BasicBehaviour, FSM, State)
 
 
+def _closing_braces(statements: list[Any], blocks: list[Any], lines: list[str]) -> dict[int, Any]:
+    """By line: the block whose `}` is the last thing on that line before any comment (the outermost of
+    those closed there); a line where another element starts after that `}` has none."""
+    closes: dict[int, Any] = {}
+    for block in blocks:
+        location = block.location
+        end = location.end_line
+        text = lines[end - 1] if 0 < end <= len(lines) else ""
+        if text[location.end_column - 2 : location.end_column - 1] != "}":
+            continue  # a state without a body ends at its behaviour's name
+        if location.line == end and (isinstance(block, State) or (isinstance(block, StructType) and not block.fields)):
+            continue  # written on one line by `earl fmt` too: its end-of-line comment is the line's own
+        known = closes.get(end)
+        if known is None or location.end_column > known.location.end_column:
+            closes[end] = block
+    if closes:
+        for element in statements:  # `} b/a {`: the comment is the next element's
+            location = element.location
+            closed = closes.get(location.line)
+            if closed is not None and location.column >= closed.location.end_column:
+                del closes[location.line]
+    return closes
+
+
+def keep_blank_lines_between_members(declarations: list[Any], text: str) -> None:
+    """A blank line a person left between two members of a robot, or two fields of a struct, to group
+    them: kept as a "" first in the second's leading comments, as one between a comment block and what
+    follows is kept (`earl fmt` writes no other blank line in those bodies). Also before the comments that
+    close the body. Several blank lines are one."""
+    lines: list[str] | None = None
+
+    def blank(number: int) -> bool:
+        nonlocal lines
+        lines = lines if lines is not None else text.split("\n")
+        return 0 < number <= len(lines) and not lines[number - 1].strip()
+
+    for declaration in declarations:
+        members: list[tuple[SourceLocation, Any]]  # where a member is, and what holds its comments
+        if isinstance(declaration, Robot):
+            keys = robot_member_keys(declaration)
+            located = zip(keys, _member_locations(declaration), strict=True)
+            members = [(location, key) for key, location in located if location is not None]
+        elif isinstance(declaration, StructType):
+            members = [(f.location, f) for f in declaration.fields if f.location is not None]
+        else:
+            continue
+        members.sort(key=lambda member: (member[0].line, member[0].column))
+        for (previous, _), (location, holder) in pairwise(members):
+            gap = previous.end_line + 1  # the line after the previous member
+            if gap < location.line and blank(gap):
+                said = (
+                    holder.comments
+                    if isinstance(holder, Field)
+                    else declaration.member_comments.setdefault(holder, Comments())
+                )
+                if said.leading[:1] != [""]:
+                    said.leading.insert(0, "")
+        closing = declaration.comments.closing
+        if members and closing and closing[:1] != [""] and blank(members[-1][0].end_line + 1):
+            closing.insert(0, "")
+
+
 def attach_comments(declarations: list[Any], comments: list[Token], path: str, text: str | None = None) -> list[str]:
     """Give each comment to the element it sits above, or ends the line of; return those after the last.
 
@@ -384,6 +448,7 @@ def attach_comments(declarations: list[Any], comments: list[Token], path: str, t
     # the elements written as a block, outermost first: a comment after the last line of a block's
     # body (`// TODO: a way out of fault` before an fsm's `}`) stays in that block
     blocks: list[Any] = [e for e in statements if isinstance(e, _BLOCKS)]  # each has a location (_statements)
+    closes = _closing_braces(statements, blocks, text.split("\n")) if text is not None else {}
     blocks = sorted(
         (e for e in blocks if e.location.end_line > e.location.line),
         key=lambda e: (e.location.line, -e.location.end_line),
@@ -404,6 +469,13 @@ def attach_comments(declarations: list[Any], comments: list[Token], path: str, t
     for comment in comments:
         said = str(comment)
         line = comment.line or 1
+        closed = closes.get(line)
+        if closed is not None and (comment.column or 1) >= closed.location.end_column:
+            # after a `}` (and nothing after it but the comment): about the block it closes, however that block
+            # was laid out (`r/r { a/a }  // c` as `}  // c` of a robot written over lines)
+            after = closed.comments.after
+            closed.comments.after = said if after is None else f"{after.rstrip()}  {said}"
+            continue
         owner = by_line.get(line)
         if owner is not None and (comment.column or 1) > owner.location.column:
             owner.comments.trailing = said

@@ -36,8 +36,9 @@ def location_field() -> SourceLocation | None:
 class Comments:
     """Comments a person wrote around an element, kept so `earl fmt` never drops them.
 
-    `leading` are the whole-line comments just above the element, `trailing` the
-    comment at the end of its first line.  They are not part of the model's meaning.
+    `leading` are the whole-line comments just above the element ("" where a blank line parted them,
+    and first where a blank line parted a robot's member or a struct's field from the one before),
+    `trailing` the comment at the end of its first line.  They are not part of the model's meaning.
     """
 
     leading: list[str] = field(default_factory=list)
@@ -45,6 +46,9 @@ class Comments:
     #: Comments after the last element of a file (kept on the System), or of a block's body, before its
     #: `}` (an agent, subsystem, basic behaviour, FSM, struct or robot); "" keeps a blank line between two.
     closing: list[str] = field(default_factory=list)
+    #: The comment after a block's `}` on its line (`}  // end of the arm`), kept after it; a block written
+    #: on one line (`r/r { a/a }  // c`) keeps it there too, so where it goes never depends on the layout.
+    after: str | None = None
 
 
 def comments_field() -> Comments:
