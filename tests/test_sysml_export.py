@@ -661,6 +661,59 @@ def test_comments_at_a_robot_s_members_are_in_the_robot_s_doc() -> None:
     assert all(said in robot.group(1) for said in ("the arm", "trailing", "the feed"))
 
 
+_OWN_SUFFIXES = """system s
+
+x/a {
+    cs {
+        period 1 ms
+        param period_2: int = 1
+        param period: int = 2
+        f/pp = true
+        b/bb {
+            tf = {}
+            tc = f/pp
+        }
+        fsm {
+            initial start
+            state start: b/bb
+            state start_2: b/bb
+            state done_2: b/bb
+            state done: b/bb
+
+            start -> start_2 when f/pp
+            start_2 -> done when f/pp
+        }
+    }
+}
+
+r/r {
+    x/a
+}
+"""
+
+
+def test_a_name_a_person_wrote_is_never_renamed_to_make_room_for_a_generated_one() -> None:
+    """A state `start` (a name every state body inherits) was exported as `start_2`, and the person's own
+    `start_2` then became `start_2_2`: only the clashing name gets a suffix, one that no name of the spec has."""
+    exported = export_sysml(earl.loads(_OWN_SUFFIXES, "own.earl"))
+    states = re.findall(r"state (\w+) : EARL::FSMState", exported)
+    assert states == ["start_3", "start_2", "done_2", "done_3"]
+    assert "entry; then start_3;" in exported
+    assert re.search(r"first start_3\s+if f_pp\s+then start_2 \{", exported)
+    assert re.search(r"first start_2\s+if f_pp\s+then done_3 \{", exported)
+    # a parameter named as the library's `period` feature, beside one named `period_2`
+    assert "attribute period_2 : EARL::int = 1" in exported and "attribute period_3 : EARL::int = 2" in exported
+    assert not syntax_errors(exported)
+
+
+def test_a_suffix_skips_the_names_to_come() -> None:
+    namespace = Namespace(("start",), users=("start_2", "start_3"))
+    assert namespace.claim("start") == "start_4"
+    assert namespace.claim("start_2") == "start_2"
+    assert namespace.claim("start_3") == "start_3"
+    assert namespace.claim("start_2") == "start_2_2"  # a name written twice still gets one
+
+
 def test_states_named_start_or_done_do_not_hide_what_every_state_body_inherits() -> None:
     """A state body has the features `start` and `done` (an action's first and last snapshots): a state named
     `start` hid one, and `entry; then start;` could be read as the library's."""

@@ -295,7 +295,7 @@ class _Writer:
 
     # ------------------------------------------------------------------ data types (§2.2, Figures 9 and 11)
     def types(self) -> None:
-        namespace = Namespace((self.system.name,))
+        namespace = Namespace((self.system.name,), (definition.name for definition in self.system.types))
         for definition in self.system.types:
             self.type_names[definition.name] = namespace.claim(definition.name)
         for definition in self.system.types:
@@ -363,8 +363,8 @@ class _Writer:
 
     # ------------------------------------------------------------------ the system (§2.1, Figure 2)
     def system_part(self) -> None:
-        namespace = Namespace(_SYSTEM_FEATURES)
         system = self.system
+        namespace = Namespace(_SYSTEM_FEATURES, (p.name for p in system.parameters))
         with self.block(f"part {name_text(system.name)} : EARL::System"):
             self.element_doc(system.location)
             self.parameter_list(system.parameters, namespace)
@@ -420,7 +420,7 @@ class _Writer:
         short = "" if own == earl_name else f"<{quoted(earl_name)}> "
         with self.block(f"part {short}{name_text(own)} : EARL::Agent :> agents"):
             self.element_doc(agent.location, *self.member_note(agent.family is not None, agent.index))
-            namespace = Namespace(_AGENT_FEATURES)
+            namespace = Namespace(_AGENT_FEATURES, (p.name for p in agent.parameters))
             self.parameter_list(agent.parameters, namespace)
             row = self.context.agent_type(agent)
             self.emit(f"attribute :>> agentType = EARL::AgentType::{row.name}; // Table 1: {row.description}")
@@ -466,7 +466,7 @@ class _Writer:
             header = f"part {named.declaration} : EARL::{definition} :> {subsystem.kind.value}"
         with self.block(header):
             self.element_doc(subsystem.location, *self.member_note(subsystem.family is not None, subsystem.index))
-            namespace = Namespace(_SUBSYSTEM_FEATURES)
+            namespace = Namespace(_SUBSYSTEM_FEATURES, (p.name for p in subsystem.parameters))
             names = _SubsystemNames()
             if subsystem.period is not None:
                 self.emit(
@@ -637,7 +637,7 @@ class _Writer:
             self.element_doc(fsm.location)
             # a state body inherits the features `start` and `done` (Actions::Action's first and last snapshots):
             # a state named so would hide them, and `entry; then start;` would be read against the library's
-            namespace = Namespace(("start", "done"))
+            namespace = Namespace(("start", "done"), (state.name for state in fsm.states))
             states = {state.name: namespace.claim(state.name) for state in fsm.states}
             initial = states.get(fsm.initial, fsm.initial)
             self.emit(f"entry; then {name_text(initial)};")

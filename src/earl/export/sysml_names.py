@@ -10,6 +10,7 @@ short name (`<'manip/a'>`), so a person can search the export for what they wrot
 from __future__ import annotations
 
 import re
+from collections.abc import Iterable
 
 #: Reserved words of the SysML v2 and KerML textual notations (SysML v2 and KerML 1.0, clause 8.2):
 #: a name equal to one of them must be quoted.  KerML's are included because parsers built
@@ -223,12 +224,16 @@ class Namespace:
     """The names already given in one SysML namespace; a clash gets `_2`, `_3`, … appended.
 
     `reserved` holds the names a namespace inherits from the EARL library (`ib`, `period`),
-    so that an element of the specification never hides one of them by accident.
+    so that an element of the specification never hides one of them by accident. `users` holds the
+    names a person wrote that will be claimed here as they are (states, parameters, types): a suffixed
+    name is never one of them, so a state `start` (the library's) becomes `start_3` beside a state
+    `start_2`, which keeps its name, whichever is claimed first.
     """
 
-    def __init__(self, reserved: tuple[str, ...] = ()) -> None:
+    def __init__(self, reserved: tuple[str, ...] = (), users: Iterable[str] = ()) -> None:
         self._taken: set[str] = set(reserved)
         self._short: set[str] = set()
+        self._users: frozenset[str] = frozenset(users)
 
     def taken(self, name: str) -> bool:
         """Whether `name` is given already here, as a name or a short name, or inherited from the library."""
@@ -245,7 +250,7 @@ class Namespace:
     def claim(self, preferred: str) -> str:
         name = preferred
         counter = 2
-        while name in self._taken:
+        while name in self._taken or (name != preferred and name in self._users):
             name = f"{preferred}_{counter}"
             counter += 1
         self._taken.add(name)
