@@ -547,6 +547,31 @@ def test_a_spec_whose_names_are_keywords_as_read_is_not_printed_again_to_see_tha
     assert not [d for d in check(system) if d.code == "EARL-R006"]
 
 
+@pytest.mark.parametrize(("where", "name"), [("memory", "period"), ("agent", "link")])
+def test_an_element_read_from_text_and_renamed_to_a_keyword_in_python_is_said_and_refused(
+    where: str, name: str
+) -> None:
+    """A name with a location was taken as read, so a loaded memory renamed `period` in Python passed check and
+    `to_earl()` wrote `period/m: …`, which does not read back; it is asked as a new name is, and a name as read
+    (`false/pp`, a state called `state`) is still not."""
+    from earl.model.validate import ModelNameError
+
+    system = earl.load(Path(__file__).parent.parent / "examples" / "pick_and_place")
+    manip = system.agents[1]
+    element: Any = manip.subsystems[0].memories[0] if where == "memory" else manip
+    assert element.location is not None
+    element.name = name
+    [said] = [d for d in check(system) if d.code == "EARL-R006"]
+    assert said.message.startswith(f"`{name}` is a keyword of EARL where it is declared")
+    assert said.location == element.location
+    with pytest.raises(ModelNameError, match=f"'{name}'.* is a keyword of EARL where it stands"):
+        system.to_earl()
+    system = earl.load(Path(__file__).parent.parent / "examples" / "pick_and_place")
+    system.agents[1].subsystems[0].fsm.states[1].name = "state"  # `state state: …` reads back
+    assert not [d for d in check(system) if d.code == "EARL-R006"]
+    assert "state state: jointMove/bb" in system.to_earl()
+
+
 def test_a_tuple_where_the_model_declares_a_list_is_drawn_and_exported() -> None:
     """`system.agents = tuple(…)` checked, printed and ran, but drawing and the SysML export refused it
     (expected a list, got tuple) once they checked the model's types first."""

@@ -204,7 +204,8 @@ def merge(root: ParsedFile, imported: list[ParsedFile], sources: SourceMap, libr
             ],
             sources,
         )
-    system = System(root.system_name or "", location=root.system_location)
+    # the text read, from the start: the resolver compares a name with what was written at its location
+    system = System(root.system_name or "", location=root.system_location, sources=sources)
     system.comments.leading = list(root.header_comments)
     system.comments.closing = list(root.closing_comments)
     for parsed in [*imported, root]:

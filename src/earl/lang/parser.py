@@ -106,11 +106,18 @@ def _element_parser() -> _ElementParser:
 def keyword_terminals() -> dict[str, str]:
     """Terminal name → keyword text, for messages and did-you-mean hints."""
     result: dict[str, str] = {}
-    for terminal in _parser().terminals:
+    # the reader's own parser has the grammar's terminals: no second parser is made for them
+    for terminal in _element_parser().lark.terminals:
         pattern = terminal.pattern
         if pattern.type == "str" and pattern.value.isidentifier():
             result[terminal.name] = pattern.value
     return result
+
+
+@lru_cache(maxsize=1)
+def keywords() -> frozenset[str]:
+    """Every keyword of the grammar (`state`, `period`, `false`, …)."""
+    return frozenset(keyword_terminals().values())
 
 
 def too_large(path: str, size: int | None) -> Diagnostic:
@@ -349,15 +356,19 @@ def _member_locations(robot: Robot) -> list[SourceLocation | None]:
 _BLOCKS: tuple[type, ...] = (StructType, Robot, Agent, Subsystem, BasicBehaviour, FSM, State)
 
 
-def _closing_braces(statements: list[Any], blocks: list[Any], lines: list[str]) -> dict[int, Any]:
-    """By line: the block whose `}` is the last thing on that line before any comment (the outermost of
+def _closing_braces(statements: list[Any], blocks: list[Any], comments: list[Token], text: str) -> dict[int, Any]:
+    """By line: the block whose `}` is the last thing on that line before its comment (the outermost of
     those closed there); a line where another element starts after that `}` has none."""
+    commented = {comment.line: comment for comment in comments}  # a `//` comment runs to the line's end
     closes: dict[int, Any] = {}
     for block in blocks:
         location = block.location
         end = location.end_line
-        text = lines[end - 1] if 0 < end <= len(lines) else ""
-        if text[location.end_column - 2 : location.end_column - 1] != "}":
+        comment = commented.get(end)
+        if comment is None or comment.start_pos is None:
+            continue
+        line_start = text.rfind("\n", 0, comment.start_pos) + 1
+        if text[line_start + location.end_column - 2 : line_start + location.end_column - 1] != "}":
             continue  # a state without a body ends at its behaviour's name
         if location.line == end and (isinstance(block, State) or (isinstance(block, StructType) and not block.fields)):
             continue  # written on one line by `earl fmt` too: its end-of-line comment is the line's own
@@ -448,7 +459,7 @@ def attach_comments(declarations: list[Any], comments: list[Token], path: str, t
     # the elements written as a block, outermost first: a comment after the last line of a block's
     # body (`// TODO: a way out of fault` before an fsm's `}`) stays in that block
     blocks: list[Any] = [e for e in statements if isinstance(e, _BLOCKS)]  # each has a location (_statements)
-    closes = _closing_braces(statements, blocks, text.split("\n")) if text is not None else {}
+    closes = _closing_braces(statements, blocks, comments, text) if text is not None else {}
     blocks = sorted(
         (e for e in blocks if e.location.end_line > e.location.line),
         key=lambda e: (e.location.line, -e.location.end_line),

@@ -14,7 +14,7 @@ from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
 
-from earl.diagnostics import Diagnostic, Severity, did_you_mean
+from earl.diagnostics import Diagnostic, Severity, SourceMap, did_you_mean
 from earl.model.elements import (
     FSM,
     Agent,
@@ -1541,7 +1541,7 @@ def unreadable_names(system: System) -> list[tuple[object, str, SourceLocation |
     `state/a`). Whether a keyword is one depends on where it is written (`python/m` and `initial/m`
     read back; `period/m` does not), so a system naming something as a keyword is printed and parsed:
     the names a syntax error's line holds are the unreadable ones. Costs nothing without such names."""
-    from earl.lang.parser import keyword_terminals  # the grammar's keywords; imported on need only
+    from earl.lang.parser import keywords  # the grammar's keywords; imported on need only
 
     declared = list(_declared_names(system))
     if system.name == "":
@@ -1549,14 +1549,15 @@ def unreadable_names(system: System) -> list[tuple[object, str, SourceLocation |
     found = [entry for entry in declared if not (isinstance(entry[0], str) and is_earl_name(entry[0]))]
     if found:
         return found  # the text would not read back for these alone; keywords are asked once they are gone
-    # a name read from text (it has a location) was read, so it reads back: a loaded spec is not printed
-    # and read again for its `false/pp`, as the manual names that predicate (nor is the grammar's table
-    # of keywords made for it, a second parser)
-    unread = [entry for entry in declared if entry[2] is None]
-    if not unread:
-        return []
-    keywords = set(keyword_terminals().values())
-    suspects = [entry for entry in unread if entry[0] in keywords]
+    # a name as it was read from text reads back: a loaded spec is not printed and read again for its
+    # `false/pp`, as the manual names that predicate. One given since, in Python, to an element read from
+    # text (which keeps its location) is not the name written there, and is asked as a new one is.
+    grammar = keywords()
+    suspects = [
+        entry
+        for entry in declared
+        if entry[0] in grammar and (entry[2] is None or _written_at(system.sources, entry[2]) != entry[0])
+    ]
     if not suspects:
         return []
     from earl.diagnostics import EarlError
@@ -1584,6 +1585,21 @@ def unreadable_names(system: System) -> list[tuple[object, str, SourceLocation |
         near = "\n".join(line for line in lines[at : at + 4] if line.strip())
         return [entry for entry in suspects if re.search(rf"(?<![\w]){entry[0]}(?![\w])", near)][:1]
     return []
+
+
+#: a declared name where its element's location starts: after `param`, `type`, `struct` or `state` when the
+#: declaration starts with one (a field named `state` is `state: …`, with no name after the word)
+_WRITTEN_NAME = re.compile(r"(?:(?:param|type|struct|state)\s+)?([A-Za-z_][A-Za-z0-9_]*)")
+
+
+def _written_at(sources: object, location: SourceLocation) -> str | None:
+    """The name written where `location` starts, in the text the system was read from; None when that text
+    is not at hand (a location copied from another system)."""
+    line = sources.line(location.file, location.line) if isinstance(sources, SourceMap) else None
+    if line is None:
+        return None
+    match = _WRITTEN_NAME.match(line, location.column - 1)
+    return match.group(1) if match is not None else None
 
 
 def is_earl_name(text: str) -> bool:
