@@ -375,7 +375,7 @@ def test_a_view_with_nothing_in_it_still_draws_its_frame_and_says_so() -> None:
 
 
 def test_a_family_member_outside_the_range_is_no_target(system: System) -> None:
-    assert build_diagram(system, "fsm", "manip/a.motorController[6]/ve").header.endswith("motorController[K]/ve.fsm")
+    assert build_diagram(system, "fsm", "manip/a.motorController[6]/ve").header.endswith("motorController[6]/ve.fsm")
     for outside in ("7", "0", "-1"):
         with pytest.raises(TargetError, match="no subsystem"):
             build_diagram(system, "fsm", f"manip/a.motorController[{outside}]/ve")
@@ -392,6 +392,31 @@ def test_the_fsm_view_shows_what_each_state_waits_for_and_how_long(system: Syste
     diagram, and the document that shows it, say it under the state's behaviour."""
     drawn = svg_text(build_diagram(system, "fsm", "manip/a.cs").svg())
     assert "obligatory motorControllerState[*]/ib;" in drawn and "timeout 4 ms" in drawn
+
+
+def test_a_family_member_named_without_expand_is_drawn_alone(system: System, tmp_path: Path) -> None:
+    """`--target 'manip/a.motorController[2]/ve'` without --expand drew the whole family, headed
+    `motorController[K]/ve`, saying nothing of the member asked for: the member is drawn, as --expand draws
+    it; the family is still what its name, `[K]` or `[*]` names."""
+    for target in ("manip/a.motorController[2]/ve", "manip/a.motorController[N]/ve"):
+        number = "2" if "[2]" in target else "6"
+        drawn = build_diagram(system, "fsm", target)
+        assert drawn.header == f"stm [FSM] manip/a.motorController[{number}]/ve.fsm"
+        assert drawn.dot == build_diagram(system, "fsm", target, expand=True).dot
+        assert f"title: stm [FSM] manip/a.motorController[{number}]/ve.fsm" in mermaid_of(
+            Subject(system), "fsm", target
+        )
+    behaviour = build_diagram(system, "activity", "manip/a.motorController[3]/ve.start/bb")
+    assert behaviour.header.startswith("act [Operation] manip/a.motorController[3]/ve.start/bb")
+    for family in ("manip/a.motorController/ve", "manip/a.motorController[K]/ve", "manip/a.motorController[*]/ve"):
+        assert build_diagram(system, "fsm", family).header.endswith("motorController[K]/ve.fsm")
+    agents = earl.loads(SPLIT_FAMILY, "robots.earl")
+    assert build_diagram(agents, "agent", "worker[2]/a").header.endswith("worker[2]/a")
+    assert build_diagram(agents, "agent", "worker[K]/a").header.endswith("worker[K]/a")
+    output = tmp_path / "member.dot"
+    arguments = ["--view", "fsm", "--target", "manip/a.motorController[2]/ve", "-o", str(output)]
+    assert main(["diagram", str(EXAMPLE), *arguments]) == 0
+    assert "manip/a.motorController[2]/ve.fsm" in output.read_text(encoding="utf-8")
 
 
 SPLIT_FAMILY = """\

@@ -51,7 +51,8 @@ def register(commands: Any) -> None:
         help="draw one of the manual's SysML diagrams of a specification (Graphviz or Mermaid)",
         description="Draw a SysML-style diagram of SPEC as the EARL manual draws it by hand: SVG or PNG through "
         "Graphviz's `dot`, the DOT text itself, or Mermaid text (system and fsm views). Indexed families are drawn "
-        "once with their index (motorController[K]/ve, K ∈ 1..N) unless --expand is given. Reading a spec never "
+        "once with their index (motorController[K]/ve, K ∈ 1..N) unless --expand is given; a --target naming one "
+        "member (motorController[2]/ve) draws that member. Reading a spec never "
         "runs code it names.",
         epilog=EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
@@ -62,7 +63,8 @@ def register(commands: Any) -> None:
         "--target",
         metavar="ELEMENT",
         help="what to draw, in the manual's dot notation: an agent (manip/a) for agent and types, a subsystem "
-        "(manip/a.cs) for fsm, a basic behaviour (manip/a.cs.jointMove/bb) for activity",
+        "(manip/a.cs) for fsm, a basic behaviour (manip/a.cs.jointMove/bb) for activity; a family by its name "
+        "(motorController[K]/ve), one member by its number (motorController[2]/ve)",
     )
     parser.add_argument("-o", "--output", metavar="FILE", help="write here (.svg, .png, .dot, .mmd); default: stdout")
     parser.add_argument("--format", choices=FORMATS, help="output format; default: from the output's suffix, else svg")

@@ -20,7 +20,15 @@ from earl.model.tables import AgentType
 from earl.model.validate import refuse_wrong_types
 from earl.render.diagram import Diagram
 from earl.render.names import agent_name, qualified_subsystem_name
-from earl.render.targets import TargetError, all_subsystems, find_agent, find_behaviour, find_subsystem, only_fsm
+from earl.render.targets import (
+    TargetError,
+    all_subsystems,
+    find_agent,
+    find_behaviour,
+    find_subsystem,
+    names_a_member,
+    only_fsm,
+)
 from earl.render.views.activity import activity_view
 from earl.render.views.agent import agent_view
 from earl.render.views.fsm import fsm_view
@@ -55,6 +63,14 @@ class Subject:
     def shown(self) -> System:
         return self.context.system if self.expand else self.declared
 
+    def drawn(self, view: str, target: str | None) -> System:
+        """What the view of `target` is drawn from: `shown`, or the expansion when the target names one
+        member of a family drawn once (`motorController[2]/ve`), which is then drawn alone, as --expand draws
+        it, not as its family."""
+        if not self.expand and target is not None and names_a_member(self.declared, view, target):
+            return self.context.system
+        return self.shown
+
     @cached_property
     def placements(self) -> dict[int, Placement]:
         """By the shown agent's `id`: the robots that hold it, and which members of a family each holds."""
@@ -85,7 +101,7 @@ def build_diagram(
 
 
 def diagram_of(subject: Subject, view: str, target: str | None) -> Diagram:
-    system = subject.shown
+    system = subject.drawn(view, target)
     if view == "system":
         if target is not None:
             raise TargetError("the system view shows the whole system; leave out --target")

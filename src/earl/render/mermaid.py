@@ -124,7 +124,7 @@ def mermaid_of(subject: Subject, view: str, target: str | None) -> str:
             raise TargetError("the system view shows the whole system; leave out --target")
         return system_mermaid(subject)
     if view == "fsm":
-        system = subject.shown
+        system = subject.drawn(view, target)
         agent, subsystem = find_subsystem(system, target) if target is not None else only_fsm(system)
         if subsystem.fsm is None:
             raise TargetError(f"{qualified_subsystem_name(agent, subsystem)} has no FSM to draw")

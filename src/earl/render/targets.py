@@ -6,8 +6,8 @@ subsystem (`manip/a.cs`, `manip/a.motorController/ve`), or a Basic Behaviour
 A family is named without an index, with its index variable
 (`motorController[K]/ve`) or with `[*]`; with `--expand`, a member is named by its number
 (`motorController[3]/ve`) or a parameter whose value it is (`motorController[N]/ve`).
-Without `--expand` a member's number (or such a parameter) names the family it belongs to,
-which is what is drawn.
+Without `--expand` a member's number (or such a parameter) names the family it belongs to;
+`names_a_member` says so, and the view then draws that member alone, from the expansion.
 """
 
 from __future__ import annotations
@@ -170,3 +170,31 @@ def find_behaviour(system: System, text: str) -> tuple[Agent, Subsystem, BasicBe
 
 def _index(segment: Segment) -> str:
     return "" if segment.index is None else f"[{segment.index}]"
+
+
+def names_a_member(system: System, view: str, text: str) -> bool:
+    """Whether `text` names one member of a family the declared `system` draws once (`motorController[2]/ve`,
+    `worker[N]/a`), rather than the family (`[K]`, `[*]`, no index) or an element declared alone."""
+    try:
+        segments = _segments(text)
+        if view in ("agent", "types"):
+            agent = find_agent(system, text)
+            return _is_member(segments[0], agent.family)
+        if view == "fsm":
+            agent, subsystem = find_subsystem(system, text)
+        elif view == "activity":
+            agent, subsystem, _ = find_behaviour(system, text)
+        else:
+            return False
+    except TargetError:
+        return False  # said when the view looks for it
+    return _is_member(segments[0], agent.family) or (
+        len(segments) > 1 and subsystem.kind.value != "cs" and _is_member(segments[1], subsystem.family)
+    )
+
+
+def _is_member(segment: Segment, family: Family | None) -> bool:
+    """A segment that matched `family` names one member unless it names the family itself."""
+    if family is None or segment.index is None:
+        return False
+    return segment.index.strip() not in (family.index, "*")
