@@ -860,22 +860,40 @@ def _wide_terminal(monkeypatch: pytest.MonkeyPatch) -> None:
         ("seed = true", "`seed` is a whole number >= 0"),
         ("duration = -3", "`duration` is a duration such as"),
         ('duration = "soon"', "`soon` is not a duration"),
-        ("environment = 5", '`environment` is a "module:function" string'),
-        ('record_memory = "counter/a.cs"', "`record_memory` is a list of strings"),
-        ("colour = 1", "unknown setting `colour`"),
+        ("environment = 5", '`environment` is a "module:function" string, not 5'),
+        ('environment = ["counting.cs:increment"]', '`environment` is a "module:function" string, not ["counting'),
+        ('record_memory = "counter/a.cs"', '`record_memory` is a list of strings, e.g. ["manip/a.cs"], not "counter'),
+        ('plot = ""', '`plot` is a list of strings, e.g. ["manip/a.cs.count"], not ""'),
+        ("colour = 1", "unknown setting `colour` (known: duration, environment, plot, record_links, record_memory"),
+        ('Duration = "1s"', "unknown setting `Duration`; did you mean `duration`? (known: "),
+        ("[plot]", '`plot` is a list of strings, e.g. ["manip/a.cs.count"], not a table'),
+        ('seed = "x"', '`seed` is a whole number >= 0, not "x"'),
+        ("duration = true", '`duration` is a duration such as "13s" or a positive number of seconds, not true'),
+        ('duration = ""', "`duration`: the duration is empty; write e.g. `10s`"),
+        ('environment = ""', '`environment` names no environment: name one as "MODULE:FACTORY", or "none" for none'),
+        ('report = " "', '`report` names no function: name one as "MODULE:FUNCTION", or leave `report` out'),
+        ('plot = [""]', '`plot` has an empty string in [""]: each names a signal, e.g. ["manip/a.cs.count"]'),
+        ('record_links = ["counter/a:*", ""]', '`record_links` has an empty string in ["counter/a:*", ""]: each'),
+        ('record_memory = [""]', '`record_memory` has an empty string in [""]: each names a subsystem'),
+        ("seed =", "3:7: not valid TOML: Invalid value"),
     ],
 )
 def test_a_run_toml_setting_of_the_wrong_kind_is_a_usage_error(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], setting: str, fragment: str
 ) -> None:
+    """One line naming the file, the line and the key, what is expected and what is written (as TOML
+    writes it: `true`, `"x"`). `environment = ""` was EARL-X001 (exit 1) and `report = ""` was ignored;
+    an empty string in a list named no subsystem (or matched no link, recording none); the message
+    named neither the line nor the file as the spec names it; `true` was shown as `True`."""
     from earl.cli.main import main
 
     spec = counter_copy(tmp_path)
-    (spec.parent / "run.toml").write_text(setting + "\n")
+    (spec.parent / "run.toml").write_text("# the counter's defaults\n\n" + setting + "\n")
     assert main(["run", str(spec), "--duration", "10ms", "--no-progress"]) == 2
     error = capsys.readouterr().err
-    assert "run.toml" in error and fragment in error
-    assert "Traceback" not in error
+    where = f"{spec.parent / 'run.toml'}:3"
+    assert error.startswith(f"earl: error: {where}") and len(error.splitlines()) == 1, error
+    assert fragment in error, error
 
 
 def test_run_toml_is_read_next_to_the_spec_a_symbolic_link_points_to(

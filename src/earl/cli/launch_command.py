@@ -91,7 +91,7 @@ def register(commands: Any) -> None:
 
 
 def run(arguments: argparse.Namespace) -> int:
-    from earl.runtime.simulation import read_run_settings
+    from earl.runtime.run_settings import read_run_settings
     from earl.transport.deployment import DeploymentError, read_deployment
     from earl.transport.process import DEPLOYMENT_FILE
 

@@ -37,7 +37,7 @@ from earl.transport.deployment import DeploymentError
 
 if TYPE_CHECKING:
     from earl.lang.loader import ParameterValue
-    from earl.runtime.simulation import RunSettings
+    from earl.runtime.run_settings import RunSettings
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 
@@ -66,7 +66,8 @@ exit codes: 0 the run completed (or the spec's code called sys.exit(0)), 1 inval
             or run.toml's report asked for failed at the end (the run and its trace are
             whole); with --transport zenoh also when a link's messages were refused for
             another data type (the run goes on, and names the links at its end),
-            2 usage error, 130 interrupted (the trace is closed and readable)
+            2 usage error (an option, or a run.toml that cannot be used), 130
+            interrupted (the trace is closed and readable)
 """
 
 
@@ -349,7 +350,7 @@ def check_options(arguments: argparse.Namespace) -> CheckedOptions:
     anything runs, by `earl run` and by `earl launch` for each process's `args`. Fills in what follows from
     them: --signal from run.toml's `plot`, --trace from --plot, --realtime with --transport zenoh."""
     from earl.runtime.durations import parse_duration
-    from earl.runtime.simulation import read_run_settings
+    from earl.runtime.run_settings import read_run_settings
 
     path = spec_path(arguments.spec)
     parameters = parse_parameters(arguments.param)

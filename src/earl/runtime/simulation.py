@@ -16,9 +16,8 @@ import contextlib
 import inspect
 import math
 import numbers
-import tomllib
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -32,6 +31,7 @@ from earl.runtime.binding import BindingProblem, resolve_callable, user_code_pat
 from earl.runtime.builder import NANOSECONDS, Network, RemoteLinks, build_network, to_nanoseconds
 from earl.runtime.engine import exception_text
 from earl.runtime.events import Fault, Recorder, Recorders, StatisticsRecorder
+from earl.runtime.run_settings import RunSettings, read_run_settings
 from earl.runtime.scheduler import Inbox, Scheduler
 from earl.runtime.trace import TraceWriter
 from earl.runtime.values import shown_value
@@ -599,111 +599,3 @@ def bind_report(report: str, spec: Path, settings: RunSettings) -> Callable[[Sim
             )
         except BindingProblem as problem:
             raise EarlError([problem.diagnostic], settings.sources()) from None
-
-
-@dataclass
-class RunSettings:
-    """Defaults for `earl run` read from a `run.toml` next to the spec (command-line options win)."""
-
-    environment: str | None = None
-    duration: float | None = None
-    seed: int | None = None
-    record_memory: list[str] | None = None
-    report: str | None = None
-    plot: list[str] | None = None
-    record_links: list[str] | None = None
-    #: the file as a diagnostic names it, its text and the line of each key: a wrong `report` or
-    #: `environment` is said at its line, as a wrong function is at the spec's
-    file: str = ""
-    text: str = ""
-    lines: dict[str, int] = field(default_factory=dict)
-
-    def location(self, key: str) -> SourceLocation | None:
-        """Where `key = …` is written in run.toml (None without a run.toml, or for a key it does not set)."""
-        line = self.lines.get(key)
-        if line is None:
-            return None
-        written = self.text.split("\n")[line - 1].rstrip("\r").rstrip()
-        # the value, after the `=` (the caret under what is wrong: a misspelt `module:function`)
-        equals = written.find("=")
-        start = equals + 1 + (len(written) - equals - 1 - len(written[equals + 1 :].lstrip())) if equals >= 0 else 0
-        if start >= len(written):
-            start = 0
-        return SourceLocation(self.file, line, start + 1, line, max(start + 1, len(written)))
-
-    def sources(self) -> SourceMap:
-        """run.toml's text, for a diagnostic to quote its line."""
-        sources = SourceMap()
-        if self.file:
-            sources.add(self.file, self.text)
-        return sources
-
-
-def _key_lines(text: str) -> dict[str, int]:
-    """The line each top-level key of a run.toml is set on (`report = "…"`, `"report" = "…"`)."""
-    import re
-
-    lines: dict[str, int] = {}
-    for number, line in enumerate(text.split("\n"), start=1):
-        if line.lstrip().startswith("["):
-            break  # a table: no setting of earl's is in one
-        found = re.match(r"""\s*(?:"([^"]*)"|'([^']*)'|([A-Za-z0-9_-]+))\s*=""", line)
-        if found:
-            lines.setdefault(next(group for group in found.groups() if group is not None), number)
-    return lines
-
-
-def read_run_settings(spec: Path) -> RunSettings:
-    path = spec.resolve().parent / "run.toml"  # next to the file itself, as its modules and imports
-    if not path.is_file():
-        return RunSettings()
-    # named as the spec is (`run.toml` beside `system.earl`), unless the spec is a link to another directory
-    beside = spec.parent / "run.toml"
-    shown = str(beside) if beside.resolve() == path else str(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-        data = tomllib.loads(text)
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as error:
-        raise ValueError(f"{path}: not valid TOML: {error}") from None
-    known = {"environment", "duration", "seed", "record_memory", "record_links", "report", "plot"}
-    unknown = sorted(set(data) - known)
-    if unknown:
-        raise ValueError(f"{path}: unknown setting `{unknown[0]}` (known: {', '.join(sorted(known))})")
-
-    def refuse(key: str, wanted: str) -> ValueError:
-        return ValueError(f"{path}: `{key}` is {wanted}, not {data[key]!r}")
-
-    duration = data.get("duration")
-    if duration is not None:
-        wanted = 'a duration such as "13s" or a positive number of seconds'
-        if isinstance(duration, bool) or not isinstance(duration, str | int | float):
-            raise refuse("duration", wanted)
-        from earl.runtime.durations import parse_duration
-
-        try:  # a number is seconds, as a bare number on the command line is: one set of rules for both
-            duration = parse_duration(str(duration))
-        except ValueError as error:
-            if not isinstance(duration, str):
-                raise refuse("duration", wanted) from None
-            raise ValueError(f"{path}: `duration`: {error}") from None
-    seed = data.get("seed")
-    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int) or seed < 0):
-        raise refuse("seed", "a whole number >= 0")
-    for key in ("environment", "report"):
-        if key in data and not isinstance(data[key], str):
-            raise refuse(key, 'a "module:function" string')
-    for key in ("record_memory", "plot", "record_links"):
-        if key in data and not (isinstance(data[key], list) and all(isinstance(item, str) for item in data[key])):
-            raise refuse(key, 'a list of strings, e.g. ["manip/a.cs"]')
-    return RunSettings(
-        environment=data.get("environment"),
-        duration=duration,
-        seed=seed,
-        record_memory=data.get("record_memory"),
-        report=data.get("report"),
-        plot=data.get("plot"),
-        record_links=data.get("record_links"),
-        file=shown,
-        text=text,
-        lines=_key_lines(text),
-    )
