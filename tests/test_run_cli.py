@@ -1097,13 +1097,24 @@ ZENOH_PROCESS = ["--agents", "counter/a", "--transport", "zenoh"]
         (["run", str(SPECS / "pendulum"), "--environment", ""], "--environment names no environment: name one as"),
         (["run", str(SPECS / "counter"), *ZENOH_PROCESS, "--deployment", ""], "--deployment names no file"),
         (["run", str(SPECS / "counter"), *ZENOH_PROCESS, "--zenoh-config", " "], "--zenoh-config names no file"),
+        (["run", str(SPECS / "counter"), "--record-links", "", "--trace", "t.mcap"], "--record-links names no link"),
+        (
+            ["run", str(SPECS / "counter"), "--record-links", "*", "--record-links", " ", "--trace", "t.mcap"],
+            "--record-links names no",
+        ),
+        (
+            ["run", str(SPECS / "counter"), "--record-memory", "", "--trace", "t.mcap"],
+            "--record-memory names no subsystem",
+        ),
         (["launch", str(SPECS / "counter"), "--deployment", ""], "--deployment names no file: name one, e.g."),
         (["diagram", str(SPECS / "counter"), "--view", "fsm", "--target", ""], "--target names no element"),
     ],
 )
 def test_an_empty_option_is_not_taken_for_the_option_left_out(tmp_path: Path, command: list[str], said: str) -> None:
     """`--environment ""` ran run.toml's environment, `--deployment ""` read the deploy.toml beside the
-    spec (or said it was missing), `--target ""` was "`` is not a target: `` should look like …"."""
+    spec (or said it was missing), `--target ""` was "`` is not a target: `` should look like …",
+    `--record-links ""` said it matched no link and ran on, recording no link at all, `--record-memory ""`
+    was "names no subsystem of this run:  (subsystems are named like …)"."""
     result = earl_cli(*command, cwd=tmp_path)
     assert result.returncode == 2, result.stdout + result.stderr
     assert result.stderr.startswith(f"earl: error: {said}") and len(result.stderr.splitlines()) == 1, result.stderr

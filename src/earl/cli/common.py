@@ -33,14 +33,21 @@ def spec_path(text: str) -> Path:
     return path
 
 
+def named(text: str, option: str, example: str, what: str) -> str:
+    """What an option names, refused as a usage error when it names nothing: an empty value
+    (`--record-links ""`, `--record-links "$LINKS"` with LINKS unset) or one of spaces is a mistake,
+    not a name, and is said in the same words for every option."""
+    if not text.strip():
+        raise UsageError(f"{option} names no {what}: name one, e.g. {option} {example}")
+    return text
+
+
 def named_path(text: str, option: str, example: str, what: str = "file") -> Path:
     """The path an option names (an output, a file to read). An empty one (`-o ""`,
     `-o "$OUT"` with OUT unset) names nothing, as one of spaces does: Path("") is the current
     directory, which one command took for standard output and another for the place to write, so
     every command refuses it alike, as a usage error, before anything is read."""
-    if not text.strip():
-        raise UsageError(f"{option} names no {what}: name one, e.g. {option} {example}")
-    return Path(text)
+    return Path(named(text, option, example, what))
 
 
 def parse_parameter(text: str) -> tuple[str, ParameterValue]:

@@ -25,6 +25,7 @@ from earl.cli.common import (
     UsageError,
     brief,
     fault_kinds,
+    named,
     named_path,
     parse_parameters,
     spec_path,
@@ -366,6 +367,13 @@ def check_options(arguments: argparse.Namespace) -> CheckedOptions:
             named_path(given, option, example)
     if arguments.environment is not None and not arguments.environment.strip():  # was run.toml's, unsaid
         raise UsageError("--environment names no environment: name one as MODULE:FACTORY, or `none` for none")
+    # an empty pattern matched no link and the trace kept none; an empty subsystem was "names no subsystem: "
+    for option, given, example, what in (
+        ("--record-links", arguments.record_links, "'task,*'", "link pattern"),
+        ("--record-memory", arguments.record_memory, "manip/a.cs", "subsystem"),
+    ):
+        for text in given or []:
+            named(text, option, example, what)
     try:
         settings = read_run_settings(path)
     except ValueError as error:
