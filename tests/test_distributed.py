@@ -845,6 +845,8 @@ def test_a_process_that_fails_in_the_middle_of_its_run_leaves_the_others_running
         ('["--duration="]', "--duration: the duration is empty"),
         ('["--plot", "/nonexistent/dir/s.png", "--signal", "sender/a.cs.count"]', "--plot '/nonexistent/dir/s.png'"),
         ('["--wait-for-peers", "soon"]', "--wait-for-peers: `soon` is not a duration"),
+        ('["--signal", "sender/a.cs.count"]', "--signal needs --plot FILE.png"),  # a plot of nothing
+        ('["--record-links", ""]', "--record-links names no link pattern"),
         ('["--seed", "x"]', "argument --seed: `x` is not a whole number"),
         ('["--bogus"]', "unrecognized arguments: --bogus"),
         ('["--help"]', "it asks for help"),

@@ -573,12 +573,12 @@ def test_the_checker_runs_first_and_its_errors_stop_the_run(tmp_path: Path) -> N
             "the directory `/nonexistent/dir` does",
         ),
         (["--trace", "/nonexistent/dir/x.mcap"], "cannot write the trace /nonexistent/dir/x.mcap: the directory"),
-        (["--record-memory", "counter/a.nothing"], "names no subsystem"),
+        (["--record-memory", "counter/a.nothing", "--trace", "t.mcap"], "names no subsystem"),
         (["--param", "LIMIT"], "NAME=VALUE"),
     ],
 )
-def test_usage_errors_exit_2_with_one_line(arguments: list[str], fragment: str) -> None:
-    result = earl_cli("run", str(SPECS / "counter"), *arguments)
+def test_usage_errors_exit_2_with_one_line(tmp_path: Path, arguments: list[str], fragment: str) -> None:
+    result = earl_cli("run", str(SPECS / "counter"), *arguments, cwd=tmp_path)
     assert result.returncode == 2
     assert fragment in result.stderr
     assert "Traceback" not in result.stderr
@@ -1015,10 +1015,41 @@ def test_an_element_of_an_array_output_buffer_is_plotted_by_its_index(tmp_path: 
     assert wrong.returncode == 1 and "the trace has `v[0]`, `v[1]`" in wrong.stderr, wrong.stderr
 
 
-def test_options_that_would_record_nothing_are_said(tmp_path: Path) -> None:
-    result = earl_cli("run", str(SPECS / "counter"), "--duration", "20ms", "--record-memory", "all")
-    assert result.returncode == 0
-    assert "--record-memory choose what a trace records; without --trace nothing is recorded" in result.stderr
+@pytest.mark.parametrize(
+    ("options", "said"),
+    [
+        (["--signal", "counter/a.cs.count"], "--signal needs --plot FILE.png: it names what the plot draws"),
+        (["--record-memory", "all"], "--record-memory needs --trace FILE.mcap: it chooses what the trace records"),
+        (["--record-links", "*"], "--record-links needs --trace FILE.mcap: it chooses what the trace records"),
+        (
+            ["--record-memory", "all", "--record-links", "*"],
+            "--record-memory and --record-links need --trace FILE.mcap: they choose what the trace records",
+        ),
+    ],
+)
+def test_an_option_without_the_one_it_goes_with_is_a_usage_error(tmp_path: Path, options: list[str], said: str) -> None:
+    """`--signal` without `--plot` went nowhere without a word; `--record-*` without a trace recorded
+    nothing and ran on (exit 0), as `--wait-for-peers` without `--transport zenoh` is refused."""
+    result = earl_cli("run", str(SPECS / "counter"), "--duration", "20ms", *options, cwd=tmp_path)
+    assert result.returncode == 2, result.stdout + result.stderr
+    assert result.stderr.startswith(f"earl: error: {said}") and len(result.stderr.splitlines()) == 1, result.stderr
+    assert result.stdout == "" and list(tmp_path.iterdir()) == []  # refused before the run
+    # with what they go with, they are used: --plot writes the trace they choose from
+    plotted = earl_cli(
+        "run",
+        str(SPECS / "counter"),
+        "--duration",
+        "20ms",
+        *options,
+        *([] if "--signal" in options else ["--signal", "counter/a.cs.count"]),
+        "--plot",
+        str(tmp_path / "p.png"),
+    )
+    assert plotted.returncode == 0, plotted.stderr
+    assert (tmp_path / "p.png").is_file() and (tmp_path / "p.mcap").is_file()
+
+
+def test_a_record_links_pattern_that_matches_no_link_is_said(tmp_path: Path) -> None:
     traced = earl_cli(
         "run",
         str(SPECS / "counter"),

@@ -103,14 +103,16 @@ def register(commands: Any) -> None:
         action="append",
         default=None,
         metavar="SUBSYSTEM",
-        help="record memory snapshots of a subsystem after each iteration (repeatable; `all` for every one)",
+        help="with --trace (or --plot): record memory snapshots of a subsystem after each iteration "
+        "(repeatable; `all` for every one)",
     )
     parser.add_argument(
         "--record-links",
         action="append",
         default=None,
         metavar="PATTERN",
-        help="record only messages on links matching a glob, e.g. 'task,*' (repeatable; default: all)",
+        help="with --trace (or --plot): record only messages on links matching a glob, e.g. 'task,*' "
+        "(repeatable; default: all)",
     )
     parser.add_argument(
         "--plot",
@@ -122,7 +124,7 @@ def register(commands: Any) -> None:
         action="append",
         default=None,
         metavar="SIGNAL",
-        help="a signal for --plot, e.g. 'manip/a.cs.windingCurrent[*]' (repeatable; x[1] of a family is "
+        help="with --plot: a signal it draws, e.g. 'manip/a.cs.windingCurrent[*]' (repeatable; x[1] of a family is "
         "member 1, v[0] of an array its first element; see `earl plot --help`)",
     )
     parser.add_argument(
@@ -384,6 +386,8 @@ def check_options(arguments: argparse.Namespace) -> CheckedOptions:
     except ValueError as error:
         raise UsageError(f"--duration: {error}") from None
     from_command_line = arguments.signal is not None
+    if from_command_line and not arguments.plot:  # the signals went nowhere, without a word
+        raise UsageError("--signal needs --plot FILE.png: it names what the plot draws after the run")
     signals = arguments.signal if from_command_line else settings.plot
     if arguments.plot and not signals:
         raise UsageError("--plot needs signals: name them with --signal, or `plot = [...]` in run.toml")
@@ -402,6 +406,17 @@ def check_options(arguments: argparse.Namespace) -> CheckedOptions:
     arguments.signal = signals
     if arguments.plot and not arguments.trace:
         arguments.trace = str(Path(arguments.plot).with_suffix(".mcap"))
+    # as --signal without --plot: what they choose went nowhere (a line said so, and the run went on)
+    chosen = [
+        option
+        for option, given in (("--record-memory", arguments.record_memory), ("--record-links", arguments.record_links))
+        if given
+    ]
+    if arguments.trace is None and chosen:
+        need, choose = ("needs", "it chooses") if len(chosen) == 1 else ("need", "they choose")
+        raise UsageError(
+            f"{' and '.join(chosen)} {need} --trace FILE.mcap: {choose} what the trace records (--plot writes one too)"
+        )
     if arguments.plot and Path(arguments.plot).resolve() == Path(arguments.trace).resolve():
         raise UsageError(f"--trace and --plot both name {arguments.plot}: the plot would replace the trace")
     if arguments.trace is not None and not Path(arguments.trace).parent.is_dir():
@@ -437,15 +452,11 @@ def check_options(arguments: argparse.Namespace) -> CheckedOptions:
 def _say_what_is_not_recorded(
     arguments: argparse.Namespace, simulation: Any, record_links_of_run_toml: list[str] | None
 ) -> None:
-    """A line for options that would record nothing: no trace to record into, or a link pattern (of
-    --record-links, or else of run.toml's `record_links`) that matches no link of the system (a
-    misspelt glob would otherwise leave the trace quietly empty)."""
+    """A line for each link pattern (of --record-links, or else of run.toml's `record_links`) that
+    matches no link of the system: a misspelt glob would otherwise leave the trace quietly empty.
+    (--record-links without a trace to record into is refused by `check_options`.)"""
     from fnmatch import fnmatchcase
 
-    chosen = [name for name in ("record_memory", "record_links") if getattr(arguments, name) is not None]
-    if arguments.trace is None and chosen:
-        options = " and ".join(f"--{name.replace('_', '-')}" for name in chosen)
-        print(f"earl run: {options} choose what a trace records; without --trace nothing is recorded", file=sys.stderr)
     links = sorted(simulation.network.link_types)
     if arguments.record_links is not None:
         patterns, said = arguments.record_links, "--record-links `{}`"
