@@ -176,7 +176,7 @@ def test_two_processes_exchange_messages_and_a_remote_message_wakes_a_waiting_su
     faults = [data for topic, _, data in events if topic == "/earl/faults"]
     # a ping whose arrays were not tuples, or not a Record, would be an exception fault of answer/pf
     assert not [f for f in faults if f["kind"] in ("exception", "type")], faults
-    memory = [data for topic, _, data in events if topic == "receiver/a.cs/memory"]
+    memory = [data for topic, _, data in events if topic == "/receiver/a.cs/memory"]
     # one iteration per ping (two pings between receives leave one: a latest-value buffer)
     assert 100 < memory[-1]["received"] <= pings, (memory[-1], pings)
     assert memory[-1]["lastPing"]["stamp"][1] == float(memory[-1]["lastPing"]["count"])
@@ -209,7 +209,7 @@ def test_a_killed_sender_leaves_its_receiver_holding_and_a_restarted_one_resumes
     events = trace(tmp_path / "r.mcap")
     stale = [t for topic, t, data in events if topic == "/earl/faults" and data["kind"] == "stale"]
     assert len(stale) >= 1
-    changes = [(t, data["to"]) for topic, t, data in events if topic == "receiver/a.cs/fsm"]
+    changes = [(t, data["to"]) for topic, t, data in events if topic == "/receiver/a.cs/fsm"]
     # stale input: stale(ping/ib) holds, the receiver waits in `gone`; the restarted sender's pings bring it back
     assert any(t >= stale[0] and state == "gone" for t, state in changes), changes
     back = [t for t, state in changes if state == "listen" and t > stale[0]]
@@ -691,7 +691,7 @@ def test_pick_and_place_split_over_two_processes_survives_a_killed_task_agent_an
     output = robot.output
     assert "Traceback" not in output + second.output
     assert "pick-and-place: placed=true" in output, output
-    task_states = [data["to"] for topic, _, data in trace(tmp_path / "task.mcap") if topic == "task/a.cs/fsm"]
+    task_states = [data["to"] for topic, _, data in trace(tmp_path / "task.mcap") if topic == "/task/a.cs/fsm"]
     assert task_states[-1] == "done", task_states
 
     events = trace(tmp_path / "robot.mcap")
@@ -701,14 +701,14 @@ def test_pick_and_place_split_over_two_processes_survives_a_killed_task_agent_an
         if topic == "/earl/faults" and data["kind"] == "stale" and data["subsystem"] == "manip/a.cs"
     ]
     assert stale, "manip/a.cs never saw task/a go"
-    changes = [(t, data["to"]) for topic, t, data in events if topic == "manip/a.cs/fsm"]
+    changes = [(t, data["to"]) for topic, t, data in events if topic == "/manip/a.cs/fsm"]
     resumed = next(t for t, state in changes if t > stale[0] and state != "idle")
     idle = max(t for t, state in changes if t < resumed and state == "idle")
     assert idle > stale[0] - 5_000_000_000  # it was idle, holding, when the new task/a began
     holding = [
         data["currentJointPos"]
         for topic, t, data in events
-        if topic == "manip/a.cs/memory" and idle + 500_000_000 <= t < resumed
+        if topic == "/manip/a.cs/memory" and idle + 500_000_000 <= t < resumed
     ]
     assert len(holding) > 100, "manip/a.cs held for less than the outage"
     for joint in range(3):

@@ -16,8 +16,18 @@ from earl.runtime.trace_reader import TraceError, read_signals
 SECOND = 1_000_000_000
 
 
-def write_trace(path: Path, states: list[tuple[float, str]], messages: list[tuple[float, Any]], schema: Any) -> None:
-    """A trace of subsystem `s/a.cs`: its FSM's `states` and what its output buffer `cmd` sent."""
+def write_trace(
+    path: Path,
+    states: list[tuple[float, str]],
+    messages: list[tuple[float, Any]],
+    schema: Any,
+    memory: dict[str, float] | None = None,
+    legacy: bool = False,
+) -> None:
+    """A trace of subsystem `s/a.cs`: its FSM's `states`, what its output buffer `cmd` sent and, if
+    given, one snapshot of its `memory` (numbers). Its topics are named as earl writes them
+    (`/s/a.cs/fsm`), or `legacy` as earl wrote them before they had a leading slash (`s/a.cs/fsm`)."""
+    slash = "" if legacy else "/"
     with open(path, "wb") as stream:
         writer = Writer(stream)
         writer.start()
@@ -26,16 +36,23 @@ def write_trace(path: Path, states: list[tuple[float, str]], messages: list[tupl
         run = writer.register_channel("/earl/run", "json", run_schema)
         writer.add_message(run, 0, json.dumps({"event": "start", "seed": 0}).encode(), 0)
         fsm_schema = writer.register_schema("Fsm", "jsonschema", json.dumps({"type": "object"}).encode())
-        fsm = writer.register_channel("s/a.cs/fsm", "json", fsm_schema, {"subsystem": "s/a.cs"})
+        fsm = writer.register_channel(f"{slash}s/a.cs/fsm", "json", fsm_schema, {"subsystem": "s/a.cs"})
         link_schema = writer.register_schema("Cmd", "jsonschema", json.dumps(schema).encode())
         link = writer.register_channel(
-            "link/s/a:cs,ve", "json", link_schema, {"link": "s/a:cs,ve", "source": "s/a.cs.cmd"}
+            f"{slash}link/s/a:cs,ve", "json", link_schema, {"link": "s/a:cs,ve", "source": "s/a.cs.cmd"}
         )
         for time, state in states:
             data = {"from": "", "to": state, "transition": "t"}
             writer.add_message(fsm, int(time * SECOND), json.dumps(data).encode(), int(time * SECOND))
         for time, value in messages:
             writer.add_message(link, int(time * SECOND), json.dumps(value).encode(), int(time * SECOND))
+        if memory is not None:
+            properties = {key: {"type": "number"} for key in memory}
+            memory_schema = writer.register_schema(
+                "Memory", "jsonschema", json.dumps({"type": "object", "properties": properties}).encode()
+            )
+            snapshots = writer.register_channel(f"{slash}s/a.cs/memory", "json", memory_schema, {"subsystem": "s/a.cs"})
+            writer.add_message(snapshots, SECOND, json.dumps(memory).encode(), SECOND)
         writer.finish()
 
 
@@ -196,6 +213,24 @@ def test_read_signals_refuses_a_malformed_signal_and_a_subsystem_alone_saying_wh
         TraceError, match=r"`s/a\.cs` names a subsystem: .* e\.g\. `s/a\.cs\.cmd` \(the trace has `cmd`\)"
     ):
         read_signals(trace, ["s/a.cs"])
+
+
+@pytest.mark.parametrize("legacy", [False, True], ids=["topics-with-slash", "earlier-topics"])
+def test_a_subsystem_named_alone_is_answered_with_its_memory_and_buffers_whichever_way_its_topics_are_named(
+    tmp_path: Path, legacy: bool
+) -> None:
+    """Its recorded memory (`/s/a.cs/memory`) and the buffers its recorded links leave are listed, and a
+    misspelt value of it gets a did-you-mean, in a trace of this earl and in one an earlier earl wrote
+    (`s/a.cs/memory`, `link/…`): looking them up by one spelling said its memory was not recorded."""
+    trace = tmp_path / "t.mcap"
+    write_trace(trace, [(0.0, "idle")], [(0.1, {"ready": True})], GOAL, memory={"count": 3.0}, legacy=legacy)
+    with pytest.raises(TraceError) as caught:
+        read_signals(trace, ["s/a.cs"])
+    assert "e.g. `s/a.cs.cmd` (the trace has `cmd`, `count`)" in str(caught.value)
+    assert "memory is not in this trace" not in str(caught.value)
+    with pytest.raises(TraceError, match=r"the trace has no values for `s/a\.cs\.cuont`; did you mean `count`\?"):
+        read_signals(trace, ["s/a.cs.cuont"])
+    assert [series.values for series in read_signals(trace, ["s/a.cs.count"]).series] == [[3.0]]
 
 
 def test_another_tool_s_topics_are_listed_escaped_when_its_file_is_said_to_be_no_earl_trace(tmp_path: Path) -> None:

@@ -277,7 +277,7 @@ def test_each_link_gets_a_message_writer_only_from_the_recorders_that_record_it(
 
     with (tmp_path / "links.mcap").open("rb") as stream:
         topics = {channel.topic for _, channel, _ in make_reader(stream).iter_messages()}
-    assert not any(topic.startswith("link/") for topic in topics)
+    assert topics and not any(topic.startswith("/link/") for topic in topics)
 
 
 def test_a_trace_written_by_its_own_process_is_the_trace_written_in_process(tmp_path: Path) -> None:
@@ -971,7 +971,7 @@ def test_the_entry_into_the_initial_state_names_no_transition(tmp_path: Path) ->
         changes = [
             json.loads(message.data)
             for _, channel, message in make_reader(stream).iter_messages()
-            if channel.topic == "counter/a.cs/fsm"
+            if channel.topic == "/counter/a.cs/fsm"
         ]
     assert changes[0] == {"from": None, "to": "counting", "transition": None}
     assert changes[1:] == [{"from": "counting", "to": "finished", "transition": "counting,finished"}]

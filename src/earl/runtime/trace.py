@@ -1,16 +1,17 @@
 """The trace of a run: an MCAP file that Foxglove opens (JSON messages with JSON schemas).
 
-Topics (one channel each; log time = run time in ns):
+Topics (one channel each; log time = run time in ns; names in `trace_topics.py`):
 
-    SUBSYSTEM/fsm        a state change   {"from", "to", "transition"}
-    SUBSYSTEM/behaviour  a behaviour starts or stops {"event", "state", "behaviour", "iterations", "reason"}
-    SUBSYSTEM/memory     a memory snapshot after an iteration (only for subsystems asked for)
-    link/LINK            every message sent on a link (or those chosen); a struct as itself,
-                         any other value as {"value": ...}
-    /earl/faults         faults, with the traceback of a failing function
-    /earl/run            the run's settings at the start and its end time
+    /SUBSYSTEM/fsm        a state change   {"from", "to", "transition"}
+    /SUBSYSTEM/behaviour  a behaviour starts or stops {"event", "state", "behaviour", "iterations", "reason"}
+    /SUBSYSTEM/memory     a memory snapshot after an iteration (only for subsystems asked for)
+    /link/LINK            every message sent on a link (or those chosen); a struct as itself,
+                          any other value as {"value": ...}
+    /earl/faults          faults, with the traceback of a failing function
+    /earl/run             the run's settings at the start and its end time
 
-A subsystem is named as everywhere else: `manip/a.cs`, `manip/a.motorController[3]/ve`.
+Every topic starts with `/`, as ROS's and Foxglove's do. A subsystem is named as everywhere else:
+`/manip/a.cs/fsm`, `/manip/a.motorController[3]/ve/memory`.
 The same spec and seed give a byte-identical file: nothing in it depends on the wall clock.
 
 `TraceWriter` decides what is written (topics, schemas, which links); a sink writes it.
@@ -40,6 +41,7 @@ import msgpack  # type: ignore[import-untyped]
 
 from earl import __version__
 from earl.model.types import DataType
+from earl.runtime import trace_topics
 from earl.runtime.events import Fault, MessageWriter, Recorder
 from earl.runtime.values import TypeSystem, json_schema, to_json
 
@@ -273,17 +275,19 @@ class TraceWriter(Recorder):
     def run_started(self, settings: dict[str, Any]) -> None:
         # the file's header names the SDK that wrote it; which earl ran is said here
         start = {"event": "start", "earl": __version__, **settings}
-        self._write(self._channel("/earl/run", "earl.Run", _RUN_SCHEMA, {}), 0, start)
+        self._write(self._channel(trace_topics.RUN, "earl.Run", _RUN_SCHEMA, {}), 0, start)
 
     def state_changed(
         self, time: int, subsystem: str, source: str | None, destination: str, transition: str | None
     ) -> None:
-        channel = self._channel(f"{subsystem}/fsm", "earl.StateChange", _STATE_SCHEMA, {"subsystem": subsystem})
+        channel = self._channel(
+            trace_topics.fsm(subsystem), "earl.StateChange", _STATE_SCHEMA, {"subsystem": subsystem}
+        )
         self._write(channel, time, {"from": source, "to": destination, "transition": transition})
 
     def behaviour_started(self, time: int, subsystem: str, state: str, behaviour: str) -> None:
         channel = self._channel(
-            f"{subsystem}/behaviour", "earl.BehaviourEvent", _BEHAVIOUR_SCHEMA, {"subsystem": subsystem}
+            trace_topics.behaviour(subsystem), "earl.BehaviourEvent", _BEHAVIOUR_SCHEMA, {"subsystem": subsystem}
         )
         self._write(channel, time, {"event": "start", "state": state, "behaviour": behaviour})
 
@@ -291,7 +295,7 @@ class TraceWriter(Recorder):
         self, time: int, subsystem: str, state: str, behaviour: str, iterations: int, reason: str
     ) -> None:
         channel = self._channel(
-            f"{subsystem}/behaviour", "earl.BehaviourEvent", _BEHAVIOUR_SCHEMA, {"subsystem": subsystem}
+            trace_topics.behaviour(subsystem), "earl.BehaviourEvent", _BEHAVIOUR_SCHEMA, {"subsystem": subsystem}
         )
         self._write(
             channel,
@@ -337,7 +341,7 @@ class TraceWriter(Recorder):
         return channel
 
     def _link_channel(self, link: str) -> int | None:
-        topic = f"link/{link}"
+        topic = trace_topics.link(link)
         if not self._recorded(link):
             self._channels[topic] = None
             return None
@@ -355,7 +359,7 @@ class TraceWriter(Recorder):
         return self._channel(topic, name, schema, metadata, wrap=True)
 
     def memory_snapshot(self, time: int, subsystem: str, memory: dict[str, Any]) -> None:
-        topic = f"{subsystem}/memory"
+        topic = trace_topics.memory(subsystem)
         channel = self._channels.get(topic)
         if channel is None:
             properties = {key: json_schema(self.types, t) for key, t in self.memory_types.get(subsystem, {}).items()}
@@ -368,7 +372,7 @@ class TraceWriter(Recorder):
         self._write(channel, time, dict(memory))  # a copy: the engine goes on changing its memory
 
     def fault(self, fault: Fault) -> None:
-        channel = self._channel("/earl/faults", "earl.Fault", _FAULT_SCHEMA, {})
+        channel = self._channel(trace_topics.FAULTS, "earl.Fault", _FAULT_SCHEMA, {})
         self._write(
             channel,
             fault.time,
@@ -389,7 +393,7 @@ class TraceWriter(Recorder):
             return
         self.closed = True
         self._write(
-            self._channel("/earl/run", "earl.Run", _RUN_SCHEMA, {}), end_time, {"event": "end", **(summary or {})}
+            self._channel(trace_topics.RUN, "earl.Run", _RUN_SCHEMA, {}), end_time, {"event": "end", **(summary or {})}
         )
         self._sink.finish()
 

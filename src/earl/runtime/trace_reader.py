@@ -23,6 +23,7 @@ from mcap.records import Channel, Message, Schema
 from mcap.stream_reader import CRCValidationError, StreamReader
 
 from earl.diagnostics import did_you_mean, escape_controls
+from earl.runtime import trace_topics
 from earl.runtime.signal_syntax import signal_syntax_error
 from earl.runtime.values import iter_leaves
 
@@ -163,16 +164,12 @@ def _not_from_earl(path: Path, topic: str) -> TraceError:
     )
 
 
-#: the topic of the run's start and end, which every trace earl writes has
-RUN_TOPIC = "/earl/run"
-
-
 def _not_an_earl_trace(path: Path, topics: Iterable[str]) -> TraceError:
     """Said alike by `earl trace` and `earl plot` of an MCAP file another tool wrote."""
     found = sorted({escape_controls(topic) for topic in topics})  # another tool's names: shown, not obeyed
     listed = ", ".join(found[:5]) + (f" and {len(found) - 5} more" if len(found) > 5 else "")
     return TraceError(
-        f"{path} is an MCAP file but not an earl trace: it has no {RUN_TOPIC} topic "
+        f"{path} is an MCAP file but not an earl trace: it has no {trace_topics.RUN} topic "
         f"({f'its topics: {listed}' if found else 'it has no topics'}); `earl run --trace FILE.mcap` writes one"
     )
 
@@ -191,7 +188,7 @@ def _indexed_topics(path: Path) -> set[str] | None:
 def summarise(path: Path) -> TraceSummary:
     # another tool's file is said to be one before its messages are read: they need not be JSON
     indexed = _indexed_topics(path)
-    if indexed is not None and RUN_TOPIC not in indexed:
+    if indexed is not None and trace_topics.RUN not in indexed:
         raise _not_an_earl_trace(path, indexed)
     summariser = _Summariser()
     cut: list[bool] = []
@@ -230,21 +227,21 @@ class _Summariser:
 
     def add(self, topic: str, metadata: dict[str, str], time: int, data: Any) -> None:
         self.end_time = max(self.end_time, time)
-        if topic == "/earl/run":
+        kind, name = trace_topics.classify(topic, metadata)
+        if kind == "run":
             self.seen_run = True
             if data.get("event") == "start":
                 self.settings = {k: v for k, v in data.items() if k != "event"}
             elif data.get("event") == "end":
                 self.ended = True
-                for name, count in data.get("iterations", {}).items():
-                    self.of(name).iterations = int(count)
-        elif topic == "/earl/faults":
+                for subsystem, count in data.get("iterations", {}).items():
+                    self.of(subsystem).iterations = int(count)
+        elif kind == "faults":
             self.faults.append({"time": time, **data})
             self.of(data.get("subsystem", "?")).faults += 1
-        elif topic.startswith("link/"):
+        elif kind == "link":
             self.messages += 1
-        elif topic.endswith("/fsm"):
-            name = metadata.get("subsystem", topic[: -len("/fsm")])
+        elif kind == "fsm":
             summary = self.of(name)
             state_to = str(data["to"])
             if name in self.entered:
@@ -389,12 +386,27 @@ def read_signals(path: Path, names: list[str]) -> Signals:
     The file is read once, whatever the number of signals: a trace of a long run is large.
     """
     channels = _channels(path)
-    if RUN_TOPIC not in channels:  # before its signals are looked for: another tool's file has none
+    if trace_topics.RUN not in channels:  # before its signals are looked for: another tool's file has none
         raise _not_an_earl_trace(path, channels)
     available = {topic: metadata for topic, (metadata, _) in channels.items()}
-    subsystems = sorted({t[: -len("/fsm")] for t in available if t.endswith("/fsm")}, key=len, reverse=True)
+    #: (kind, subsystem) -> topic, whichever way this trace's earl named its topics
+    by_kind: dict[tuple[str, str], str] = {}
+    links: list[tuple[str, dict[str, str]]] = []
+    for topic, metadata in available.items():
+        kind, owner = trace_topics.classify(topic, metadata)
+        if kind == "link":
+            links.append((topic, metadata))
+        else:
+            by_kind[(kind, owner)] = topic
+    subsystems = sorted({owner for kind, owner in by_kind if kind == "fsm"}, key=len, reverse=True)
     wanted: dict[str, tuple[str, str]] = {}  # topic -> (subsystem, prefix of its leaves)
     owners: list[tuple[str, str, str]] = []  # (name, subsystem, name inside the subsystem)
+    memory_topics: dict[str, str] = {}
+
+    def elements_of(subsystem: str) -> list[str]:
+        memory_topic = by_kind.get(("memory", subsystem))
+        return _elements_in(subsystem, None if memory_topic is None else channels[memory_topic][1], links)
+
     for name in names:
         malformed = signal_syntax_error(name)
         if malformed is not None:
@@ -402,7 +414,7 @@ def read_signals(path: Path, names: list[str]) -> Signals:
         subsystem = next((s for s in subsystems if name.startswith(s + ".")), None)
         if subsystem is None and name in subsystems:
             # the subsystem alone: it is in the trace, but a signal is one of its values
-            elements = _elements_in(name, channels)
+            elements = elements_of(name)
             if not elements:
                 raise TraceError(
                     f"`{name}` names a subsystem: a signal goes on to its memory or output buffer, and the trace "
@@ -411,7 +423,7 @@ def read_signals(path: Path, names: list[str]) -> Signals:
             listed = ", ".join(f"`{element}`" for element in elements)
             unrecorded = (
                 f"; its memory is not in this trace (`earl run --record-memory {name}` records it)"
-                if f"{name}/memory" not in channels
+                if ("memory", name) not in by_kind
                 else ""
             )
             raise TraceError(
@@ -424,18 +436,21 @@ def read_signals(path: Path, names: list[str]) -> Signals:
             )
         inner = name[len(subsystem) + 1 :]
         owners.append((name, subsystem, inner))
-        if f"{subsystem}/memory" in available:
-            wanted[f"{subsystem}/memory"] = (subsystem, "")
+        memory_topic = by_kind.get(("memory", subsystem))
+        if memory_topic is not None:
+            wanted[memory_topic] = (subsystem, "")
+            memory_topics[subsystem] = memory_topic
         # only the links of the output buffer the name starts with: a control subsystem's other links
         # can carry tens of thousands of messages that this plot would decode for nothing
         element = signal_element(inner)
-        for topic, metadata in available.items():
+        for topic, metadata in links:
             source = metadata.get("source", "")
-            if topic.startswith("link/") and source.startswith(subsystem + "."):
+            if source.startswith(subsystem + "."):
                 buffer = source[len(subsystem) + 1 :]
                 if signal_element(buffer) == element:
                     wanted.setdefault(topic, (subsystem, buffer))
-        wanted[f"{subsystem}/fsm"] = (subsystem, "")
+        wanted[by_kind[("fsm", subsystem)]] = (subsystem, "")
+    fsm_topics = {by_kind[("fsm", subsystem)] for _, subsystem, _ in owners}
     leaves: dict[tuple[str, str], tuple[list[float], list[float]]] = {}
     #: the leaves that had a value at least once: a number, a Boolean, or an infinite real (null)
     valued: set[tuple[str, str]] = set()
@@ -452,14 +467,14 @@ def read_signals(path: Path, names: list[str]) -> Signals:
     held: dict[str, set[tuple[str, str]]] = {}
     end = 0.0
     cut: list[bool] = []
-    for topic, _, time, data in _messages(path, [*wanted, "/earl/run"], cut):
+    for topic, _, time, data in _messages(path, [*wanted, trace_topics.RUN], cut):
         seconds = time * 1e-9
         end = max(end, seconds)
-        if topic == "/earl/run":
+        if topic == trace_topics.RUN:
             continue
         try:
             subsystem, buffer = wanted[topic]
-            if topic.endswith("/fsm"):
+            if topic in fsm_topics:
                 stays.setdefault(subsystem, []).append((seconds, str(data["to"])))
                 continue
             present: set[tuple[str, str]] = set()
@@ -546,13 +561,13 @@ def read_signals(path: Path, names: list[str]) -> Signals:
                 empty.append(f"`{name}` had no value in this run (an optional field never sent, or an empty array)")
                 leaf_hints.append(f"`{name}` had no value in this run ({hint})")
                 continue
-            if f"{subsystem}/memory" not in available:
+            if subsystem not in memory_topics:
                 hint = (
                     f"if it is memory, record it with `--record-memory {subsystem}`; an output buffer is in the "
                     "trace when a link leaves it (and `--record-links` keeps that link)"
                 )
             else:
-                elements = _elements_in(subsystem, channels)
+                elements = elements_of(subsystem)
                 has = f" (the trace has {', '.join(f'`{e}`' for e in elements)})" if elements else ""
                 hint = did_you_mean(element, [signal_element(e) for e in elements]) or (
                     f"check the name against the spec{has}"
@@ -571,17 +586,17 @@ def read_signals(path: Path, names: list[str]) -> Signals:
     return Signals(series, bands, end, empty, bool(cut))
 
 
-def _elements_in(subsystem: str, channels: dict[str, tuple[dict[str, str], Any]]) -> list[str]:
-    """What a signal of `subsystem` can go on to in this trace: its recorded memory and the output
-    buffers whose links are recorded, a family written `name[*]`."""
+def _elements_in(subsystem: str, memory_schema: Any, links: list[tuple[str, dict[str, str]]]) -> list[str]:
+    """What a signal of `subsystem` can go on to in this trace: its recorded memory (`memory_schema`,
+    the schema of its memory topic, None when it has none) and the output buffers whose links are
+    recorded (`links`: every link topic of the trace with its metadata), a family written `name[*]`."""
     names: list[str] = []
-    memory = channels.get(f"{subsystem}/memory")
-    properties = memory[1].get("properties") if memory is not None and isinstance(memory[1], dict) else None
+    properties = memory_schema.get("properties") if isinstance(memory_schema, dict) else None
     if isinstance(properties, dict):
         names += [str(key) for key in properties]
-    for topic, (metadata, _) in channels.items():
+    for _, metadata in links:
         source = metadata.get("source", "")
-        if topic.startswith("link/") and source.startswith(subsystem + "."):
+        if source.startswith(subsystem + "."):
             names.append(source[len(subsystem) + 1 :])
     shown = (signal_element(name) + ("[*]" if "[" in name else "") for name in names)
     return sorted(dict.fromkeys(shown), key=_natural)
