@@ -945,7 +945,7 @@ def test_a_stop_signal_ends_the_run_between_two_instants(tmp_path: Path) -> None
     assert process.returncode == 130, stderr
     assert "stopping after this instant" in stderr and "interrupted at" in stderr
     [end] = [data for topic, _, _, data in _messages(trace, ["/earl/run"]) if "iterations" in data]
-    counts = set(end["iterations"].values())
+    counts = {entry["iterations"] for entry in end["iterations"]}
     assert len(counts) == 1 and counts != {0}, end["iterations"]
 
 

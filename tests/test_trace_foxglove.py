@@ -1,5 +1,5 @@
-"""Traces open in Foxglove: every topic can be named in a message path, with the leading `/` of ROS's
-and Foxglove's topics, and traces of an earlier earl are still read.
+"""Traces open in Foxglove: every topic and every field of a message can be named in a message path,
+with the leading `/` of ROS's and Foxglove's topics, and traces of an earlier earl are still read.
 
 The rules are Foxglove's, written here from its sources, not from earl's code:
 
@@ -61,6 +61,34 @@ def parse_path(path: str) -> tuple[str, list[tuple[str, int | None]]]:
     return topic, steps
 
 
+def evaluate(message: Any, steps: list[tuple[str, int | None]]) -> Any:
+    """What the path's steps name in a message, as Foxglove's paths go: a field, then an element."""
+    value = message
+    for name, index in steps:
+        value = value[name]
+        if index is not None:
+            value = value[index]
+    return value
+
+
+def field_paths(value: Any, prefix: str = "") -> list[tuple[str, Any]]:
+    """(path, leaf) for every leaf of a message, each step a `.field` with at most one `[index]` after
+    it; an AssertionError for a key that is no id or an array directly inside an array."""
+    if isinstance(value, dict):
+        found = []
+        for key, inner in value.items():
+            assert re.fullmatch(ID, key), f"field {key!r} after {prefix or 'the topic'} is no name a path can take"
+            found.extend(field_paths(inner, f"{prefix}.{key}"))
+        return found
+    if isinstance(value, list):
+        assert not prefix.endswith("]"), f"{prefix} is an array inside an array, which no message path indexes"
+        found = []
+        for index, inner in enumerate(value):
+            found.extend(field_paths(inner, f"{prefix}[{index}]"))
+        return found
+    return [(prefix, value)]
+
+
 def channels_and_messages(path: Path) -> tuple[dict[str, Any], dict[str, list[Any]]]:
     """Each topic's channel (with its schema's text and encodings) and its messages, decoded."""
     with open(path, "rb") as stream:
@@ -87,24 +115,86 @@ def run_earl(*arguments: str | Path) -> subprocess.CompletedProcess[str]:
     )
 
 
-def test_every_topic_of_the_flagship_trace_starts_with_a_slash_and_is_a_message_path_topic(tmp_path: Path) -> None:
-    """A trace of the pick-and-place system with all memory and all links recorded: only `/earl/run` and
-    `/earl/faults` had the leading `/` of ROS's and Foxglove's topics (`manip/a.cs/fsm`, `link/task,manip`);
-    every topic has it now, and each is the topic of a message path (quoted where it has a `.`)."""
+def test_every_topic_and_field_of_the_flagship_trace_is_a_foxglove_message_path(tmp_path: Path) -> None:
+    """A trace of the pick-and-place system with all memory and all links recorded: every topic starts
+    with `/` and is a message path's topic; every leaf of every message is a path of `.field[index]`
+    steps that names that leaf. Memory families (`windingCurrent[K in 1..6]`) were keys
+    `windingCurrent[1]` that no path could name, and the end's iteration counts were keyed by subsystem
+    (`manip/a.cs`): a family is an array, member K at K, and the counts a list."""
     trace = tmp_path / "run.mcap"
     ran = run_earl("run", PICK_AND_PLACE, "--duration", "0.3s", "--trace", trace, "--record-memory", "all")
     assert ran.returncode == 0, ran.stderr
     channels, messages = channels_and_messages(trace)
     assert {"/earl/run", "/manip/a.cs/memory", "/manip/a.cs/fsm", "/link/task,manip"} <= set(channels)
-    for topic in channels:
+    for topic, (message_encoding, schema_encoding, _) in channels.items():
         assert topic.startswith("/"), topic
+        assert (message_encoding, schema_encoding) == ("json", "jsonschema"), topic
         assert parse_path(quote_topic(topic)) == (topic, []), topic
         assert messages[topic], f"{topic} has no message"
-    assert parse_path('"/manip/a.cs/memory".currentJointPos[2]') == ("/manip/a.cs/memory", [("currentJointPos", 2)])
+        for message in messages[topic]:
+            for path, leaf in field_paths(message):
+                named, steps = parse_path(quote_topic(topic) + path)
+                assert named == topic and evaluate(message, steps) == leaf, (topic, path)
+    # the example of docs/runtime.md: member 1 of the memory family is element 1 in Foxglove
+    topic, steps = parse_path('"/manip/a.cs/memory".windingCurrent[1]')
+    in_foxglove = [evaluate(message, steps) for message in messages[topic]]
+    [series] = read_signals(trace, ["manip/a.cs.windingCurrent[1]"]).series
+    assert series.values == in_foxglove and any(value != 0.0 for value in in_foxglove)
+    # the end of the run counts each subsystem's iterations in a list, a subsystem's name being no field name
+    [end] = [message for message in messages["/earl/run"] if message["event"] == "end"]
+    assert {entry["subsystem"] for entry in end["iterations"]} >= {"manip/a.cs", "task/a.cs"}
     summary = run_earl("trace", "summary", trace)
     assert summary.returncode == 0 and "manip/a.motorController[1]/ve" in summary.stdout, summary.stderr
-    [series] = read_signals(trace, ["manip/a.cs.currentJointPos[1]"]).series
-    assert len(series.values) == len(messages["/manip/a.cs/memory"])
+
+
+FAMILIES = """\
+system families
+famRobot/r {
+    f/a
+}
+f/a {
+    cs {
+        period 10 ms
+        fromZero[J in 0..1]/m: double = 1.5 * J
+        fromTwo[J in 2..3]/m: double = 1.0 * J
+        rows[J in 1..2]/m: double[2] = [1.0, 2.0]
+        grid/m: double[2][2] = [[1.0, 2.0], [3.0, 4.0]]
+        far/m: double = 1e999
+        go/pp = true
+        run/bb {
+            tf = {}
+            tc = go/pp
+        }
+        fsm {
+            initial run
+            state run: run/bb
+            run -> run when go/pp
+        }
+    }
+}
+"""
+
+
+def test_memory_families_are_arrays_indexed_as_the_spec_counts(tmp_path: Path) -> None:
+    """A family from 0 is an array from its first element, one from 2 has two nulls before it (in the
+    schema's `prefixItems`), and `earl plot` of `fromTwo[*]` draws members 2 and 3, not the nulls. A
+    family of arrays is an array of arrays: in the messages, left out of the schema (Foxglove refuses
+    a channel whose schema has one), and still plotted by earl."""
+    (tmp_path / "system.earl").write_text(FAMILIES)
+    trace = tmp_path / "f.mcap"
+    ran = run_earl("run", tmp_path, "--duration", "0.05s", "--trace", trace, "--record-memory", "all")
+    assert ran.returncode == 0, ran.stderr
+    channels, messages = channels_and_messages(trace)
+    _, _, schema = channels["/f/a.cs/memory"]
+    assert "rows" not in schema["properties"] and schema["properties"]["fromZero"]["items"] == {"type": "number"}
+    assert schema["properties"]["fromTwo"]["prefixItems"] == [{"type": "null"}] * 2
+    last = messages["/f/a.cs/memory"][-1]
+    assert last["fromZero"] == [0.0, 1.5] and last["fromTwo"] == [None, None, 2.0, 3.0]
+    assert last["rows"] == [None, [1.0, 2.0], [1.0, 2.0]]
+    signals = read_signals(trace, ["f/a.cs.fromTwo[*]", "f/a.cs.rows[2][1]", "f/a.cs.far"])
+    assert [series.name for series in signals.series] == ["fromTwo[2]", "fromTwo[3]", "rows[2][1]", "far"]
+    assert signals.series[2].values[-1] == 2.0
+    assert not signals.empty  # `far`, an infinite real, had a value: no optional field never sent
 
 
 def write_earlier_trace(path: Path) -> None:

@@ -399,7 +399,7 @@ def test_a_null_leaf_of_a_trace_is_a_leaf_the_reader_tells_apart_by_the_schema()
     """JSON writes an infinite real and an absent optional field as null: both are leaves (a gap in a
     plot, not a signal that seems never recorded), and the channel's schema says which one it is. A
     memory family's member is one property (`log[2]`)."""
-    from earl.runtime.trace_reader import _null_is_absent
+    from earl.runtime.trace_reader import _is_padding, _null_is_absent
     from earl.runtime.values import iter_leaves
 
     leaves = list(iter_leaves({"position": [1.0, None], "stop": False, "note": "text"}))
@@ -417,6 +417,11 @@ def test_a_null_leaf_of_a_trace_is_a_leaf_the_reader_tells_apart_by_the_schema()
     assert not _null_is_absent(schema, "position[1]") and not _null_is_absent(schema, "log[2]")
     assert not _null_is_absent(schema, "pose.x")
     assert _null_is_absent(schema, "spare") and _null_is_absent(schema, "pose") and _null_is_absent(None, "x")
+    # a memory family is an array whose elements before its first member are null (`prefixItems`)
+    family = {"type": "array", "items": {"type": "number"}, "prefixItems": [{"type": "null"}]}
+    schema = {"type": "object", "properties": {"log": family, "gain": {"type": "number"}}}
+    assert not _null_is_absent(schema, "log[2]") and not _null_is_absent(schema, "gain")
+    assert _is_padding(schema, "log[0]") and not _is_padding(schema, "log[1]") and not _is_padding(schema, "gain")
 
 
 def test_an_output_buffer_read_as_an_attribute_before_it_is_written_is_told_to_keep_a_variable(

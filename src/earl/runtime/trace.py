@@ -4,14 +4,17 @@ Topics (one channel each; log time = run time in ns; names in `trace_topics.py`)
 
     /SUBSYSTEM/fsm        a state change   {"from", "to", "transition"}
     /SUBSYSTEM/behaviour  a behaviour starts or stops {"event", "state", "behaviour", "iterations", "reason"}
-    /SUBSYSTEM/memory     a memory snapshot after an iteration (only for subsystems asked for)
+    /SUBSYSTEM/memory     a memory snapshot after an iteration (only for subsystems asked for); a
+                          memory family is one array, member K at index K (`windingCurrent[1]`)
     /link/LINK            every message sent on a link (or those chosen); a struct as itself,
                           any other value as {"value": ...}
     /earl/faults          faults, with the traceback of a failing function
     /earl/run             the run's settings at the start and its end time
 
 Every topic starts with `/`, as ROS's and Foxglove's do. A subsystem is named as everywhere else:
-`/manip/a.cs/fsm`, `/manip/a.motorController[3]/ve/memory`.
+`/manip/a.cs/fsm`, `/manip/a.motorController[3]/ve/memory`. Every field of a message is a name
+Foxglove's message paths take (letters, digits, `_`), so that `"/manip/a.cs/memory".windingCurrent[1]`
+plots in Foxglove what `earl plot` calls `manip/a.cs.windingCurrent[1]`.
 The same spec and seed give a byte-identical file: nothing in it depends on the wall clock.
 
 `TraceWriter` decides what is written (topics, schemas, which links); a sink writes it.
@@ -27,6 +30,7 @@ import contextlib
 import fcntl
 import json
 import os
+import re
 import select
 import struct
 import subprocess
@@ -74,6 +78,69 @@ _FAULT_SCHEMA = {
     },
 }
 _RUN_SCHEMA = {"type": "object", "title": "earl.Run"}
+
+
+#: a member of a memory family, as the runtime keys it: `windingCurrent[3]`
+_MEMBER = re.compile(r"(\w+)\[(\d+)\]\Z")
+
+
+class MemoryLayout:
+    """How a subsystem's memory is written: each memory under its name, and a family as one array
+    with member K at index K (null before the family's first index), so that its members are
+    `windingCurrent[1]` … in Foxglove as in the spec. The runtime keys a member `windingCurrent[1]`,
+    which no message path can name (a field is letters, digits and `_`)."""
+
+    def __init__(self, types: TypeSystem, memory_types: dict[str, DataType]) -> None:
+        families: dict[str, dict[int, str]] = {}
+        #: each field with whether it is a family, in declaration order
+        order: list[tuple[str, bool]] = []
+        #: each field's schema (a family's: its members')
+        schemas: dict[str, dict[str, Any]] = {}
+        for key, data_type in memory_types.items():
+            member = _MEMBER.match(key)
+            if member is None:
+                order.append((key, False))
+                schemas[key] = json_schema(types, data_type)
+                continue
+            name, index = member.group(1), int(member.group(2))
+            if name not in families:
+                families[name] = {}
+                order.append((name, True))
+                schemas[name] = json_schema(types, data_type)
+            families[name][index] = key
+        self.plan: list[tuple[str, str | list[str | None]]] = []
+        self.properties: dict[str, Any] = {}
+        for name, family in order:
+            schema: dict[str, Any] | None = schemas[name]
+            if family:
+                members = families[name]
+                first, last = min(members), max(members)
+                self.plan.append((name, [members.get(index) for index in range(last + 1)]))
+                if schema is not None and schema["type"] != "array":
+                    schema = {"type": "array", "items": schema, "minItems": last + 1, "maxItems": last + 1}
+                    if first:
+                        # standard JSON Schema for "the first items are null": earl's reader skips them
+                        schema["prefixItems"] = [{"type": "null"}] * first
+                else:
+                    # a family of arrays is an array of arrays, which no message path indexes and
+                    # Foxglove refuses in a schema, with the whole channel: in the messages only
+                    schema = None
+            else:
+                self.plan.append((name, name))
+            if schema is not None:
+                self.properties[name] = schema
+        self.has_families = any(isinstance(source, list) for _, source in self.plan)
+
+    def snapshot(self, memory: dict[str, Any]) -> dict[str, Any]:
+        """The message for `memory`: a copy, since the engine goes on changing its memory."""
+        if not self.has_families:
+            return dict(memory)
+        return {
+            name: memory.get(source)
+            if isinstance(source, str)
+            else [None if key is None else memory.get(key) for key in source]
+            for name, source in self.plan
+        }
 
 
 #: one encoder for the whole run: `json.dumps` with these options would build one per message
@@ -256,6 +323,8 @@ class TraceWriter(Recorder):
         self._channels: dict[str, int | None] = {}
         #: link -> channel number or None, the same as `_channels` without making the topic's name
         self._links: dict[str, int | None] = {}
+        #: subsystem -> its memory's channel and layout
+        self._memories: dict[str, tuple[int, MemoryLayout]] = {}
         self.closed = False
 
     # ------------------------------------------------------------------ plumbing
@@ -359,17 +428,21 @@ class TraceWriter(Recorder):
         return self._channel(topic, name, schema, metadata, wrap=True)
 
     def memory_snapshot(self, time: int, subsystem: str, memory: dict[str, Any]) -> None:
-        topic = trace_topics.memory(subsystem)
-        channel = self._channels.get(topic)
-        if channel is None:
-            properties = {key: json_schema(self.types, t) for key, t in self.memory_types.get(subsystem, {}).items()}
+        found = self._memories.get(subsystem)
+        if found is None:
+            layout = MemoryLayout(self.types, self.memory_types.get(subsystem, {}))
+            schema = {
+                "type": "object",
+                "title": f"{subsystem}.m",
+                "properties": layout.properties,
+                "required": list(layout.properties),
+            }
             channel = self._channel(
-                topic,
-                f"earl.Memory.{subsystem}",
-                {"type": "object", "title": f"{subsystem}.m", "properties": properties},
-                {"subsystem": subsystem},
+                trace_topics.memory(subsystem), f"earl.Memory.{subsystem}", schema, {"subsystem": subsystem}
             )
-        self._write(channel, time, dict(memory))  # a copy: the engine goes on changing its memory
+            found = self._memories[subsystem] = (channel, layout)
+        channel, layout = found
+        self._write(channel, time, layout.snapshot(memory))
 
     def fault(self, fault: Fault) -> None:
         channel = self._channel(trace_topics.FAULTS, "earl.Fault", _FAULT_SCHEMA, {})
@@ -392,9 +465,11 @@ class TraceWriter(Recorder):
         if self.closed:
             return
         self.closed = True
-        self._write(
-            self._channel(trace_topics.RUN, "earl.Run", _RUN_SCHEMA, {}), end_time, {"event": "end", **(summary or {})}
-        )
+        end: dict[str, Any] = {"event": "end", **(summary or {})}
+        if isinstance(end.get("iterations"), dict):
+            # a list, not an object keyed by subsystem: `manip/a.cs` is no name a message path can take
+            end["iterations"] = [{"subsystem": name, "iterations": count} for name, count in end["iterations"].items()]
+        self._write(self._channel(trace_topics.RUN, "earl.Run", _RUN_SCHEMA, {}), end_time, end)
         self._sink.finish()
 
 

@@ -234,7 +234,7 @@ class _Summariser:
                 self.settings = {k: v for k, v in data.items() if k != "event"}
             elif data.get("event") == "end":
                 self.ended = True
-                for subsystem, count in data.get("iterations", {}).items():
+                for subsystem, count in _iterations(data.get("iterations", [])):
                     self.of(subsystem).iterations = int(count)
         elif kind == "faults":
             self.faults.append({"time": time, **data})
@@ -257,6 +257,14 @@ class _Summariser:
             summary = self.subsystems[name]
             summary.state_time[state] = summary.state_time.get(state, 0) + self.end_time - since
         return TraceSummary(self.end_time, self.subsystems, self.faults, self.messages, self.settings, self.ended)
+
+
+def _iterations(counts: Any) -> list[tuple[str, Any]]:
+    """(subsystem, count) of the end message: a list of {"subsystem", "iterations"}, or in a trace of
+    an earlier earl an object keyed by subsystem."""
+    if isinstance(counts, dict):
+        return list(counts.items())
+    return [(str(entry["subsystem"]), entry["iterations"]) for entry in counts]
 
 
 def topics(path: Path) -> dict[str, dict[str, str]]:
@@ -315,6 +323,13 @@ def _null_is_absent(schema: Any, leaf: str) -> bool:
     return bool(found.get("type") != "number")
 
 
+def _is_padding(schema: Any, leaf: str) -> bool:
+    """Whether `leaf` is one of the nulls before a memory family's first member (`windingCurrent[0]` of
+    `windingCurrent[K in 1..6]`): no value of the run, which the schema's `prefixItems` say."""
+    found = _leaf_schema(schema, leaf)
+    return isinstance(found, dict) and found.get("type") == "null"
+
+
 def _leaf_schema(schema: Any, leaf: str) -> Any:
     """The part of a channel's schema for `leaf` of its messages; None when the schema does not show it."""
     current = schema
@@ -325,7 +340,7 @@ def _leaf_schema(schema: Any, leaf: str) -> Any:
             return None
         properties = current.get("properties")
         if isinstance(properties, dict):
-            # a memory family's member is one property, `log[2]`: the longest name that starts `rest`
+            # in earlier traces a memory family's member is one property, `log[2]`: the longest name that starts `rest`
             name = max(
                 (key for key in properties if rest == key or rest.startswith((f"{key}.", f"{key}["))),
                 key=len,
@@ -335,10 +350,13 @@ def _leaf_schema(schema: Any, leaf: str) -> Any:
                 return None
             current, rest = properties[name], rest[len(name) :].removeprefix(".")
         else:
-            index = re.match(r"\[\d+\]", rest)
+            index = re.match(r"\[(\d+)\]", rest)
             if index is None:
                 return None
-            current, rest = current.get("items"), rest[index.end() :].removeprefix(".")
+            # the nulls before a memory family's first member are described apart, in `prefixItems`
+            position, before = int(index.group(1)), current.get("prefixItems")
+            current = before[position] if isinstance(before, list) and position < len(before) else current.get("items")
+            rest = rest[index.end() :].removeprefix(".")
     return current
 
 
@@ -459,8 +477,9 @@ def read_signals(path: Path, names: list[str]) -> Signals:
     #: the leaves that held text: no number, which the plot says instead of "no value"
     texts: set[tuple[str, str]] = set()
     #: (topic, leaf) -> whether a null there is an absent optional field (else an infinite real), and
-    #: whether that field holds text when present (an optional string never sent is no number either)
-    null_meaning: dict[tuple[str, str], tuple[bool, bool]] = {}
+    #: whether that field holds text when present (an optional string never sent is no number either),
+    #: and whether it is one of the nulls before a memory family's first member
+    null_meaning: dict[tuple[str, str], tuple[bool, bool, bool]] = {}
     stays: dict[str, list[tuple[float, str]]] = {}
     #: each topic's leaves that its messages have held: one that a later message lacks (an optional
     #: field withdrawn, an array sent shorter) has no value from then on, a gap until it comes back
@@ -494,9 +513,14 @@ def read_signals(path: Path, names: list[str]) -> Signals:
                     meaning = null_meaning.get((topic, raw))
                     if meaning is None:
                         schema = channels[topic][1]
-                        text = _present_branch(_leaf_schema(schema, raw))
-                        is_text = isinstance(text, dict) and text.get("type") == "string"
-                        meaning = null_meaning[(topic, raw)] = (_null_is_absent(schema, raw), is_text)
+                        if _is_padding(schema, raw):
+                            meaning = null_meaning[(topic, raw)] = (True, False, True)
+                        else:
+                            text = _present_branch(_leaf_schema(schema, raw))
+                            is_text = isinstance(text, dict) and text.get("type") == "string"
+                            meaning = null_meaning[(topic, raw)] = (_null_is_absent(schema, raw), is_text, False)
+                    if meaning[2]:  # before a memory family's first member: no element of the spec
+                        continue
                     if meaning[1]:
                         texts.add(key)
                         continue
