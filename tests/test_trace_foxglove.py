@@ -1,5 +1,5 @@
 """Traces open in Foxglove: every topic and every field of a message can be named in a message path,
-with the leading `/` of ROS's and Foxglove's topics, and traces of an earlier earl are still read.
+and every channel's JSON schema is one Foxglove's reader of JSON channels takes.
 
 The rules are Foxglove's, written here from its sources, not from earl's code:
 
@@ -7,7 +7,10 @@ The rules are Foxglove's, written here from its sources, not from earl's code:
   `packages/studio-base/src/components/MessagePathSyntax/grammar.ne` of foxglove/studio): a topic is
   ids joined by `/` (`/some/topic`, an id being `[a-zA-Z0-9_]+`) or any text in double quotes with `\\"`
   and `\\\\` escaped (`"/foo.bar".baz`); then `.name` steps, a name being an id, each followed by at most
-  one index `[N]` ("Nested arrays (arrays of arrays) are not supported by message path syntax").
+  one index `[N]` ("Nested arrays (arrays of arrays) are not supported by message path syntax");
+- JSON schemas (`packages/mcap-support/src/parseJsonSchema.ts` of foxglove/studio): the root and every
+  object are `"type": "object"` with `properties`; each property has one `type` of boolean, string,
+  number, integer, object or array, and an array's `items` one of those but array.
 """
 
 from __future__ import annotations
@@ -89,6 +92,30 @@ def field_paths(value: Any, prefix: str = "") -> list[tuple[str, Any]]:
     return [(prefix, value)]
 
 
+# ---------------------------------------------------------------- Foxglove's reader of JSON schemas
+SCALARS = {"boolean", "string", "number", "integer"}
+
+
+def assert_foxglove_takes(schema: Any, where: str) -> None:
+    assert isinstance(schema, dict) and schema.get("type") == "object", f"{where}: not an object schema"
+    properties = schema.get("properties")
+    assert isinstance(properties, dict), f"{where}: an object without `properties`"
+    for name, field in properties.items():
+        here = f"{where}.{name}"
+        assert isinstance(field, dict) and "oneOf" not in field and "anyOf" not in field, here
+        kind = field.get("type")
+        if kind == "object":
+            assert_foxglove_takes(field, here)
+        elif kind == "array":
+            items = field.get("items")
+            assert isinstance(items, dict), f"{here}: an array without `items`"
+            assert items.get("type") in SCALARS | {"object"}, f"{here}: array items of type {items.get('type')!r}"
+            if items.get("type") == "object":
+                assert_foxglove_takes(items, f"{here}[]")
+        else:
+            assert kind in SCALARS, f"{here}: type {kind!r}"
+
+
 def channels_and_messages(path: Path) -> tuple[dict[str, Any], dict[str, list[Any]]]:
     """Each topic's channel (with its schema's text and encodings) and its messages, decoded."""
     with open(path, "rb") as stream:
@@ -118,18 +145,18 @@ def run_earl(*arguments: str | Path) -> subprocess.CompletedProcess[str]:
 def test_every_topic_and_field_of_the_flagship_trace_is_a_foxglove_message_path(tmp_path: Path) -> None:
     """A trace of the pick-and-place system with all memory and all links recorded: every topic starts
     with `/` and is a message path's topic; every leaf of every message is a path of `.field[index]`
-    steps that names that leaf. Memory families (`windingCurrent[K in 1..6]`) were keys
-    `windingCurrent[1]` that no path could name, and the end's iteration counts were keyed by subsystem
-    (`manip/a.cs`): a family is an array, member K at K, and the counts a list."""
+    steps that names that leaf; every schema is one Foxglove reads. Memory families (`windingCurrent[K
+    in 1..6]`) were keys `windingCurrent[1]` that no path could name: they are arrays, member K at K."""
     trace = tmp_path / "run.mcap"
     ran = run_earl("run", PICK_AND_PLACE, "--duration", "0.3s", "--trace", trace, "--record-memory", "all")
     assert ran.returncode == 0, ran.stderr
     channels, messages = channels_and_messages(trace)
     assert {"/earl/run", "/manip/a.cs/memory", "/manip/a.cs/fsm", "/link/task,manip"} <= set(channels)
-    for topic, (message_encoding, schema_encoding, _) in channels.items():
+    for topic, (message_encoding, schema_encoding, schema) in channels.items():
         assert topic.startswith("/"), topic
         assert (message_encoding, schema_encoding) == ("json", "jsonschema"), topic
         assert parse_path(quote_topic(topic)) == (topic, []), topic
+        assert_foxglove_takes(schema, topic)
         assert messages[topic], f"{topic} has no message"
         for message in messages[topic]:
             for path, leaf in field_paths(message):
@@ -175,25 +202,28 @@ f/a {
 """
 
 
-def test_memory_families_are_arrays_indexed_as_the_spec_counts(tmp_path: Path) -> None:
+def test_memory_families_are_arrays_indexed_as_the_spec_counts_and_arrays_of_arrays_stay_out_of_the_schema(
+    tmp_path: Path,
+) -> None:
     """A family from 0 is an array from its first element, one from 2 has two nulls before it (in the
     schema's `prefixItems`), and `earl plot` of `fromTwo[*]` draws members 2 and 3, not the nulls. A
-    family of arrays is an array of arrays: in the messages, left out of the schema (Foxglove refuses
-    a channel whose schema has one), and still plotted by earl."""
+    family of arrays and a `double[2][2]` are arrays of arrays: in the messages, left out of the schema
+    (Foxglove refuses a channel whose schema has one), and still plotted by earl."""
     (tmp_path / "system.earl").write_text(FAMILIES)
     trace = tmp_path / "f.mcap"
     ran = run_earl("run", tmp_path, "--duration", "0.05s", "--trace", trace, "--record-memory", "all")
     assert ran.returncode == 0, ran.stderr
     channels, messages = channels_and_messages(trace)
     _, _, schema = channels["/f/a.cs/memory"]
-    assert "rows" not in schema["properties"] and schema["properties"]["fromZero"]["items"] == {"type": "number"}
+    assert_foxglove_takes(schema, "memory")
+    assert set(schema["properties"]) == {"fromZero", "fromTwo", "far"}
     assert schema["properties"]["fromTwo"]["prefixItems"] == [{"type": "null"}] * 2
     last = messages["/f/a.cs/memory"][-1]
     assert last["fromZero"] == [0.0, 1.5] and last["fromTwo"] == [None, None, 2.0, 3.0]
-    assert last["rows"] == [None, [1.0, 2.0], [1.0, 2.0]]
-    signals = read_signals(trace, ["f/a.cs.fromTwo[*]", "f/a.cs.rows[2][1]", "f/a.cs.far"])
-    assert [series.name for series in signals.series] == ["fromTwo[2]", "fromTwo[3]", "rows[2][1]", "far"]
-    assert signals.series[2].values[-1] == 2.0
+    assert last["rows"] == [None, [1.0, 2.0], [1.0, 2.0]] and last["grid"] == [[1.0, 2.0], [3.0, 4.0]]
+    signals = read_signals(trace, ["f/a.cs.fromTwo[*]", "f/a.cs.grid[1][0]", "f/a.cs.rows[2][1]", "f/a.cs.far"])
+    assert [series.name for series in signals.series] == ["fromTwo[2]", "fromTwo[3]", "grid[1][0]", "rows[2][1]", "far"]
+    assert signals.series[2].values[-1] == 3.0 and signals.series[3].values[-1] == 2.0
     assert not signals.empty  # `far`, an infinite real, had a value: no optional field never sent
 
 

@@ -417,10 +417,18 @@ def test_a_null_leaf_of_a_trace_is_a_leaf_the_reader_tells_apart_by_the_schema()
     assert not _null_is_absent(schema, "position[1]") and not _null_is_absent(schema, "log[2]")
     assert not _null_is_absent(schema, "pose.x")
     assert _null_is_absent(schema, "spare") and _null_is_absent(schema, "pose") and _null_is_absent(None, "x")
-    # a memory family is an array whose elements before its first member are null (`prefixItems`)
+    # as earl writes them now, for Foxglove: an optional field is its type, left out of `required`, and a
+    # memory family an array whose elements before its first member are null (`prefixItems`)
+    pose = {"type": "object", "properties": {"x": {"type": "number"}}, "required": ["x"]}
     family = {"type": "array", "items": {"type": "number"}, "prefixItems": [{"type": "null"}]}
-    schema = {"type": "object", "properties": {"log": family, "gain": {"type": "number"}}}
-    assert not _null_is_absent(schema, "log[2]") and not _null_is_absent(schema, "gain")
+    schema = {
+        "type": "object",
+        "properties": {"spare": {"type": "number"}, "pose": pose, "log": family, "gain": {"type": "number"}},
+        "required": ["log", "gain"],
+    }
+    assert _null_is_absent(schema, "spare") and _null_is_absent(schema, "pose")
+    assert not _null_is_absent(schema, "pose.x") and not _null_is_absent(schema, "log[2]")
+    assert not _null_is_absent(schema, "gain")
     assert _is_padding(schema, "log[0]") and not _is_padding(schema, "log[1]") and not _is_padding(schema, "gain")
 
 

@@ -49,14 +49,18 @@ from earl.runtime import trace_topics
 from earl.runtime.events import Fault, MessageWriter, Recorder
 from earl.runtime.values import TypeSystem, json_schema, to_json
 
+# Foxglove's reader of JSON schemas takes one `type` per field and an object's `properties` (see
+# `values.json_schema`): a field that may be null (`from` before the first state) is its type, and
+# left out of `required`.
 _STATE_SCHEMA = {
     "type": "object",
     "title": "earl.StateChange",
     "properties": {
-        "from": {"type": ["string", "null"]},
+        "from": {"type": "string", "description": "null at the first state"},
         "to": {"type": "string"},
-        "transition": {"type": ["string", "null"]},
+        "transition": {"type": "string", "description": "null at the first state"},
     },
+    "required": ["to"],
 }
 _BEHAVIOUR_SCHEMA = {
     "type": "object",
@@ -68,6 +72,7 @@ _BEHAVIOUR_SCHEMA = {
         "iterations": {"type": "integer"},
         "reason": {"type": "string"},
     },
+    "required": ["event", "state", "behaviour"],
 }
 _FAULT_SCHEMA = {
     "type": "object",
@@ -77,8 +82,28 @@ _FAULT_SCHEMA = {
         for name in ("subsystem", "kind", "message", "state", "behaviour", "function", "traceback")
     },
 }
-_RUN_SCHEMA = {"type": "object", "title": "earl.Run"}
-
+#: the start message's settings and the end message's counts; `parameters` (the values given with
+#: --param, by name) has no fixed fields, so it is left out, as a field of no fixed type must be
+_RUN_SCHEMA = {
+    "type": "object",
+    "title": "earl.Run",
+    "properties": {
+        "event": {"type": "string", "enum": ["start", "end"]},
+        "earl": {"type": "string"},
+        "system": {"type": "string"},
+        "seed": {"type": "integer"},
+        "realtime": {"type": "boolean"},
+        "faults": {"type": "integer"},
+        "iterations": {
+            "type": "array",
+            "items": {
+                "type": "object",
+                "properties": {"subsystem": {"type": "string"}, "iterations": {"type": "integer"}},
+            },
+        },
+    },
+    "required": ["event"],
+}
 
 #: a member of a memory family, as the runtime keys it: `windingCurrent[3]`
 _MEMBER = re.compile(r"(\w+)\[(\d+)\]\Z")
@@ -94,8 +119,8 @@ class MemoryLayout:
         families: dict[str, dict[int, str]] = {}
         #: each field with whether it is a family, in declaration order
         order: list[tuple[str, bool]] = []
-        #: each field's schema (a family's: its members')
-        schemas: dict[str, dict[str, Any]] = {}
+        #: each field's schema (a family's: its members'), None for one Foxglove cannot be told
+        schemas: dict[str, dict[str, Any] | None] = {}
         for key, data_type in memory_types.items():
             member = _MEMBER.match(key)
             if member is None:
@@ -111,7 +136,7 @@ class MemoryLayout:
         self.plan: list[tuple[str, str | list[str | None]]] = []
         self.properties: dict[str, Any] = {}
         for name, family in order:
-            schema: dict[str, Any] | None = schemas[name]
+            schema = schemas[name]
             if family:
                 members = families[name]
                 first, last = min(members), max(members)
@@ -415,14 +440,15 @@ class TraceWriter(Recorder):
             self._channels[topic] = None
             return None
         data_type = self.link_types.get(link)
-        schema: dict[str, Any] = {"type": "object"}
+        schema: dict[str, Any] = {"type": "object", "properties": {}}
         name = "earl.Message"
         if data_type is not None:
             inner = json_schema(self.types, data_type)
-            if inner.get("type") == "object":
+            if inner is not None and inner["type"] == "object":
                 schema, name = inner, str(inner.get("title", name))
             else:
-                schema = {"type": "object", "properties": {"value": inner}}
+                value = {} if inner is None else {"value": inner}
+                schema = {"type": "object", "properties": value, "required": list(value)}
                 name = f"earl.{type(data_type).__name__}.{json.dumps(inner, sort_keys=True)}"
         metadata = {"link": link, "source": self.link_sources.get(link, "")}
         return self._channel(topic, name, schema, metadata, wrap=True)

@@ -313,9 +313,10 @@ def _null_is_absent(schema: Any, leaf: str) -> bool:
     """Whether a null at `leaf` of a message (`ball.note`, `log[2]`, `value[0]`) is an optional field
     that was absent, rather than an infinite real: JSON writes both as null, and only the channel's
     schema tells them apart. A null that the schema does not show to be a real (no schema, or an
-    optional real, whose absence is the likelier) counts as absent."""
-    found = _leaf_schema(schema, leaf)
-    if not isinstance(found, dict):
+    optional real, whose absence is the likelier) counts as absent. An optional field is one its
+    object's `required` leaves out; earlier traces wrote it `anyOf: [T, null]`."""
+    found, optional = _leaf_schema(schema, leaf)
+    if optional or not isinstance(found, dict):
         return True
     options = found.get("anyOf", [])
     if any(isinstance(option, dict) and option.get("type") == "null" for option in options):
@@ -326,18 +327,20 @@ def _null_is_absent(schema: Any, leaf: str) -> bool:
 def _is_padding(schema: Any, leaf: str) -> bool:
     """Whether `leaf` is one of the nulls before a memory family's first member (`windingCurrent[0]` of
     `windingCurrent[K in 1..6]`): no value of the run, which the schema's `prefixItems` say."""
-    found = _leaf_schema(schema, leaf)
+    found, _ = _leaf_schema(schema, leaf)
     return isinstance(found, dict) and found.get("type") == "null"
 
 
-def _leaf_schema(schema: Any, leaf: str) -> Any:
-    """The part of a channel's schema for `leaf` of its messages; None when the schema does not show it."""
+def _leaf_schema(schema: Any, leaf: str) -> tuple[Any, bool]:
+    """The part of a channel's schema for `leaf` of its messages (None when the schema does not show
+    it), and whether that leaf is an optional field (one its object's `required` list leaves out)."""
     current = schema
     rest = leaf
+    optional = False
     while rest:
         current = _present_branch(current)
         if not isinstance(current, dict):
-            return None
+            return None, False
         properties = current.get("properties")
         if isinstance(properties, dict):
             # in earlier traces a memory family's member is one property, `log[2]`: the longest name that starts `rest`
@@ -347,17 +350,19 @@ def _leaf_schema(schema: Any, leaf: str) -> Any:
                 default=None,
             )
             if name is None:
-                return None
+                return None, False
+            required = current.get("required")
+            optional = isinstance(required, list) and name not in required
             current, rest = properties[name], rest[len(name) :].removeprefix(".")
         else:
             index = re.match(r"\[(\d+)\]", rest)
             if index is None:
-                return None
+                return None, False
             # the nulls before a memory family's first member are described apart, in `prefixItems`
             position, before = int(index.group(1)), current.get("prefixItems")
             current = before[position] if isinstance(before, list) and position < len(before) else current.get("items")
-            rest = rest[index.end() :].removeprefix(".")
-    return current
+            optional, rest = False, rest[index.end() :].removeprefix(".")
+    return current, optional
 
 
 def _present_branch(schema: Any) -> Any:
@@ -516,7 +521,7 @@ def read_signals(path: Path, names: list[str]) -> Signals:
                         if _is_padding(schema, raw):
                             meaning = null_meaning[(topic, raw)] = (True, False, True)
                         else:
-                            text = _present_branch(_leaf_schema(schema, raw))
+                            text = _present_branch(_leaf_schema(schema, raw)[0])
                             is_text = isinstance(text, dict) and text.get("type") == "string"
                             meaning = null_meaning[(topic, raw)] = (_null_is_absent(schema, raw), is_text, False)
                     if meaning[2]:  # before a memory family's first member: no element of the spec

@@ -516,8 +516,16 @@ def to_json(value: Value) -> Any:
     return value
 
 
-def json_schema(types: TypeSystem, data_type: DataType) -> dict[str, Any]:
-    """A JSON Schema for a data type, so that Foxglove can show the fields of a trace message."""
+def json_schema(types: TypeSystem, data_type: DataType) -> dict[str, Any] | None:
+    """A JSON Schema for a data type, so that Foxglove can show the fields of a trace message; None
+    for a value whose shape Foxglove cannot be told.
+
+    Only what Foxglove's reader of JSON channels takes (its `parseJsonSchema`): each field one
+    `type` of boolean, string, number, integer, object (with `properties`) or array of one of the
+    others. So an optional field is described as its value when present and left out of `required`
+    (its absence is written as null); an array of arrays (`double[3][3]`), which that reader refuses
+    along with the whole channel and no message path can index, is left out of the schema (its
+    values are in the messages all the same)."""
     resolved = types.resolve(data_type)
     if isinstance(resolved, PrimitiveType):
         if resolved.name == "boolean":
@@ -530,7 +538,10 @@ def json_schema(types: TypeSystem, data_type: DataType) -> dict[str, Any]:
             return {"type": "array", "items": {"type": "integer"}}
         return {"type": "integer"}
     if isinstance(resolved, ArrayType):
-        schema: dict[str, Any] = {"type": "array", "items": json_schema(types, resolved.element)}
+        items = json_schema(types, resolved.element)
+        if items is None or items["type"] == "array":
+            return None
+        schema: dict[str, Any] = {"type": "array", "items": items}
         size = _fixed_size(resolved)
         if size is not None:
             schema["minItems"] = schema["maxItems"] = size
@@ -538,12 +549,13 @@ def json_schema(types: TypeSystem, data_type: DataType) -> dict[str, Any]:
     properties = {}
     for f in resolved.fields:
         inner = json_schema(types, f.data_type)
-        properties[f.name] = {"anyOf": [inner, {"type": "null"}]} if f.optional else inner
+        if inner is not None:
+            properties[f.name] = inner
     return {
         "type": "object",
         "title": resolved.name,
         "properties": properties,
-        "required": [f.name for f in resolved.fields if not f.optional],
+        "required": [f.name for f in resolved.fields if not f.optional and f.name in properties],
     }
 
 
