@@ -267,3 +267,79 @@ def test_a_trace_of_an_earlier_earl_is_read_as_before(tmp_path: Path) -> None:
     assert found == [("level[1]", [1.0, 2.0, 3.0]), ("level[2]", [-1.0, -2.0, -3.0])]
     plot = run_earl("plot", trace, "--signal", "s/a.cs.level[1]", "-o", tmp_path / "old.png")
     assert plot.returncode == 0 and (tmp_path / "old.png").stat().st_size > 0, plot.stderr
+
+
+TREES = """\
+system trees
+
+struct Tree {
+    label: double
+    children: Tree[]
+    spare: double?
+}
+
+treeRobot/r {
+    t/a
+    u/a
+}
+
+t/a {
+    cs {
+        period 10 ms
+        out/ob: Tree
+        send/pf(-> out/ob) = python "trees:send"
+        go/pp = true
+        run/bb {
+            tf = {} then {send/pf}
+            tc = go/pp
+        }
+        fsm {
+            initial run
+            state run: run/bb
+            run -> run when go/pp
+        }
+    }
+}
+
+u/a {
+    cs {
+        period 10 ms
+        in/ib: Tree
+        go/pp = true
+        run/bb {
+            tf = {}
+            tc = go/pp
+        }
+        fsm {
+            initial run
+            state run: run/bb
+            run -> run when go/pp
+        }
+    }
+}
+
+link t,u: t/a.cs.out -> u/a.cs.in
+"""
+
+SEND_TREE = """\
+def send(inputs, outputs, context):
+    outputs.out = {"label": 1.0, "children": [{"label": 2.0, "children": [], "spare": None}], "spare": 3.0}
+"""
+
+
+def test_a_struct_inside_itself_is_traced_and_its_schema_ends(tmp_path: Path) -> None:
+    """`children: Tree[]` of `Tree` (a type may contain itself through a variable array): writing the
+    link's schema recursed without end, a RecursionError traceback when the run started. The recursive
+    field is left out of the schema, which Foxglove reads; its values are in the messages."""
+    (tmp_path / "system.earl").write_text(TREES)
+    (tmp_path / "trees.py").write_text(SEND_TREE)
+    trace = tmp_path / "t.mcap"
+    ran = run_earl("run", tmp_path, "--duration", "0.05s", "--trace", trace)
+    assert ran.returncode == 0 and "Traceback" not in ran.stderr, ran.stderr
+    channels, messages = channels_and_messages(trace)
+    _, _, schema = channels["/link/t,u"]
+    assert_foxglove_takes(schema, "/link/t,u")
+    assert set(schema["properties"]) == {"label", "spare"} and schema["required"] == ["label"]
+    assert messages["/link/t,u"][-1]["children"][0]["label"] == 2.0
+    [series] = read_signals(trace, ["t/a.cs.out.children[0].label"]).series
+    assert series.values[-1] == 2.0

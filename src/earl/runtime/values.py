@@ -522,10 +522,16 @@ def json_schema(types: TypeSystem, data_type: DataType) -> dict[str, Any] | None
 
     Only what Foxglove's reader of JSON channels takes (its `parseJsonSchema`): each field one
     `type` of boolean, string, number, integer, object (with `properties`) or array of one of the
-    others. So an optional field is described as its value when present and left out of `required`
-    (its absence is written as null); an array of arrays (`double[3][3]`), which that reader refuses
-    along with the whole channel and no message path can index, is left out of the schema (its
-    values are in the messages all the same)."""
+    others, written out in place. So an optional field is described as its value when present and
+    left out of `required` (its absence is written as null); an array of arrays (`double[3][3]`),
+    which that reader refuses along with the whole channel and no message path can index, and a
+    struct inside itself (`children: Tree[]` of `Tree`), which no schema written out in place can
+    end, are left out of the schema (their values are in the messages all the same)."""
+    return _json_schema(types, data_type, frozenset())
+
+
+def _json_schema(types: TypeSystem, data_type: DataType, enclosing: frozenset[str]) -> dict[str, Any] | None:
+    """`json_schema`, inside the structs named `enclosing`."""
     resolved = types.resolve(data_type)
     if isinstance(resolved, PrimitiveType):
         if resolved.name == "boolean":
@@ -538,7 +544,7 @@ def json_schema(types: TypeSystem, data_type: DataType) -> dict[str, Any] | None
             return {"type": "array", "items": {"type": "integer"}}
         return {"type": "integer"}
     if isinstance(resolved, ArrayType):
-        items = json_schema(types, resolved.element)
+        items = _json_schema(types, resolved.element, enclosing)
         if items is None or items["type"] == "array":
             return None
         schema: dict[str, Any] = {"type": "array", "items": items}
@@ -546,9 +552,11 @@ def json_schema(types: TypeSystem, data_type: DataType) -> dict[str, Any] | None
         if size is not None:
             schema["minItems"] = schema["maxItems"] = size
         return schema
+    if resolved.name in enclosing:
+        return None
     properties = {}
     for f in resolved.fields:
-        inner = json_schema(types, f.data_type)
+        inner = _json_schema(types, f.data_type, enclosing | {resolved.name})
         if inner is not None:
             properties[f.name] = inner
     return {
