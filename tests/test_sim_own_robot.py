@@ -288,3 +288,56 @@ def test_a_sensor_a_subsystem_is_mapped_to_is_checked_before_the_run_and_read_du
         assert plant.sensor("angle2") == (pytest.approx(plant.joint_position("elbow")),)
     finally:
         simulation.close()
+
+
+def test_a_map_for_a_member_this_run_leaves_out_is_left_alone(tmp_path: Path) -> None:
+    """An environment written for up to three joints maps each member by its number; with J = 2 no
+    `motor[3]/re` runs and nothing looks its map up, so the run is not refused (docs/simulation.md)."""
+    copy = pendulum_copy(
+        tmp_path,
+        "swinging/environment.py",
+        old='    plant.map_actuator("arm/a.motor[K]/re", "motor{K}", encoder=True)',
+        new=('    for k in (1, 2, 3):\n        plant.map_actuator(f"arm/a.motor[{k}]/re", f"motor{k}", encoder=True)'),
+    )
+    simulation = earl.simulate(earl.load(copy))
+    try:
+        simulation.advance_to(0.01)
+        assert simulation.faults == []
+        plant: Any = simulation.environment
+        assert plant.actuator_of(simulation.scheduler.network.by_name["arm/a.motor[2]/re"].context) == "motor2"
+    finally:
+        simulation.close()
+
+
+def test_a_map_on_a_virtual_effector_is_checked_and_looked_up_as_a_real_one_s(tmp_path: Path) -> None:
+    """Every subsystem's functions get `context.environment`: a virtual effector may ask `actuator_of` too."""
+    mapped = '    plant.map_actuator("arm/a.joint[K]/ve", "{name}")\n    return plant'
+    environment = "swinging/environment.py"
+    copy = pendulum_copy(tmp_path, environment, old="    return plant", new=mapped.format(name="motor{K}"))
+    simulation = earl.simulate(earl.load(copy))
+    try:
+        simulation.advance_to(0.01)
+        plant: Any = simulation.environment
+        assert plant.actuator_of(simulation.scheduler.network.by_name["arm/a.joint[2]/ve"].context) == "motor2"
+    finally:
+        simulation.close()
+    copy = pendulum_copy(tmp_path / "missing", environment, old="    return plant", new=mapped.format(name="drive{K}"))
+    with pytest.raises(EarlError) as refused:
+        earl.simulate(earl.load(copy))
+    [diagnostic] = refused.value.diagnostics
+    assert diagnostic.message.startswith("`arm/a.joint[1]/ve`, `arm/a.joint[2]/ve` act on the actuator `drive1`")
+    assert diagnostic.location is not None and diagnostic.location.line == spec_line(copy, "joint[K in 1..J]/ve {")
+
+
+def test_a_name_in_braces_that_cannot_be_written_is_said_once_at_the_effector(tmp_path: Path) -> None:
+    # `{K[0]}` subscripts the number K: said once, though `encoder=True` maps the name twice
+    copy = pendulum_copy(tmp_path, "swinging/environment.py", old='"motor{K}"', new='"motor{K[0]}"')
+    with pytest.raises(EarlError) as refused:
+        earl.simulate(earl.load(copy))
+    [diagnostic] = refused.value.diagnostics
+    assert diagnostic.code == "EARL-X021"
+    assert diagnostic.message == (
+        "the actuator `motor{K[0]}` mapped for `arm/a.motor[1]/re` cannot be written from its parameters "
+        "('int' object is not subscriptable); in braces go the names of its parameters: J, K"
+    )
+    assert diagnostic.location is not None and diagnostic.location.line == spec_line(copy, "motor[K in 1..J]/re {")

@@ -231,7 +231,7 @@ class MujocoPlant:
     # ------------------------------------------------------------ what each real effector and receptor acts on
 
     def map_actuator(self, subsystem: str, actuator: str, *, encoder: bool = False) -> None:
-        """Say which actuator the real effector `subsystem` acts on, so that a missing one is refused before
+        """Say which actuator the real effector (or any subsystem) `subsystem` acts on, so that a missing one is refused before
         the run (`bind`) instead of failing in every iteration; its functions ask `actuator_of(context)`.
 
         `subsystem` is named as the run names it, a family with its index: `arm/a.motor[K]/re`;
@@ -243,7 +243,7 @@ class MujocoPlant:
             self._add_map(_Map(subsystem, "encoder", actuator))
 
     def map_sensor(self, subsystem: str, sensor: str) -> None:
-        """Say which of the model's `<sensor>`s the real receptor (or effector) `subsystem` reads, as
+        """Say which of the model's `<sensor>`s the real receptor (or any subsystem) `subsystem` reads, as
         `map_actuator` does for an actuator; its functions ask `sensor_of(context)` and read `sensor(name)`."""
         self._add_map(_Map(subsystem, "sensor", sensor))
 
@@ -288,17 +288,22 @@ class MujocoPlant:
     def _unmet_maps(self, system: System) -> list[Diagnostic]:
         """Each map's subsystems whose actuator (encoder, sensor) the model lacks, found by `_name_of`, the
         lookup their functions make during the run, with the parameters they are given then; and each map
-        that names no real effector or receptor of the system."""
-        members = _real_members(system)
+        that names no subsystem of the system but one close to a name it has. A map for a member of a family
+        that this run's parameters leave out (`motor[6]/re` of `motor[K in 1..N]/re` with N = 3) is no
+        slip: nothing looks it up, as nothing would with N = 6."""
+        members = _members(system, real_only=False)
         self._resolved.clear()
         problems: list[Diagnostic] = []
         said: set[str] = set()  # a map that names no subsystem is said once, not for its actuator and encoder
+        unwritten: set[tuple[str, str]] = set()  # so is a name that cannot be written (`encoder=True` maps it twice)
         for found in self._maps:
             mapped = [member for member in members if found.matches(member.shown, member.parameters)]
             if found.subsystem in said:
                 continue
             if not mapped:
                 # a map for a subsystem of another system may do no harm; one close to a name of this one is a slip
+                if any(found.names_beyond(member.shown, member.parameters) for member in members):
+                    continue
                 names = list(dict.fromkeys([member.family for member in members] + [m.shown for m in members]))
                 if did_you_mean(found.subsystem, names) is not None:
                     said.add(found.subsystem)
@@ -317,7 +322,9 @@ class MujocoPlant:
                 try:
                     name = self._name_of(member.shown, member.parameters, found.kind)
                 except PlantError as error:
-                    problems.append(Diagnostic(Severity.ERROR, str(error), member.location, code="EARL-X021"))
+                    if (found.subsystem, found.template) not in unwritten:
+                        unwritten.add((found.subsystem, found.template))
+                        problems.append(Diagnostic(Severity.ERROR, str(error), member.location, code="EARL-X021"))
                     break
                 if name not in self._known(found.kind):
                     missing.append((member, name))
@@ -360,7 +367,7 @@ class MujocoPlant:
         return Diagnostic(
             Severity.ERROR,
             f"the environment maps `{found.subsystem}` to `{found.template}`, but the system has "
-            f"no real effector or receptor of that name (it has: {', '.join(families) or 'none'})",
+            f"no subsystem of that name (it has: {', '.join(families) or 'none'})",
             None,
             code="EARL-X021",
             hint=did_you_mean(found.subsystem, names),
@@ -623,27 +630,45 @@ class _Map:
 
         return re.sub(r"\[([A-Za-z_]\w*)\]", index, self.subsystem) == subsystem
 
+    def names_beyond(self, subsystem: str, parameters: Mapping[str, Any]) -> bool:
+        """`arm/a.motor[6]/re` names a member of the family of `arm/a.motor[2]/re`, by a number that may be
+        outside the family's range in this run (each `[NAME]` by its parameter, as `matches`)."""
+        if not re.search(r"\[\d+\]", self.subsystem):
+            return False
+
+        def index(found: re.Match[str]) -> str:
+            value = parameters.get(found[1])
+            return found[0] if value is None else f"[{value}]"
+
+        named = re.escape(re.sub(r"\[([A-Za-z_]\w*)\]", index, self.subsystem))
+        return re.fullmatch(re.sub(r"\\\[\d+\\\]", r"\\[\\d+\\]", named), subsystem) is not None
+
     def name_for(self, subsystem: str, parameters: Mapping[str, Any]) -> str:
         try:
             return self.template.format_map(parameters)
-        except (KeyError, IndexError, ValueError, AttributeError) as error:
+        except (KeyError, IndexError, ValueError, AttributeError, TypeError) as error:
+            # what str.format raises for what is in braces (`{Q}`, `{K[0]}`, `{K.x}`, a lone `{`)
             shown = ", ".join(parameters) or "none"
+            reason = f"it has no parameter `{error.args[0]}`" if isinstance(error, KeyError) else str(error)
             raise PlantError(
-                f"the {self.kind} `{self.template}` mapped for `{subsystem}` cannot be written from its parameters "
-                f"({type(error).__name__}: {error}); in braces go the names of its parameters: {shown}"
+                f"the {'actuator' if self.kind == 'encoder' else self.kind} `{self.template}` mapped for "
+                f"`{subsystem}` cannot be written from its parameters ({reason}); in braces go the names of its "
+                f"parameters: {shown}"
             ) from None
 
 
 def _real_families(system: System) -> dict[str, list[_Member]]:
     """The real effectors and receptors, by family (`arm/a.motor[K]/re`; one that is no family by its own name)."""
     families: dict[str, list[_Member]] = {}
-    for member in _real_members(system):
+    for member in _members(system, real_only=True):
         families.setdefault(member.family, []).append(member)
     return families
 
 
-def _real_members(system: System) -> list[_Member]:
-    """The real effectors and receptors of the (expanded) system, each with the parameters its functions get."""
+def _members(system: System, *, real_only: bool) -> list[_Member]:
+    """The subsystems of the (expanded) system, each with the parameters its functions get: the real effectors
+    and receptors alone for the periods the plant must divide; every subsystem for the maps, since any of them
+    is given `context.environment` and may ask `actuator_of` or `sensor_of`."""
     from earl.model.kinds import Kind
     from earl.model.text import subsystem_name
     from earl.runtime.parameters import agent_parameters, subsystem_parameters
@@ -652,7 +677,7 @@ def _real_members(system: System) -> list[_Member]:
     for agent in system.agents:
         inherited = agent_parameters(system, agent)
         for subsystem in agent.subsystems:
-            if subsystem.kind not in (Kind.REAL_EFFECTOR, Kind.REAL_RECEPTOR):
+            if real_only and subsystem.kind not in (Kind.REAL_EFFECTOR, Kind.REAL_RECEPTOR):
                 continue
             shown = subsystem_name(agent, subsystem)
             index = "" if subsystem.index is None else str(subsystem.index)
