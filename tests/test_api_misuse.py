@@ -6,6 +6,7 @@ text, not crash the checker or go into the run's generated code."""
 
 from __future__ import annotations
 
+import functools
 import re
 from collections.abc import Callable
 from pathlib import Path
@@ -598,6 +599,73 @@ class _ClosesWithWhat:
     def close(self, viewer: object) -> None: ...
 
 
+class _TimeByName:
+    def advance(self, *, time: float) -> None: ...
+
+
+def _passing_the_count(advance: Callable[[Any, float, int], None]) -> Callable[[Any, float], None]:
+    """A decorator whose wrapper earl calls with the time; `functools.wraps` makes it look like `advance`."""
+
+    @functools.wraps(advance)
+    def wrapper(self: Any, time: float) -> None:
+        advance(self, time, len(self.counts))
+
+    return wrapper
+
+
+class _Decorated:
+    def __init__(self) -> None:
+        self.counts: list[int] = []
+
+    @_passing_the_count
+    def advance(self, time: float, count: int) -> None:
+        self.counts.append(count)
+
+
+class _ClosingWidth:
+    """`close` is data here, the gripper's closing width: earl calls no `close` then, and runs."""
+
+    def __init__(self) -> None:
+        self.close = 0.02
+        self.times: list[float] = []
+
+    def advance(self, time: float) -> None:
+        self.times.append(time)
+
+
+class _OpensAViewer:
+    def __init__(self, advance: object) -> None:
+        self.closed = 0
+        self.advance = advance
+
+    def close(self) -> None:
+        self.closed += 1
+
+
+def test_a_decorated_advance_is_checked_as_the_wrapper_earl_calls() -> None:
+    environment = _Decorated()
+    with earl.simulate(earl.loads(TEXT), environment=environment) as simulation:
+        simulation.advance_to(0.02)
+    assert environment.counts[:3] == [0, 1, 2]
+
+
+def test_an_environment_whose_close_is_data_runs_and_is_not_called() -> None:
+    environment = _ClosingWidth()
+    with earl.simulate(earl.loads(TEXT), environment=environment) as simulation:
+        simulation.advance_to(0.02)
+    assert environment.times[-1] == pytest.approx(0.02) and environment.close == 0.02
+
+
+@pytest.mark.parametrize("advance", [lambda: None, 0.001], ids=["no time", "no method"])
+def test_an_environment_whose_advance_is_refused_is_closed(advance: object) -> None:
+    """What it opened (a viewer) is closed when the run is refused, as when its `bind` refuses."""
+    environment = _OpensAViewer(advance)
+    with pytest.raises(EarlError) as refused:
+        earl.simulate(earl.loads(TEXT), environment=environment)
+    assert [d.code for d in refused.value.diagnostics] == ["EARL-X020"]
+    assert environment.closed == 1
+
+
 class _Fits:
     """Methods as earl calls them, with defaults and *args: all of these fit."""
 
@@ -618,6 +686,8 @@ class _Fits:
         (_NoTime(), "the environment's `advance()` cannot be called as earl calls it, advance(time): too many"),
         (_BindsNothing(), "the environment's `bind()` cannot be called as earl calls it, bind(system): too many"),
         (_ClosesWithWhat(), "the environment's `close(viewer)` cannot be called as earl calls it, close(): missing"),
+        # keyword-only, shown as written: `advance(time)` would look callable as earl calls it
+        (_TimeByName(), "the environment's `advance(*, time)` cannot be called as earl calls it, advance(time): too"),
     ],
 )
 def test_an_environment_object_whose_methods_earl_cannot_call_is_refused_before_the_run(

@@ -499,9 +499,13 @@ def _environment_method(
     what it has under that name cannot be called."""
     method = getattr(environment, name, None)
     if method is not None and not callable(method):
-        message = f"the environment's `{name}` is a {type(method).__name__}, not a method"
-        raise EarlError([Diagnostic(Severity.ERROR, message, location, code="EARL-X020")], sources)
+        raise EarlError([_not_a_method(name, method, location)], sources)
     return method
+
+
+def _not_a_method(name: str, found: object, location: SourceLocation | None) -> Diagnostic:
+    message = f"the environment's `{name}` is a {type(found).__name__}, not a method"
+    return Diagnostic(Severity.ERROR, message, location, code="EARL-X020")
 
 
 #: the environment's optional methods, each with what earl passes it (docs/runtime.md, "The environment")
@@ -510,37 +514,56 @@ _ENVIRONMENT_CALLS = {"bind": ("system",), "advance": ("time",), "close": ()}
 
 def _refuse_unfit_methods(environment: object, location: SourceLocation | None, sources: SourceMap) -> None:
     """Before the run, EARL-X020 for an environment method earl could not call as it will (`advance()`
-    without the time): it would raise a TypeError at the first instant, or `close` only at the end."""
+    without the time): it would raise a TypeError at the first instant, or `close` only at the end. An
+    `advance` or `bind` that is no method is refused too, as earl would call it; a `close` that is data
+    (a gripper's closing width) is left alone, as `Simulation.close` leaves it. What the environment
+    opened (a viewer) is closed before the refusal, as when its `bind` refuses."""
     if environment is None:
         return
     problems = []
     for name, arguments in _ENVIRONMENT_CALLS.items():
-        method = _environment_method(environment, name, location, sources)
-        if method is None:
+        method = getattr(environment, name, None)
+        if method is None or (name == "close" and not callable(method)):
+            continue
+        if not callable(method):
+            problems.append(_not_a_method(name, method, location))
             continue
         try:
-            signature = inspect.signature(method)
+            # the callable earl calls, not the function a decorator wraps (`functools.wraps` sets
+            # `__wrapped__`, which `inspect.signature` follows by default)
+            signature = inspect.signature(method, follow_wrapped=False)
         except (TypeError, ValueError):  # a builtin or extension method that does not say: called as it is
             continue
         try:
             signature.bind(*arguments)
         except TypeError as error:
             shown = f"{name}({', '.join(arguments)})"
-            # as written, without annotations: `advance()`, `close(viewer)`
-            written = ", ".join(
-                str(p.replace(annotation=inspect.Parameter.empty)) for p in signature.parameters.values()
+            # as written (`*` and `/` kept), without annotations: `advance()`, `close(viewer)`, `advance(*, time)`
+            written = signature.replace(
+                parameters=[p.replace(annotation=inspect.Parameter.empty) for p in signature.parameters.values()],
+                return_annotation=inspect.Signature.empty,
             )
             problems.append(
                 Diagnostic(
                     Severity.ERROR,
-                    f"the environment's `{name}({written})` cannot be called as earl calls it, {shown}: {error}",
+                    f"the environment's `{name}{written}` cannot be called as earl calls it, {shown}: {error}",
                     location,
                     code="EARL-X020",
                     hint=f"define it as `def {name}(self{''.join(', ' + a for a in arguments)})`",
                 )
             )
     if problems:
+        _close_refused(environment)
         raise EarlError(problems, sources)
+
+
+def _close_refused(environment: object) -> None:
+    """The environment's `close()`, if it has one, when the run will not start: what it opened (a renderer,
+    a video) is finished now; its own error would hide why the run was refused."""
+    close = getattr(environment, "close", None)
+    if callable(close):
+        with contextlib.suppress(Exception):
+            close()
 
 
 def _bind(environment: object, expanded: System, location: SourceLocation | None, sources: SourceMap) -> None:
@@ -552,11 +575,7 @@ def _bind(environment: object, expanded: System, location: SourceLocation | None
     try:
         bind(expanded)
     except Exception as error:
-        # the run will not start: what the environment opened (a renderer, a video) is finished now
-        close = getattr(environment, "close", None)
-        if callable(close):
-            with contextlib.suppress(Exception):
-                close()
+        _close_refused(environment)
         if isinstance(error, EarlError):  # located by the environment, at the spec's lines
             for diagnostic in error.diagnostics:
                 # what is at no line of the spec (a map of the environment's own) is said where it is named
