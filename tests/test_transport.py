@@ -305,6 +305,31 @@ def test_listeners_on_different_sockets_of_one_port_are_two_endpoints(tmp_path: 
     assert [process.listen for process in read_deployment(path).processes] == [first, second]
 
 
+@pytest.mark.parametrize(
+    ("first", "second"),
+    [
+        ("tcp/0.0.0.0:7451", "tcp/192.168.1.20:7451"),  # each computer has its own port 7451
+        ("tcp/[::]:7451", "tcp/[::]:7451"),
+        ("tcp/127.0.0.1:7451", "tcp/127.0.0.1:7451"),
+    ],
+)
+def test_processes_on_two_hosts_may_listen_on_one_port(tmp_path: Path, first: str, second: str) -> None:
+    path = tmp_path / "deploy.toml"
+    path.write_text(
+        f"[[process]]\nagents = ['a']\nlisten = '{first}'\nhost = 'robot'\n"
+        f"[[process]]\nagents = ['b']\nlisten = '{second}'\nhost = 'laptop'\n"
+    )
+    assert [process.host for process in read_deployment(path).processes] == ["robot", "laptop"]
+    # on one host, by its name in another case or by this machine's names, they clash
+    for one, other in (("robot", "ROBOT."), ("localhost", "127.0.0.1")):
+        path.write_text(
+            f"[[process]]\nagents = ['a']\nlisten = '{first}'\nhost = '{one}'\n"
+            f"[[process]]\nagents = ['b']\nlisten = '{second}'\nhost = '{other}'\n"
+        )
+        with pytest.raises(DeploymentError, match=r"cannot both listen on port 7451|the same endpoint"):
+            read_deployment(path)
+
+
 @settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(
     st.lists(

@@ -75,6 +75,17 @@ def is_this_host(host: str) -> bool:
     return name in _this_host_names()
 
 
+def same_host(first: str, second: str) -> bool:
+    """Whether two processes' `host`s are one computer, whose ports they share: the same name (in any case,
+    with or without the final dot), or both this machine. Two names of one other computer (`robot` and its
+    address) cannot be told apart here: they are taken to be two."""
+
+    def plain(host: str) -> str:
+        return host.strip().rstrip(".").lower().strip("[]")
+
+    return plain(first) == plain(second) or (is_this_host(first) and is_this_host(second))
+
+
 @functools.cache
 def _this_host_names() -> frozenset[str]:
     names = {socket.gethostname().lower(), socket.getfqdn().lower().rstrip(".")}
@@ -266,8 +277,8 @@ def read_deployment(path: Path) -> Deployment:
         raise DeploymentError(f"{path}: no `[[process]]` table; each names its `agents` and `listen` endpoint")
     processes: list[ProcessGroup] = []
     seen_agents: dict[str, int] = {}
-    #: each process's `listen` endpoint so far, and the socket it binds
-    seen_endpoints: list[tuple[int, str, Listener]] = []
+    #: each process's `listen` endpoint so far, the socket it binds, and the host it runs on
+    seen_endpoints: list[tuple[int, str, Listener, str]] = []
     for number, table in enumerate(tables, start=1):
         where = f"{path}: process {number}"
         listed: set[str] = set()
@@ -295,8 +306,13 @@ def read_deployment(path: Path) -> Deployment:
         problem = endpoint_problem(listen)
         if problem is not None:
             raise DeploymentError(f"{where}: `listen = {listen!r}`: {problem}")
+        host = table.get("host", "localhost")
+        if not isinstance(host, str) or not host:
+            raise DeploymentError(f"{where}: `host` must be a host name")
         this = listener(listen)
-        for other_number, other, bound in seen_endpoints:
+        for other_number, other, bound, other_host in seen_endpoints:
+            if not same_host(host, other_host):
+                continue  # each computer has its own ports: `0.0.0.0:7451` on one, `192.168.1.20:7451` on another
             why = clash(this, bound)
             if why == "":
                 raise DeploymentError(
@@ -307,14 +323,11 @@ def read_deployment(path: Path) -> Deployment:
                     f"{where}: `{listen}` and process {other_number}'s `{other}` cannot both listen on port "
                     f"{this.port} ({why}); give each its own port"
                 )
-        seen_endpoints.append((number, listen, this))
+        seen_endpoints.append((number, listen, this, host))
         environment = table.get("environment")
-        host = table.get("host", "localhost")
         args = table.get("args", [])
         if environment is not None and not isinstance(environment, bool):
             raise DeploymentError(f"{where}: `environment` must be true or false")
-        if not isinstance(host, str) or not host:
-            raise DeploymentError(f"{where}: `host` must be a host name")
         if not isinstance(args, list) or not all(isinstance(a, str) for a in args):
             raise DeploymentError(f'{where}: `args` must be a list of `earl run` options, e.g. ["--trace", "x.mcap"]')
         for arg in args:

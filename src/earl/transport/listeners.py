@@ -1,4 +1,7 @@
-"""Whether two `listen` endpoints of a deployment would take the same socket of this host.
+"""Whether two `listen` endpoints of a deployment would take the same socket of one host.
+
+Only the endpoints of processes on the same host are compared (`same_host` in deployment.py): each
+computer has its own ports, so `tcp/0.0.0.0:7451` on one and `tcp/192.168.1.20:7451` on another both listen.
 
 Two processes cannot listen where the operating system gives one socket: the second would fail
 as its Zenoh session opens ("Address already in use"). What decides it is the kind of socket the
