@@ -1178,6 +1178,21 @@ def test_a_record_links_pattern_of_run_toml_that_matches_no_link_is_said(tmp_pat
     assert overridden.returncode == 0 and "matches no link" not in overridden.stderr, overridden.stderr
 
 
+def test_record_links_empty_in_run_toml_records_no_link_and_says_nothing_as_docs_runtime_md_advises(
+    tmp_path: Path,
+) -> None:
+    page = " ".join((Path(__file__).parent.parent / "docs" / "runtime.md").read_text(encoding="utf-8").split())
+    advice = page.split("to record no link,", 1)[1].split(";", 1)[0]
+    assert "`record_links = []` in run.toml" in advice and "pattern" not in advice  # a pattern is warned of
+    spec = counter_copy(tmp_path)
+    (spec.parent / "run.toml").write_text("record_links = []\n")
+    trace = tmp_path / "t.mcap"
+    result = earl_cli("run", str(spec.parent), "--duration", "20ms", "--trace", str(trace))
+    assert result.returncode == 0 and "matches no link" not in result.stderr, result.stderr
+    summary = earl_cli("trace", "summary", str(trace))
+    assert "0 messages on links" in summary.stdout, summary.stdout
+
+
 def test_run_toml_s_record_links_are_not_checked_against_the_links_of_some_agents_only() -> None:
     """The example's run.toml names links of every agent; a run of the grip agent has only its own."""
     result = earl_cli("run", str(EXAMPLE), "--agents", "grip/a", "--environment", "none", "--duration", "10ms")

@@ -112,7 +112,7 @@ def register(commands: Any) -> None:
         default=None,
         metavar="PATTERN",
         help="with --trace (or --plot): record only messages on links matching a glob, e.g. 'task,*' "
-        "(repeatable; default: all)",
+        "(repeatable; default: all; to record none, write record_links = [] in run.toml)",
     )
     parser.add_argument(
         "--plot",
