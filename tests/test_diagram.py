@@ -419,6 +419,85 @@ def test_a_family_member_named_without_expand_is_drawn_alone(system: System, tmp
     assert "manip/a.motorController[2]/ve.fsm" in output.read_text(encoding="utf-8")
 
 
+def _nested_families() -> str:
+    """pick_and_place with its manipulator a family of two agents, each holding `motorController[K in 1..N]/ve`."""
+    text = EXAMPLE.read_text(encoding="utf-8")
+    for old, new in [
+        ("\nmanip/a {", "\nmanip[I in 1..2]/a {"),
+        (
+            "link task,manip: task/a.cs.manipulatorCommand -> manip/a.cs.manipulatorCommand",
+            "link task,manip[I in 1..2]: task/a.cs.manipulatorCommand -> manip[I]/a.cs.manipulatorCommand",
+        ),
+        (
+            "link manip,task: manip/a.cs.manipulatorState -> task/a.cs.manipulatorState",
+            "link manip[1],task: manip[1]/a.cs.manipulatorState -> task/a.cs.manipulatorState",
+        ),
+        ("    manip/a\n", "    manip[1]/a\n    manip[2]/a\n"),
+        ("    link task,manip\n", "    link task,manip[I in 1..2]\n"),
+        ("    link manip,task\n", "    link manip[1],task\n"),
+    ]:
+        assert old in text, old
+        text = text.replace(old, new)
+    return text
+
+
+def test_a_target_naming_a_family_inside_a_member_or_a_member_inside_a_family_draws_the_declared_family(
+    tmp_path: Path,
+) -> None:
+    """In a family of agents holding a family of subsystems, a target naming a member of one family and the
+    other family (`manip[2]/a.motorController[K]/ve`) was matched against the expansion, where `[K]` names
+    nothing: exit 2 "no subsystem". It names a family, drawn once as declared; a member of each family is
+    still drawn alone."""
+    spec = tmp_path / "system.earl"
+    spec.write_text(_nested_families(), encoding="utf-8")
+    nested = earl.load(spec)
+    family = "manip[I]/a.motorController[K]/ve"
+    for target in (
+        "manip[2]/a.motorController[K]/ve",
+        "manip[I]/a.motorController[3]/ve",
+        "manip/a.motorController[2]/ve",  # no index: the family of `manip`, as `manip[*]`
+        "manip[*]/a.motorController[02]/ve",
+    ):
+        assert build_diagram(nested, "fsm", target).header == f"stm [FSM] {family}.fsm", target
+        assert f"title: stm [FSM] {family}.fsm" in mermaid_of(Subject(nested), "fsm", target), target
+    behaviour = build_diagram(nested, "activity", "manip[2]/a.motorController[K]/ve.operate/bb")
+    assert behaviour.header.startswith(f"act [Operation] {family}.operate/bb")
+    for member in ("manip[2]/a.motorController[3]/ve", "manip[2]/a.motorController[03]/ve"):
+        drawn = build_diagram(nested, "fsm", member)
+        assert drawn.header == "stm [FSM] manip[2]/a.motorController[3]/ve.fsm"
+        assert drawn.dot == build_diagram(nested, "fsm", member, expand=True).dot
+    for outside in ("manip[3]/a.motorController[K]/ve", "manip[2]/a.motorController[7]/ve", "manip[J]/a.cs"):
+        with pytest.raises(TargetError, match="no subsystem"):
+            build_diagram(nested, "fsm", outside)
+    for view, target, fmt in [
+        ("fsm", "manip[2]/a.motorController[K]/ve", "dot"),
+        ("fsm", "manip[2]/a.motorController[K]/ve", "mermaid"),
+        ("fsm", "manip[I]/a.motorController[3]/ve", "dot"),
+        ("activity", "manip[2]/a.motorController[K]/ve.operate/bb", "dot"),
+    ]:
+        output = tmp_path / f"drawn.{fmt}"
+        arguments = ["diagram", str(spec), "--view", view, "--target", target, "--format", fmt, "-o", str(output)]
+        assert main(arguments) == 0, (view, target, fmt)
+        assert family in output.read_text(encoding="utf-8")
+
+
+def test_a_member_number_is_read_as_a_number_with_or_without_expand(system: System, tmp_path: Path) -> None:
+    """`motorController[02]/ve` drew member 2 when the family was drawn once; once a member was drawn from the
+    expansion its index was compared as text, and `02` named nothing (exit 2)."""
+    for expand in (False, True):
+        drawn = build_diagram(system, "fsm", "manip/a.motorController[02]/ve", expand=expand)
+        assert drawn.header == "stm [FSM] manip/a.motorController[2]/ve.fsm"
+        output = tmp_path / "member.mmd"
+        arguments = ["diagram", str(EXAMPLE), "--view", "fsm", "--target", "manip/a.motorController[02]/ve"]
+        arguments += ["--expand"] if expand else []
+        assert main([*arguments, "--format", "mermaid", "-o", str(output)]) == 0
+        assert "manip/a.motorController[2]/ve.fsm" in output.read_text(encoding="utf-8")
+    for outside in ("7", "0", "-1", "J", "007"):
+        for expand in (False, True):
+            with pytest.raises(TargetError, match="no subsystem"):
+                build_diagram(system, "fsm", f"manip/a.motorController[{outside}]/ve", expand=expand)
+
+
 SPLIT_FAMILY = """\
 system robots
 

@@ -52,7 +52,8 @@ def register(commands: Any) -> None:
         description="Draw a SysML-style diagram of SPEC as the EARL manual draws it by hand: SVG or PNG through "
         "Graphviz's `dot`, the DOT text itself, or Mermaid text (system and fsm views). Indexed families are drawn "
         "once with their index (motorController[K]/ve, K ∈ 1..N) unless --expand is given; a --target naming one "
-        "member (motorController[2]/ve) draws that member. Reading a spec never "
+        "member (motorController[2]/ve) draws that member, one naming a family anywhere on its way "
+        "(manip[2]/a.motorController[K]/ve) draws the declared family. Reading a spec never "
         "runs code it names.",
         epilog=EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,

@@ -6,8 +6,9 @@ subsystem (`manip/a.cs`, `manip/a.motorController/ve`), or a Basic Behaviour
 A family is named without an index, with its index variable
 (`motorController[K]/ve`) or with `[*]`; with `--expand`, a member is named by its number
 (`motorController[3]/ve`) or a parameter whose value it is (`motorController[N]/ve`).
-Without `--expand` a member's number (or such a parameter) names the family it belongs to;
-`names_a_member` says so, and the view then draws that member alone, from the expansion.
+Without `--expand` a target naming a member of each family on its way (or such a parameter) is
+drawn alone, from the expansion (`names_a_member` says so); one that names a family anywhere on
+its way (`manip[2]/a.motorController[K]/ve`) is drawn as the declared family.
 """
 
 from __future__ import annotations
@@ -52,6 +53,11 @@ def _segments(text: str) -> list[Segment]:
 Environment = Mapping[str, bool | int | float | str]
 
 
+def _number(written: str) -> int | None:
+    """A member's number as written, read as a number (`02` is member 2) by both matchers alike."""
+    return int(written) if re.fullmatch(r"-?\d+", written) else None
+
+
 def _matches(
     segment: Segment, name: str, family: Family | None, index: int | None, kind: str, environment: Environment
 ) -> bool:
@@ -61,7 +67,7 @@ def _matches(
         written = None if segment.index is None else segment.index.strip()
         if written is not None and written in environment:
             written = str(environment[written])
-        return written == str(index)
+        return written is not None and _number(written) == index
     if family is None:
         return segment.index is None
     # a family drawn once answers to its name, its index variable, or any member's number; not to another
@@ -71,10 +77,11 @@ def _matches(
         return True
     if number in environment:  # a parameter, `[N]`: the member it is
         number = str(environment[number])
-    if not number.lstrip("-").isdigit():
+    member = _number(number)
+    if member is None:
         return False
     try:
-        return int(number) in family_members(family, environment)
+        return member in family_members(family, environment)
     except ConstantError:  # its range needs an agent's own parameters: the name alone decides
         return True
 
@@ -173,13 +180,16 @@ def _index(segment: Segment) -> str:
 
 
 def names_a_member(system: System, view: str, text: str) -> bool:
-    """Whether `text` names one member of a family the declared `system` draws once (`motorController[2]/ve`,
-    `worker[N]/a`), rather than the family (`[K]`, `[*]`, no index) or an element declared alone."""
+    """Whether `text` names one member of every family the declared `system` draws once that it passes
+    through (`manip/a.motorController[2]/ve`, `worker[N]/a`, `manip[2]/a.motorController[3]/ve`), rather than a
+    family (`[K]`, `[*]`, no index) or an element declared alone. A target that names a family anywhere
+    (`manip[2]/a.motorController[K]/ve`, `manip/a.motorController[2]/ve` when `manip` is a family) is drawn
+    as its declared family: a family's drawing is the same for each of its members."""
     try:
         segments = _segments(text)
         if view in ("agent", "types"):
             agent = find_agent(system, text)
-            return _is_member(segments[0], agent.family)
+            return _is_member(segments[0], agent.family) is True
         if view == "fsm":
             agent, subsystem = find_subsystem(system, text)
         elif view == "activity":
@@ -188,13 +198,16 @@ def names_a_member(system: System, view: str, text: str) -> bool:
             return False
     except TargetError:
         return False  # said when the view looks for it
-    return _is_member(segments[0], agent.family) or (
-        len(segments) > 1 and subsystem.kind.value != "cs" and _is_member(segments[1], subsystem.family)
-    )
+    named = [_is_member(segments[0], agent.family)]
+    if len(segments) > 1 and subsystem.kind.value != "cs":
+        named.append(_is_member(segments[1], subsystem.family))
+    families = [member for member in named if member is not None]
+    return bool(families) and all(families)
 
 
-def _is_member(segment: Segment, family: Family | None) -> bool:
-    """A segment that matched `family` names one member unless it names the family itself."""
-    if family is None or segment.index is None:
-        return False
-    return segment.index.strip() not in (family.index, "*")
+def _is_member(segment: Segment, family: Family | None) -> bool | None:
+    """For a segment that matched `family`: whether it names one member (True) or the family itself (False);
+    None when there is no family to name a member of."""
+    if family is None:
+        return None
+    return segment.index is not None and segment.index.strip() not in (family.index, "*")
