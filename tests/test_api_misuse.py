@@ -7,7 +7,10 @@ text, not crash the checker or go into the run's generated code."""
 from __future__ import annotations
 
 import functools
+import os
 import re
+import subprocess
+import sys
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -707,3 +710,69 @@ def test_an_environment_object_whose_methods_fit_runs() -> None:
     with earl.simulate(earl.loads(TEXT), environment=environment) as simulation:
         simulation.advance_to(0.02)
     assert environment.times[-1] == pytest.approx(0.02)
+
+
+def _counter_with(tmp_path: Path, memories: str, *replacements: tuple[str, str]) -> Path:
+    """The runtime's counter spec with `memories` declared just before its control subsystem's FSM."""
+    spec = tmp_path / "counter"
+    text = (Path(__file__).parent / "runtime_specs" / "counter" / "system.earl").read_text(encoding="utf-8")
+    text = text.replace("\n        fsm {", f"\n{memories}        fsm {{", 1)
+    for old, new in replacements:
+        assert old in text, old
+        text = text.replace(old, new)
+    spec.mkdir()
+    (spec / "system.earl").write_text(text, encoding="utf-8")
+    return spec
+
+
+def _earl(*arguments: str | Path) -> subprocess.CompletedProcess[str]:
+    source = str(Path(__file__).parent.parent / "src")
+    return subprocess.run(
+        [sys.executable, "-m", "earl", *map(str, arguments)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env={**os.environ, "PYTHONPATH": source},
+    )
+
+
+def test_a_family_index_named_state_is_a_name_as_written_and_fmt_says_what_does_not_read_back(
+    tmp_path: Path,
+) -> None:
+    """The words `param`, `type`, `struct` and `state` before a name were skipped for every kind of name, so
+    the family index of `seen[state in 1..2]/m` was read as `in`, taken for a name renamed in Python, and blamed
+    for what did not read back (`and/m` after `sent/m: int = 0`): check refused it with EARL-R006 and
+    `earl fmt --check` ended in a ModelNameError traceback. Check says ok, as before, and fmt names `and`."""
+    spec = _counter_with(tmp_path, "        and/m: int = 0\n        seen[state in 1..2]/m: int = 0\n")
+    checked = _earl("check", spec)
+    assert checked.returncode == 0 and "ok" in checked.stdout, checked.stdout + checked.stderr
+    formatted = _earl("fmt", "--check", spec)
+    assert formatted.returncode == 1 and "Traceback" not in formatted.stderr, formatted.stderr
+    [said] = formatted.stderr.splitlines()
+    assert "cannot be put in canonical form" in said and "after `and`" in said and "the file is left as it is" in said
+    assert not [d for d in check(earl.load(spec)) if d.code == "EARL-R006"]
+
+
+def test_a_name_after_its_keyword_on_another_line_or_a_keyword_named_index_is_read_as_written(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Only a parameter, type, struct or state follows its keyword, and a line end or a comment may part them
+    (`state // the last one` ⏎ `timeout: …`); each was taken for a name renamed in Python, so the spec was
+    printed and parsed again while read."""
+    import earl.lang.formatter
+
+    def refused(system: object) -> str:
+        raise AssertionError("printed while read")
+
+    spec = _counter_with(
+        tmp_path,
+        "        seen[state in 1..2]/m: int = 0\n        kept[param in 1..2]/m: int = 0\n",
+        ("state finished: finished/bb", "state // the last one\n            timeout: finished/bb"),
+        ("counting -> finished when", "counting -> timeout when"),
+        ("param LIMIT: int = 3", "param\n    period: int = 3\n\nparam LIMIT: int = 3"),
+    )
+    monkeypatch.setattr(earl.lang.formatter, "format_system", refused)
+    system = earl.load(spec)
+    assert not [d for d in check(system) if d.code == "EARL-R006"]
+    monkeypatch.undo()
+    assert earl.loads(system.to_earl(), "again.earl") == system

@@ -12,6 +12,7 @@ from earl.cli.common import UsageError, spec_path, usage_error
 from earl.cli.output import print_diagnostics
 from earl.diagnostics import EarlError
 from earl.lang.loader import parse_file_as_read, parse_source, save
+from earl.model.validate import ModelNameError
 
 
 def register(commands: Any) -> None:
@@ -21,7 +22,7 @@ def register(commands: Any) -> None:
         description="Print each FILE in canonical form: four-space indentation, one declaration per line, "
         "the parts of every subsystem in the manual's order. Comments are kept.",
         epilog="exit codes: 0 done (or canonical with --check), 1 invalid, not canonical, or a file that could not "
-        "be rewritten (it is left as it was), 2 usage error",
+        "be put in canonical form or rewritten (it is left as it was), 2 usage error",
     )
     parser.add_argument("files", metavar="FILE", nargs="+", help=".earl files")
     mode = parser.add_mutually_exclusive_group()
@@ -47,7 +48,12 @@ def run(arguments: argparse.Namespace) -> int:
             continue
         # as the bytes are: `\r\n` or `\r` line ends are not canonical (universal newlines would hide them)
         original = data.decode("utf-8", errors="replace")
-        canonical = system.to_earl()
+        try:
+            canonical = system.to_earl()
+        except ModelNameError:  # a name to_earl would not write; said where the file declares it
+            sys.stderr.write(f"earl fmt: {_unwritable_name(system, str(path))}; the file is left as it is\n")
+            status = 1
+            continue
         problem = _reads_back_differently(system, canonical, str(path))
         if problem is not None:
             sys.stderr.write(
@@ -81,6 +87,17 @@ def run(arguments: argparse.Namespace) -> int:
         else:
             sys.stdout.write(canonical)
     return status
+
+
+def _unwritable_name(system: Any, path: str) -> str:
+    """Where the name `to_earl` refused is declared and why, as one line."""
+    from earl.lang.resolver import unreadable_names
+
+    name, what, location, _ = unreadable_names(system)[0]
+    return (
+        f"{location or path}: cannot be put in canonical form: `{name}` ({what}) would not read back where "
+        "canonical form writes it (a name that is also a keyword): rename it"
+    )
 
 
 def _reads_back_differently(system: Any, canonical: str, path: str) -> str | None:

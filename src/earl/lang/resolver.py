@@ -1556,7 +1556,7 @@ def unreadable_names(system: System) -> list[tuple[object, str, SourceLocation |
     suspects = [
         entry
         for entry in declared
-        if entry[0] in grammar and (entry[2] is None or _written_at(system.sources, entry[2]) != entry[0])
+        if entry[0] in grammar and (entry[2] is None or _written_at(system, entry[2], entry[3]) != entry[0])
     ]
     if not suspects:
         return []
@@ -1587,19 +1587,50 @@ def unreadable_names(system: System) -> list[tuple[object, str, SourceLocation |
     return []
 
 
-#: a declared name where its element's location starts: after `param`, `type`, `struct` or `state` when the
-#: declaration starts with one (a field named `state` is `state: …`, with no name after the word)
-_WRITTEN_NAME = re.compile(r"(?:(?:param|type|struct|state)\s+)?([A-Za-z_][A-Za-z0-9_]*)")
+#: a declared name where its element's location starts, after the keyword its declaration starts with:
+#: `param N: …`, `type T = …`, `struct S {`, `state s: …` (a line end or a comment may part them); only for that
+#: kind, as a family index `state` (`seen[state in 1..2]/m`) is the name itself, not `in` after it
+_WRITTEN_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+_AFTER_KEYWORD = {
+    keyword: re.compile(rf"{keyword}(?:\s|//[^\n]*)+([A-Za-z_][A-Za-z0-9_]*)")
+    for keyword in ("param", "type", "struct", "state")
+}
+_PARAMETER = re.compile(r"\.parameters\[\d+\]\.name$")
+_TYPE = re.compile(r"^system\.types\[(\d+)\]\.name$")
+_STATE = re.compile(r"\.fsm\.states\[\d+\]\.name$")
 
 
-def _written_at(sources: object, location: SourceLocation) -> str | None:
+def _declaring_keyword(system: System, path: str) -> str | None:
+    """The keyword the declaration of the name at `path` (as `_declared_names` gives it) starts with."""
+    if _PARAMETER.search(path):
+        return "param"
+    if _STATE.search(path):
+        return "state"
+    definition = _TYPE.match(path)
+    if definition is not None:
+        return "struct" if isinstance(system.types[int(definition[1])], StructType) else "type"
+    return None
+
+
+def _written_at(system: System, location: SourceLocation, path: str) -> str | None:
     """The name written where `location` starts, in the text the system was read from; None when that text
     is not at hand (a location copied from another system)."""
-    line = sources.line(location.file, location.line) if isinstance(sources, SourceMap) else None
+    sources = system.sources
+    if not isinstance(sources, SourceMap):
+        return None
+    line = sources.line(location.file, location.line)
     if line is None:
         return None
-    match = _WRITTEN_NAME.match(line, location.column - 1)
-    return match.group(1) if match is not None else None
+    keyword = _declaring_keyword(system, path)
+    if keyword is None:
+        match = _WRITTEN_NAME.match(line, location.column - 1)
+        return match.group(0) if match is not None else None
+    # the declaration's span, which holds its name whatever lines it is written on
+    span = [line[location.column - 1 :]]
+    for number in range(location.line + 1, location.end_line + 1):
+        span.append(sources.line(location.file, number) or "")
+    after = _AFTER_KEYWORD[keyword].match("\n".join(span))
+    return after.group(1) if after is not None else None
 
 
 def is_earl_name(text: str) -> bool:
