@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import operator
 import string
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from typing import Any
 
 from hypothesis import strategies as st
@@ -77,7 +77,8 @@ from earl.model import (
     TypeReference,
 )
 from earl.model.expressions import ARITHMETIC_OPERATORS, COMPARISON_OPERATORS
-from earl.model.text import expression_text
+from earl.model.location import Comments
+from earl.model.text import expression_text, robot_member_keys
 from earl.model.types import PRIMITIVE_TYPES
 
 #: Every keyword of src/earl/lang/earl.lark (test_roundtrip checks this against the grammar).
@@ -527,12 +528,59 @@ def commented_systems(draw: DrawFn) -> System:
             carrier.comments.trailing = draw(_comment_texts)
         if _written_over_lines(carrier) and draw(st.booleans()):
             carrier.comments.after = draw(_comment_texts)  # after its `}`
-    for declaration in system.order:
-        # a blank line a person left between two fields of a struct, to group them
-        for later in declaration.fields[1:] if isinstance(declaration, StructType) else ():
-            if draw(st.booleans()):
-                later.comments.leading.insert(0, "")
+    _blank_lines(draw, system)
     return system
+
+
+def _blank_lines(draw: DrawFn, system: System) -> None:
+    """Blank lines a person left inside a group of a body, to group its members further: a "" first in a
+    member's leading comments. Never before the first of a group (the first top-level parameter after a
+    type, the first memory, the first transition), where `earl fmt` writes a blank line of its own."""
+
+    def maybe(comments: Comments) -> None:
+        if draw(st.booleans()):
+            comments.leading.insert(0, "")
+
+    def some(later: Iterable[Any]) -> None:
+        for element in later:
+            maybe(element.comments)
+
+    def maybe_in(table: dict[str, Comments], key: str) -> None:  # a table holds only comments said
+        if draw(st.booleans()):
+            table.setdefault(key, Comments()).leading.insert(0, "")
+
+    previous: object = None
+    for declaration in system.order:
+        # one-line declarations of one kind are one group, but for one with comments above it
+        one_liner = isinstance(declaration, Parameter | TypeAlias | Link)
+        if one_liner and type(declaration) is type(previous) and not declaration.comments.leading:
+            maybe(declaration.comments)
+        previous = declaration
+        if isinstance(declaration, StructType):
+            some(declaration.fields[1:])
+        elif isinstance(declaration, Robot):
+            for key in robot_member_keys(declaration)[1:]:
+                maybe_in(declaration.member_comments, key)
+        elif isinstance(declaration, Agent):
+            some(declaration.parameters[1:])
+            some(declaration.links[1:])
+            for subsystem in declaration.subsystems:
+                some(subsystem.parameters[0 if subsystem.period is not None else 1 :])
+                some([*subsystem.input_buffers, *subsystem.output_buffers][1:])
+                for group in (
+                    subsystem.memories,
+                    subsystem.primitive_predicates,
+                    subsystem.partial_transition_functions,
+                    subsystem.stage_sets,
+                ):
+                    some(group[1:])
+                for behaviour in subsystem.basic_behaviours:
+                    for clause in ("tc", "ec") if behaviour.error_condition is not None else ("tc",):
+                        maybe_in(behaviour.clause_comments, clause)
+                if subsystem.fsm is not None:
+                    some(subsystem.fsm.states)  # after `initial`
+                    some(subsystem.fsm.transitions[1:])
+                    some(subsystem.fsm.assumptions[1:])
 
 
 def _written_over_lines(carrier: Any) -> bool:

@@ -283,7 +283,9 @@ def test_a_comment_that_ends_a_block_stays_in_it(tmp_path: Path, capsys: pytest.
         lines = formatted.splitlines()
         assert lines[lines.index(comment) + 1] == closing, formatted
     assert (
-        "            * -> r when f/pp  // from every state  // however it was reached\n            // TODO" in formatted
+        # the blank line left before the TODO stays too
+        "            * -> r when f/pp  // from every state  // however it was reached\n\n            // TODO"
+        in formatted
     )
     assert "    // end of the agent\n}  // after the `}`: about the agent, and kept there\n\nr/r {" in formatted
     again = tmp_path / "again.earl"
@@ -440,3 +442,155 @@ def test_a_comment_after_a_closing_brace_stays_after_it_whatever_the_layout(
         path.write_text(text)
         assert main(["fmt", str(path)]) == 0
         assert capsys.readouterr().out == over_lines
+
+
+# blank lines a person left in every kind of body: one kept where there were several, none added where
+# `earl fmt` writes its own (before the first memory, the transitions, a type after a parameter)
+GROUPED_BODIES = """\
+system s
+
+import "a.earl"
+
+
+import "b.earl"
+
+param A: int = 1
+
+
+param B: int = 2
+param C: int = 3
+
+type T = int
+
+type U = int
+
+x/a {
+    param K: int = 1
+
+    param L: int = 2
+
+    cs {
+        period 1 ms
+
+        param M: int = 3
+        i/ib: int
+
+
+        j/ib: int
+        o/ob: int
+
+        m/m: int = 0
+
+        n/m: int = 0
+
+        // the limits
+        q/pp = m/mi > 0
+
+        r/pp = m/mi < 0
+
+        f/pf(m/mi -> n/mo)
+
+        g/pf(m/mi -> n/mo)
+
+        stage s1 = {f/pf}
+
+        stage s2 = {g/pf}
+
+        b/bb {
+            tf = {f/pf}
+
+            tc = q/pp
+        }
+
+        fsm {
+            initial x
+
+            state x: b/bb
+
+            state y: b/bb
+            x -> y when q/pp
+
+            y -> x when r/pp
+
+            assume true
+
+            assume false
+
+
+            // to come
+        }
+    }
+
+    link l1: cs.o -> cs.i
+
+    link l2: cs.o -> cs.j
+}
+
+link x,x: x/a.cs.o -> x/a.cs.i
+
+link x,x: x/a.cs.o -> x/a.cs.j
+
+r/r {
+    link l
+
+    x/a
+}
+"""
+
+GROUPED_BODIES_FORMATTED = (
+    GROUPED_BODIES.replace('"a.earl"\n\n\n', '"a.earl"\n\n')
+    .replace("param A: int = 1\n\n\n", "param A: int = 1\n\n")
+    .replace("        param M: int = 3\n", "        param M: int = 3\n\n")
+    .replace("i/ib: int\n\n\n", "i/ib: int\n\n")
+    .replace("            state y: b/bb\n", "            state y: b/bb\n\n")
+    .replace("assume false\n\n\n", "assume false\n\n")
+    .replace("    link l\n\n    x/a\n", "    x/a\n    link l\n")
+)
+
+
+def test_fmt_keeps_a_blank_line_that_groups_members_in_every_body(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`earl fmt` dropped a blank line left between two buffers, memories, predicates, functions, stages,
+    states, transitions, assumptions, clauses of a basic behaviour, an agent's parameters or links, and
+    top-level parameters, type aliases or links; it keeps one now, and adds none to the ones it writes."""
+    path = tmp_path / "grouped.earl"
+    path.write_text(GROUPED_BODIES)
+    assert main(["fmt", str(path)]) == 0
+    formatted = capsys.readouterr().out
+    assert formatted == GROUPED_BODIES_FORMATTED
+    assert "\n\n\n" not in formatted
+    again = tmp_path / "again.earl"
+    again.write_text(formatted)
+    assert main(["fmt", "--check", str(again)]) == 0
+
+
+def test_to_earl_writes_no_blank_line_first_in_a_body() -> None:
+    """A model built in Python with a blank line asked for before the first member of a body (or of a
+    group, where one is written anyway) gets none there, nor two: it would not read back."""
+    from earl.model import Agent, ControlSubsystem, InputBuffer, Literal, Parameter, PrimitiveType, System
+    from earl.model.location import Comments
+
+    buffer = InputBuffer("i", PrimitiveType("int"), comments=Comments([""]))
+    subsystem = ControlSubsystem(input_buffers=[buffer], comments=Comments([""]))
+    parameter = Parameter("K", PrimitiveType("int"), Literal(1), comments=Comments([""]))
+    agent = Agent("a", parameters=[parameter], subsystems=[subsystem])
+    text = System("s", agents=[agent], order=[agent]).to_earl()
+    assert text == "system s\n\na/a {\n    param K: int = 1\n\n    cs {\n        i/ib: int\n    }\n}\n"
+    assert earl.loads(text, "s.earl").to_earl() == text
+
+
+def test_fmt_keeps_a_blank_line_after_the_member_written_before_when_it_reorders(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Parts written out of the manual's order: the blank line stays above the part that followed it."""
+    path = tmp_path / "mixed.earl"
+    path.write_text(
+        "x/a {\n    cs {\n        i/ib: int\n        m/m: int\n\n        j/ib: int\n"
+        "        n/m: int\n        o/ob: int\n\n        // the end\n    }\n}\n"
+    )
+    assert main(["fmt", str(path)]) == 0
+    assert capsys.readouterr().out == (
+        "x/a {\n    cs {\n        i/ib: int\n\n        j/ib: int\n        o/ob: int\n\n"
+        "        m/m: int\n        n/m: int\n\n        // the end\n    }\n}\n"
+    )

@@ -29,10 +29,12 @@ from earl.model import (
     Negate,
     Not,
     PrimitivePredicate,
+    Robot,
     System,
 )
 from earl.model.expressions import ElementReference, Read
 from earl.model.kinds import Kind
+from earl.model.location import Comments
 from earl.model.text import expression_text, literal_text
 from strategies import (
     KEYWORDS,
@@ -116,6 +118,14 @@ def test_comments_stay_with_their_elements(system: System) -> None:
             written.comments.trailing,
             written.comments.after,
         ), type(written).__name__
+    # a robot's members and a basic behaviour's clauses keep theirs in a table of their owner's
+    for written, kept in zip(system.order, read.order, strict=True):
+        if isinstance(written, Robot):  # the reader makes a member's entry whether or not it has comments
+            said = {key: comments for key, comments in kept.member_comments.items() if comments != Comments()}
+            assert said == written.member_comments
+        for subsystem, again in zip(getattr(written, "subsystems", []), getattr(kept, "subsystems", []), strict=True):
+            for behaviour, read_back in zip(subsystem.basic_behaviours, again.basic_behaviours, strict=True):
+                assert read_back.clause_comments == behaviour.clause_comments
     assert read.to_earl() == text
 
 

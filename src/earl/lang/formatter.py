@@ -10,9 +10,11 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
+from earl.lang.layout import agent_groups, apart, fsm_groups, subsystem_groups
 from earl.model.elements import (
     FSM,
     Agent,
+    Assumption,
     BasicBehaviour,
     Duration,
     Import,
@@ -49,14 +51,18 @@ INDENT = "    "
 class _Printer:
     def __init__(self) -> None:
         self.lines: list[str] = []
+        self.opened = -1  # how many lines there were when the last block's `{` was written
 
     def blank(self) -> None:
-        if self.lines and self.lines[-1] != "":
+        """One blank line, never two, nor one first in a body (a "" a model built in Python put before
+        its first member would not read back)."""
+        if self.lines and self.lines[-1] != "" and len(self.lines) != self.opened:
             self.lines.append("")
 
     def line(self, depth: int, text: str, comments: Comments | None = None, closed: bool = False) -> None:
         """A line of code after its leading comments, ending with its own; `closed`: a block written on this
         one line, so the comment that followed its `}` ends the line too."""
+        code = text
         if comments is not None:
             for comment in comments.leading:
                 self.comment(depth, comment)
@@ -65,6 +71,8 @@ class _Printer:
             if closed and comments.after:
                 text = f"{text}  {comments.after.rstrip()}"
         self.lines.append(f"{INDENT * depth}{text}")
+        if code.endswith("{"):
+            self.opened = len(self.lines)
 
     def comment(self, depth: int, comment: str) -> None:
         """A whole-line comment; "" is the blank line that kept it apart from what follows (one, however
@@ -147,12 +155,7 @@ def format_system(system: System) -> str:
     previous: object | None = None
     for declaration in declared:
         # One-line declarations of one kind (links, parameters, aliases) stay together as written.
-        grouped = (
-            type(declaration) is type(previous)
-            and isinstance(declaration, Parameter | TypeAlias | Link)
-            and not declaration.comments.leading
-        )
-        if not grouped:
+        if apart(previous, declaration):
             printer.blank()
         previous = declaration
         if isinstance(declaration, Parameter):
@@ -223,16 +226,18 @@ def _robot(printer: _Printer, robot: Robot) -> None:
 
 def _agent(printer: _Printer, agent: Agent) -> None:
     printer.line(0, f"{family_text(agent.name, agent.family)}/a {{", agent.comments)
-    for parameter in agent.parameters:
-        _parameter(printer, 1, parameter)
-    for index, subsystem in enumerate(agent.subsystems):
-        if index or agent.parameters:
+    for index, group in enumerate(agent_groups(agent)):
+        if index:
             printer.blank()
-        _subsystem(printer, subsystem)
-    if agent.links:
-        printer.blank()
-    for link in agent.links:
-        _link(printer, 1, link)
+        for item in group:
+            if isinstance(item, Parameter):
+                _parameter(printer, 1, item)
+            elif isinstance(item, Subsystem):
+                _subsystem(printer, item)
+            elif isinstance(item, Link):
+                _link(printer, 1, item)
+            else:  # a model built in Python: never left out without a word
+                raise TypeError(f"not a part of an agent: {item!r}")
     printer.close(0, agent.comments)
 
 
@@ -249,42 +254,26 @@ def _subsystem(printer: _Printer, subsystem: Subsystem) -> None:
     )
     printer.line(1, f"{header} {{", subsystem.comments)
     depth = 2
-    groups: list[list[object]] = [
-        [*([subsystem.period] if subsystem.period is not None else []), *subsystem.parameters],
-        [*subsystem.input_buffers, *subsystem.output_buffers],
-        list(subsystem.memories),
-        list(subsystem.primitive_predicates),
-        list(subsystem.partial_transition_functions),
-        list(subsystem.stage_sets),
-    ]
-    first = True
-    for group in groups:
-        if not group:
-            continue
-        if not first:
+    for index, group in enumerate(subsystem_groups(subsystem)):
+        if index:
             printer.blank()
-        first = False
         for item in group:
-            if isinstance(item, Duration):  # the period, whose comments its subsystem keeps
-                printer.line(depth, f"period {duration_text(item)}", subsystem.clause_comments.get("period"))
+            if isinstance(item, str):  # the period, whose comments its subsystem keeps
+                period = subsystem.period
+                if not isinstance(period, Duration):  # a model built in Python: named, never left out
+                    raise TypeError(f"not a period of a subsystem: {period!r}")
+                printer.line(depth, f"period {duration_text(period)}", subsystem.clause_comments.get(item))
+            elif isinstance(item, BasicBehaviour):
+                _basic_behaviour(printer, depth, item)
+            elif isinstance(item, FSM):
+                _fsm(printer, depth, item)
             else:
                 _body_item(printer, depth, item)
-    for behaviour in subsystem.basic_behaviours:
-        if not first:
-            printer.blank()
-        first = False
-        _basic_behaviour(printer, depth, behaviour)
-    if subsystem.fsm is not None:
-        if not first:
-            printer.blank()
-        _fsm(printer, depth, subsystem.fsm)
     printer.close(1, subsystem.comments)
 
 
 def _body_item(printer: _Printer, depth: int, item: object) -> None:
-    if isinstance(item, Duration):
-        printer.line(depth, f"period {duration_text(item)}")
-    elif isinstance(item, Parameter):
+    if isinstance(item, Parameter):
         _parameter(printer, depth, item)
     elif isinstance(item, InputBuffer):
         text = f"{family_text(item.name, item.family)}/ib: {data_type_text(item.data_type)}"
@@ -335,17 +324,20 @@ def _fsm(printer: _Printer, depth: int, fsm: FSM) -> None:
     printer.line(depth, "fsm {", fsm.comments)
     if not isinstance(fsm.initial, str):  # a model built in Python: `initial None` would read back otherwise
         raise TypeError(f"the initial state is {fsm.initial!r}, not a name")
-    printer.line(depth + 1, f"initial {fsm.initial}", fsm.clause_comments.get("initial"))
-    for state in fsm.states:
-        _state(printer, depth + 1, state)
-    if fsm.transitions:
-        printer.blank()
-    for transition in fsm.transitions:
-        _transition(printer, depth + 1, transition)
-    if fsm.assumptions:
-        printer.blank()
-    for assumption in fsm.assumptions:
-        printer.line(depth + 1, f"assume {expression_text(assumption.expression)}", assumption.comments)
+    for index, group in enumerate(fsm_groups(fsm)):
+        if index:
+            printer.blank()
+        for item in group:
+            if isinstance(item, str):  # `initial`, whose comments the FSM keeps
+                printer.line(depth + 1, f"initial {fsm.initial}", fsm.clause_comments.get("initial"))
+            elif isinstance(item, State):
+                _state(printer, depth + 1, item)
+            elif isinstance(item, Transition):
+                _transition(printer, depth + 1, item)
+            elif isinstance(item, Assumption):
+                printer.line(depth + 1, f"assume {expression_text(item.expression)}", item.comments)
+            else:  # a model built in Python: never left out without a word
+                raise TypeError(f"not a part of an FSM: {item!r}")
     printer.close(depth, fsm.comments)
 
 

@@ -16,12 +16,13 @@ from earl.collector import paused as collection_paused
 from earl.diagnostics import Diagnostic, EarlError, Severity, SourceMap
 from earl.lang import reductions
 from earl.lang.driver import Driver, NotWellFormed
+from earl.lang.layout import agent_groups, apart, behaviour_groups, fsm_groups, subsystem_groups
 from earl.lang.syntax_errors import translate
 from earl.lang.transformer import ElementBuilder, ParsedFile, SpecificationSyntaxError
-from earl.model.elements import FSM, Agent, BasicBehaviour, Robot, State, Subsystem
+from earl.model.elements import FSM, Agent, BasicBehaviour, Import, Robot, State, Subsystem
 from earl.model.location import Comments, SourceLocation
 from earl.model.text import robot_member_keys
-from earl.model.types import Field, StructType
+from earl.model.types import StructType
 
 #: Larger files are refused before parsing.  The benchmark's thousand agents, written out in
 #: full, take 5 MB and some 4–5 s of CPU to read (benchmarks/results/parse.json); a file much
@@ -190,7 +191,7 @@ def parse_text(text: str, path: str = "<text>", sources: SourceMap | None = None
         parsed.header_comments = _with_blank_lines([c for c in comments if (c.line or 1) <= header_line], header_line)
         comments = [c for c in comments if (c.line or 1) > header_line]
     parsed.closing_comments = attach_comments(parsed.declarations, comments, path, text)
-    keep_blank_lines_between_members(parsed.declarations, text)
+    keep_blank_lines(parsed.declarations, text)
     return parsed
 
 
@@ -384,42 +385,154 @@ def _closing_braces(statements: list[Any], blocks: list[Any], comments: list[Tok
     return closes
 
 
-def keep_blank_lines_between_members(declarations: list[Any], text: str) -> None:
-    """A blank line a person left between two members of a robot, or two fields of a struct, to group
-    them: kept as a "" first in the second's leading comments, as one between a comment block and what
-    follows is kept (`earl fmt` writes no other blank line in those bodies). Also before the comments that
-    close the body. Several blank lines are one."""
-    lines: list[str] | None = None
+def _behaviour_clause_places(behaviour: BasicBehaviour) -> dict[str, Any]:
+    error = behaviour.error_condition
+    return {
+        "tf": behaviour.transition_function.location,
+        "tc": behaviour.terminal_condition.location,
+        "ec": error.location if error is not None else None,
+    }
 
-    def blank(number: int) -> bool:
-        nonlocal lines
-        lines = lines if lines is not None else text.split("\n")
-        return 0 < number <= len(lines) and not lines[number - 1].strip()
 
-    for declaration in declarations:
-        members: list[tuple[SourceLocation, Any]]  # where a member is, and what holds its comments
-        if isinstance(declaration, Robot):
-            keys = robot_member_keys(declaration)
-            located = zip(keys, _member_locations(declaration), strict=True)
-            members = [(location, key) for key, location in located if location is not None]
-        elif isinstance(declaration, StructType):
-            members = [(f.location, f) for f in declaration.fields if f.location is not None]
-        else:
-            continue
+def _robot_member_places(robot: Robot) -> dict[str, Any]:
+    return dict(zip(robot_member_keys(robot), _member_locations(robot), strict=True))
+
+
+class _BlankLines:
+    """keep_blank_lines for one file: whether a blank line follows a line, the text split only when a
+    comment stands between two members (lines between two members are blank otherwise: a comment there
+    would be the second's), as this runs on every read."""
+
+    __slots__ = ("lines", "text")
+
+    def __init__(self, text: str) -> None:
+        self.text = text
+        self.lines: list[str] | None = None
+
+    def after(self, line: int) -> bool:
+        """Whether the line after `line` is blank."""
+        if self.lines is None:
+            self.lines = self.text.split("\n")
+        return line < len(self.lines) and not self.lines[line].strip()
+
+    def parted(self, previous: SourceLocation, location: SourceLocation, said: Comments | None) -> bool:
+        """Whether a blank line was written right after `previous` (the member before in the body), above
+        the member at `location` whose comments are `said`."""
+        if location.line <= previous.end_line + 1:
+            return False
+        return said is None or not said.leading or self.after(previous.end_line)
+
+    def keep(
+        self,
+        block: Any,
+        groups: list[list[Any]],
+        clauses: dict[str, Any] | None = None,
+        table: dict[str, Comments] | None = None,
+    ) -> None:
+        """The members of `block`, in the groups `earl fmt` writes them in (layout.py); `clauses`: where
+        the clauses named there are (`tc`, or `a/a` in a robot), whose comments are in `table`."""
+        location = block.location
+        if location is None:
+            return
+        clauses = clauses if clauses is not None else {}
+        table = table if table is not None else {}
+        previous: SourceLocation | None = None  # the member before, as `earl fmt` writes them
+        blank: list[tuple[Any, Comments | None]] = []  # the members with a blank line above, and their comments
+        for group in groups:
+            starts = True
+            for item in group:
+                at = clauses.get(item) if isinstance(item, str) else item.location
+                if at is None:
+                    continue
+                if previous is not None:
+                    if at.line < previous.end_line:
+                        self.keep_in_order_written(block, groups, clauses, table)  # not the order `earl fmt` writes
+                        return
+                    if not starts and at.line > previous.end_line + 1:
+                        said = table.get(item) if isinstance(item, str) else item.comments
+                        if self.parted(previous, at, said):
+                            blank.append((item, said))
+                previous = at
+                starts = False
+        for item, said in blank:
+            _blank_first(table.setdefault(item, Comments()).leading if said is None else said.leading)
+        self.closing(block, previous)
+
+    def keep_in_order_written(
+        self, block: Any, groups: list[list[Any]], clauses: dict[str, Any], table: dict[str, Comments]
+    ) -> None:
+        """`keep` for a body written in another order than `earl fmt`'s: the blank line is the one after
+        the member written before."""
+        members = []  # where, the member or its key, whether it starts a group
+        for group in groups:
+            for index, item in enumerate(group):
+                at = clauses.get(item) if isinstance(item, str) else item.location
+                if at is not None:
+                    members.append((at, item, index == 0))
         members.sort(key=lambda member: (member[0].line, member[0].column))
-        for (previous, _), (location, holder) in pairwise(members):
-            gap = previous.end_line + 1  # the line after the previous member
-            if gap < location.line and blank(gap):
-                said = (
-                    holder.comments
-                    if isinstance(holder, Field)
-                    else declaration.member_comments.setdefault(holder, Comments())
-                )
-                if said.leading[:1] != [""]:
-                    said.leading.insert(0, "")
-        closing = declaration.comments.closing
-        if members and closing and closing[:1] != [""] and blank(members[-1][0].end_line + 1):
-            closing.insert(0, "")
+        for (previous, _, _), (at, item, starts) in pairwise(members):
+            said = table.get(item) if isinstance(item, str) else item.comments
+            if not starts and self.parted(previous, at, said):
+                _blank_first(table.setdefault(item, Comments()).leading if said is None else said.leading)
+        self.closing(block, members[-1][0] if members else None)
+
+    def closing(self, block: Any, last: SourceLocation | None) -> None:
+        """A blank line after the last member of a body, before the comments that close it."""
+        closing = block.comments.closing
+        if closing and last is not None and last.end_line + 1 < block.location.end_line and self.after(last.end_line):
+            _blank_first(closing)
+
+
+def keep_blank_lines(declarations: list[Any], text: str) -> None:
+    """A blank line a person left between two members of a body, to group them (two input buffers, two
+    states, two top-level parameters): kept as a "" first in the second's leading comments, as one between
+    a comment block and what follows is kept. Not where `earl fmt` writes one of its own, before the first
+    of a group (layout.py): it is there anyway, and a model read back from `earl fmt`'s text is the one
+    printed. Also a blank line before the comments that close a body. Several blank lines are one."""
+    blank = _BlankLines(text)
+    _keep_at_top_level(declarations, blank)
+    for declaration in declarations:
+        if isinstance(declaration, StructType):
+            blank.keep(declaration, [declaration.fields])
+        elif isinstance(declaration, Robot):
+            places = _robot_member_places(declaration)
+            blank.keep(declaration, [list(places)], places, declaration.member_comments)
+        elif isinstance(declaration, Agent):
+            blank.keep(declaration, agent_groups(declaration))
+            for subsystem in declaration.subsystems:
+                period = {"period": subsystem.period_location}
+                blank.keep(subsystem, subsystem_groups(subsystem), period, subsystem.clause_comments)
+                for behaviour in subsystem.basic_behaviours:
+                    clauses = _behaviour_clause_places(behaviour)
+                    blank.keep(behaviour, behaviour_groups(behaviour), clauses, behaviour.clause_comments)
+                if (fsm := subsystem.fsm) is not None:
+                    initial = {"initial": fsm.initial_location}
+                    blank.keep(fsm, fsm_groups(fsm), initial, fsm.clause_comments)
+
+
+def _blank_first(comments: list[str]) -> None:
+    if comments[:1] != [""]:
+        comments.insert(0, "")
+
+
+def _keep_at_top_level(declarations: list[Any], blank: _BlankLines) -> None:
+    """keep_blank_lines between two top-level declarations: `earl fmt` writes imports first, each after a
+    blank line, and the others in the order written, parted as `layout.apart` says."""
+    previous: Any = None  # the one `earl fmt` writes before, imports aside
+    above: SourceLocation | None = None  # where the one written before ends, an import too
+    for declaration in declarations:
+        at = declaration.location
+        if (
+            not isinstance(declaration, Import)
+            and above is not None
+            and at is not None
+            and not apart(previous, declaration)
+            and blank.parted(above, at, declaration.comments)
+        ):
+            _blank_first(declaration.comments.leading)
+        if not isinstance(declaration, Import):
+            previous = declaration
+        above = at if at is not None else above
 
 
 def attach_comments(declarations: list[Any], comments: list[Token], path: str, text: str | None = None) -> list[str]:

@@ -37,7 +37,8 @@ class Comments:
     """Comments a person wrote around an element, kept so `earl fmt` never drops them.
 
     `leading` are the whole-line comments just above the element ("" where a blank line parted them,
-    and first where a blank line parted a robot's member or a struct's field from the one before),
+    and first where a blank line parted the element from the one before it in its group of a body, as
+    `earl fmt` groups them: earl/lang/layout.py),
     `trailing` the comment at the end of its first line.  They are not part of the model's meaning.
     """
 
