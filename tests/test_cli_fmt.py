@@ -560,6 +560,9 @@ def test_fmt_keeps_a_blank_line_that_groups_members_in_every_body(
     formatted = capsys.readouterr().out
     assert formatted == GROUPED_BODIES_FORMATTED
     assert "\n\n\n" not in formatted
+    with pytest.raises(SystemExit):
+        main(["fmt", "--help"])
+    assert "one blank line where one or more were left" in " ".join(capsys.readouterr().out.split())
     again = tmp_path / "again.earl"
     again.write_text(formatted)
     assert main(["fmt", "--check", str(again)]) == 0

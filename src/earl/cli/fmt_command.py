@@ -20,7 +20,8 @@ def register(commands: Any) -> None:
         "fmt",
         help="print a specification in canonical form",
         description="Print each FILE in canonical form: four-space indentation, one declaration per line, "
-        "the parts of every subsystem in the manual's order. Comments are kept.",
+        "the parts of every subsystem in the manual's order, a blank line between two groups of them. Comments "
+        "are kept, and so is one blank line where one or more were left between two members of a group.",
         epilog="exit codes: 0 done (or canonical with --check), 1 invalid, not canonical, or a file that could not "
         "be put in canonical form or rewritten (it is left as it was), 2 usage error",
     )
