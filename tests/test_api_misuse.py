@@ -23,8 +23,10 @@ from earl import (
     BooleanOperation,
     Comparison,
     ElementReference,
+    Family,
     InputBuffer,
     Kind,
+    LinkNamePart,
     Literal,
     Predicate,
     PrimitiveType,
@@ -770,6 +772,91 @@ def test_a_name_after_its_keyword_on_another_line_or_a_keyword_named_index_is_re
         ("state finished: finished/bb", "state // the last one\n            timeout: finished/bb"),
         ("counting -> finished when", "counting -> timeout when"),
         ("param LIMIT: int = 3", "param\n    period: int = 3\n\nparam LIMIT: int = 3"),
+    )
+    monkeypatch.setattr(earl.lang.formatter, "format_system", refused)
+    system = earl.load(spec)
+    assert not [d for d in check(system) if d.code == "EARL-R006"]
+    monkeypatch.undo()
+    assert earl.loads(system.to_earl(), "again.earl") == system
+
+
+def _renamed(system: Any, path: str, name: str) -> None:
+    """`system.<path> = name`, for a path as EARL-R006 says it; a link's name part is frozen, so replaced."""
+    from dataclasses import replace
+
+    *steps, last = path.removeprefix("system.").split(".")
+    holder: Any = None
+    owner: Any = system
+    for step in steps:
+        attribute, _, index = step.partition("[")
+        holder, owner = owner, getattr(owner, attribute)
+        if index:
+            owner = owner[int(index.rstrip("]"))]
+    if isinstance(owner, LinkNamePart):  # `links[1].name[0]`: the link holds a tuple of them
+        holder.name = tuple(replace(part, name=name) if part is owner else part for part in holder.name)
+    elif isinstance(owner, Family):  # frozen, as the link's `family`
+        holder.family = replace(owner, index=name)
+    else:
+        setattr(owner, last, name)
+
+
+@pytest.mark.parametrize(
+    ("path", "name", "what"),
+    [
+        ("agents[0].subsystems[0].parameters[0].name", "my gain", "a parameter of counter/a.cs"),
+        ("agents[0].subsystems[0].stage_sets[0].name", "my stage", "a stage set of counter/a.cs"),
+        ("agents[0].links[1].name[0].name", "my link", "a part of the name of a link of `counter/a`"),
+        ("agents[0].links[1].name[1].name", "relay-display", "a part of the name of a link of `counter/a`"),
+        ("agents[0].links[0].family.index", "my K", "the family index of a link of `counter/a`"),
+        ("agents[0].links[0].family.index", "any", "the family index of a link of `counter/a`"),
+        ("agents[0].links[0].family.index", "true", "the family index of a link of `counter/a`"),
+    ],
+)
+def test_a_subsystem_parameter_stage_set_or_link_renamed_in_python_is_said_and_refused(
+    tmp_path: Path, path: str, name: str, what: str
+) -> None:
+    """A subsystem's parameter, a stage set, a part of a link's name and a link family's index were not among the
+    names EARL-R006 asks: renamed `my gain` in Python, check said nothing and `to_earl()` wrote
+    `param my gain: int = 2`, which does not read back."""
+    from earl.model.validate import ModelNameError
+
+    spec = _counter_with(
+        tmp_path,
+        "        param G: int = 2\n        stage first = {rest/pf}\n",
+        ("link cs,relay: cs.count", "link cs,relay[K in 1..1]: cs.count"),
+    )
+    system = earl.load(spec)
+    assert not [d for d in check(system) if d.code == "EARL-R006"]
+    _renamed(system, f"system.{path}", name)
+    [said] = [d for d in check(system) if d.code == "EARL-R006"]
+    assert f"({what})" in said.message and said.location is not None
+    with pytest.raises(ModelNameError, match=re.escape(f"system.{path}: '{name}' ({what})")):
+        system.to_earl()
+
+
+def test_a_system_link_renamed_in_python_is_said() -> None:
+    system = earl.load(Path(__file__).parent.parent / "examples" / "pick_and_place")
+    _renamed(system, "system.links[0].name[1].name", "the manipulator")
+    [said] = [d for d in check(system) if d.code == "EARL-R006"]
+    assert said.message == "'the manipulator' is no EARL name (a part of the name of a link of the system)"
+
+
+def test_stage_sets_and_links_named_as_keywords_in_the_text_are_read_as_written(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`stage stage = …` and `link state, fifo: …` read back as written: reading them does not print the spec
+    and parse it again (a link's name is its first word only when written with a `:`)."""
+    import earl.lang.formatter
+
+    def refused(system: object) -> str:
+        raise AssertionError("printed while read")
+
+    spec = _counter_with(
+        tmp_path,
+        "        stage stage = {rest/pf}\n",
+        ("link relay,display:", "link state, // a comment\n        fifo :"),
+        ("link display,relay: display/re.echo", "link display/re.echo"),
+        ("link cs,relay: cs.count", "link cs,relay[stage in 1..1]: cs.count"),
     )
     monkeypatch.setattr(earl.lang.formatter, "format_system", refused)
     system = earl.load(spec)

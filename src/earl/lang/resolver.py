@@ -1522,6 +1522,9 @@ def _declared_names(system: System) -> Iterator[tuple[object, str, SourceLocatio
             if subsystem.family is not None:
                 where = f"{held}.family.index"
                 yield subsystem.family.index, f"the family index of `{owner}`", subsystem.family.location, where
+            for k, parameter in enumerate(subsystem.parameters):
+                where = f"{held}.parameters[{k}].name"
+                yield parameter.name, f"a parameter of {owner}", parameter.location, where
             for kind, called in _ELEMENT_LISTS.items():
                 for k, element in enumerate(getattr(subsystem, kind)):
                     yield element.name, f"{called} of {owner}", element.location, f"{held}.{kind}[{k}].name"
@@ -1529,10 +1532,27 @@ def _declared_names(system: System) -> Iterator[tuple[object, str, SourceLocatio
                     if family is not None:
                         what = f"the family index of `{element.name}` in {owner}"
                         yield family.index, what, family.location, f"{held}.{kind}[{k}].family.index"
+            for k, stage in enumerate(subsystem.stage_sets):
+                yield stage.name, f"a stage set of {owner}", stage.location, f"{held}.stage_sets[{k}].name"
             if subsystem.fsm is not None:
                 for k, state in enumerate(subsystem.fsm.states):
                     where = f"{held}.fsm.states[{k}].name"
                     yield state.name, f"a state of the FSM of {owner}", state.location, where
+        yield from _link_names(agent.links, f"`{agent.name}/a`", at)
+    yield from _link_names(system.links, "the system", "system")
+
+
+def _link_names(links: Sequence[Link], owner: str, at: str) -> Iterator[tuple[object, str, SourceLocation | None, str]]:
+    """The names a link declares: each part of its name (`cs` is written as the keyword it is, and reads back)
+    and the index of a link family (`link cs,mc[K in 1..N]: …`)."""
+    for i, link in enumerate(links):
+        held = f"{at}.links[{i}]"
+        for j, part in enumerate(link.name):
+            if part.name != "cs":
+                yield part.name, f"a part of the name of a link of {owner}", link.location, f"{held}.name[{j}].name"
+        if link.family is not None:
+            what = f"the family index of a link of {owner}"
+            yield link.family.index, what, link.family.location, f"{held}.family.index"
 
 
 def unreadable_names(system: System) -> list[tuple[object, str, SourceLocation | None, str]]:
@@ -1588,16 +1608,20 @@ def unreadable_names(system: System) -> list[tuple[object, str, SourceLocation |
 
 
 #: a declared name where its element's location starts, after the keyword its declaration starts with:
-#: `param N: …`, `type T = …`, `struct S {`, `state s: …` (a line end or a comment may part them); only for that
-#: kind, as a family index `state` (`seen[state in 1..2]/m`) is the name itself, not `in` after it
+#: `param N: …`, `type T = …`, `struct S {`, `state s: …`, `stage s = …` (a line end or a comment may part
+#: them); only for that kind, as a family index `state` (`seen[state in 1..2]/m`) is the name itself, not `in`
+#: after it
 _WRITTEN_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 _AFTER_KEYWORD = {
     keyword: re.compile(rf"{keyword}(?:\s|//[^\n]*)+([A-Za-z_][A-Za-z0-9_]*)")
-    for keyword in ("param", "type", "struct", "state")
+    for keyword in ("param", "type", "struct", "state", "stage")
 }
 _PARAMETER = re.compile(r"\.parameters\[\d+\]\.name$")
 _TYPE = re.compile(r"^system\.types\[(\d+)\]\.name$")
 _STATE = re.compile(r"\.fsm\.states\[\d+\]\.name$")
+_STAGE = re.compile(r"\.stage_sets\[\d+\]\.name$")
+_LINK_NAME_PART = re.compile(r"\.links\[\d+\]\.name\[(\d+)\]\.name$")
+_COMMENT = re.compile(r"//[^\n]*")
 
 
 def _declaring_keyword(system: System, path: str) -> str | None:
@@ -1606,6 +1630,8 @@ def _declaring_keyword(system: System, path: str) -> str | None:
         return "param"
     if _STATE.search(path):
         return "state"
+    if _STAGE.search(path):
+        return "stage"
     definition = _TYPE.match(path)
     if definition is not None:
         return "struct" if isinstance(system.types[int(definition[1])], StructType) else "type"
@@ -1622,15 +1648,42 @@ def _written_at(system: System, location: SourceLocation, path: str) -> str | No
     if line is None:
         return None
     keyword = _declaring_keyword(system, path)
-    if keyword is None:
+    part = _LINK_NAME_PART.search(path)
+    if keyword is None and part is None:
         match = _WRITTEN_NAME.match(line, location.column - 1)
         return match.group(0) if match is not None else None
     # the declaration's span, which holds its name whatever lines it is written on
     span = [line[location.column - 1 :]]
     for number in range(location.line + 1, location.end_line + 1):
         span.append(sources.line(location.file, number) or "")
-    after = _AFTER_KEYWORD[keyword].match("\n".join(span))
+    if part is not None:
+        written = _written_link_name("\n".join(span))
+        return written[int(part[1])] if int(part[1]) < len(written) else None
+    after = _AFTER_KEYWORD[keyword].match("\n".join(span))  # type: ignore[index]
     return after.group(1) if after is not None else None
+
+
+def _written_link_name(text: str) -> list[str]:
+    """The parts of the name a link declaration (`link cs,mc[K in 1..N]: cs.x[K] -> …`) is written with; none
+    for a link written without a name (`link cs.x -> v/ve.y`), which is named after its ends."""
+    head = _COMMENT.sub(" ", text).removeprefix("link").split("->", 1)[0]
+    depth, cut, parts = 0, [0], []
+    for at, character in enumerate(head):
+        if character in "[(":
+            depth += 1
+        elif character in "])":
+            depth -= 1
+        elif depth == 0 and character == ",":
+            cut.append(at + 1)
+        elif depth == 0 and character == ":":
+            cut.append(at + 1)
+            break
+    else:
+        return []  # no `:` before the first end: the link has no name written
+    for start, end in itertools.pairwise(cut):
+        match = _WRITTEN_NAME.match(head[start : end - 1].strip())
+        parts.append(match.group(0) if match is not None else "")
+    return parts
 
 
 def is_earl_name(text: str) -> bool:
