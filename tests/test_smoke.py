@@ -81,3 +81,33 @@ def test_nohup_earl_run_outlives_its_terminal(tmp_path: Path) -> None:
             child.kill()
     assert child.returncode == 0, err
     assert b"ran 2.000 s" in out, out
+
+
+def test_every_command_s_help_says_its_exit_codes() -> None:
+    """`earl trace summary --help` said no exit codes (only `earl trace --help` did), nor did `earl rules
+    --help`; and none but `run` and `launch` said 130, which docs/language.md gives every command for Ctrl-C."""
+    import argparse
+    import subprocess
+    import sys
+
+    from earl.cli.main import build_parser
+
+    def commands(parser: argparse.ArgumentParser, words: tuple[str, ...]) -> list[tuple[str, ...]]:
+        found = [words]
+        for action in parser._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                for name, sub in action.choices.items():
+                    found += commands(sub, (*words, name))
+        return found
+
+    every = commands(build_parser(), ())
+    assert ("trace", "summary") in every and ("rules",) in every
+    for words in every:
+        shown = subprocess.run(
+            [sys.executable, "-m", "earl", *words, "--help"], capture_output=True, text=True, timeout=120
+        )
+        assert shown.returncode == 0, shown.stderr
+        said = " ".join(shown.stdout.split("exit codes:", 1)[-1].split())
+        assert "exit codes:" in shown.stdout, f"`earl {' '.join(words)} --help` says no exit codes"
+        assert said.startswith("0 "), (words, said)
+        assert "2 usage error" in said and "130 interrupted" in said, (words, said)

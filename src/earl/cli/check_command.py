@@ -28,7 +28,8 @@ def register(commands: Any) -> None:
         "every rule of the EARL manual (docs/rules.md) and analyse each FSM for overlapping, dead and missing "
         "transition conditions. Each problem is reported with its file, line and column. Reading a spec never "
         "runs code it names.",
-        epilog="exit codes: 0 valid (warnings and notes allowed; see --strict), 1 errors found, 2 usage error",
+        epilog="exit codes: 0 valid (warnings and notes allowed; see --strict), 1 errors found, 2 usage error,\n"
+        "130 interrupted (Ctrl-C)",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("spec", metavar="SPEC", help="the .earl file, or a directory with a system.earl")

@@ -41,7 +41,8 @@ examples:
   earl diagram examples/pick_and_place --view activity --target manip/a.cs.jointMove/bb -o act.svg
   earl diagram examples/pick_and_place --view agent --target manip/a --expand --param N=3 -o manip3.svg
 
-exit codes: 0 drawn, 1 the spec cannot be read, 2 usage error (bad target, an empty or unwritable -o, Graphviz missing)
+exit codes: 0 drawn, 1 the spec cannot be read, 2 usage error (bad target, an empty or unwritable -o, Graphviz missing),
+130 interrupted (Ctrl-C)
 """
 
 

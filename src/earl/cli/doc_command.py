@@ -26,7 +26,7 @@ examples:
   earl doc examples/pick_and_place -o site-n3/ --param N=3 --expand
 
 exit codes: 0 written, 1 the spec cannot be read or `earl check` found errors (the document is still
-written and shows them), 2 usage error (missing file, Graphviz missing, output not writable)
+written and shows them), 2 usage error (missing file, Graphviz missing, output not writable), 130 interrupted (Ctrl-C)
 """
 
 

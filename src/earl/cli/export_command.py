@@ -30,7 +30,7 @@ def register(commands: Any) -> None:
         f"library of the manual's concepts ({LIBRARY_FILE}); with -o it is written beside the output. The "
         "specification must pass `earl check` first. Exporting never runs code a spec names. See docs/sysml.md.",
         epilog="exit codes: 0 written, 1 invalid specification, 2 usage error (missing file, bad option, "
-        "output not writable)",
+        "output not writable), 130 interrupted (Ctrl-C)",
     )
     parser.add_argument("language", choices=["sysml"], help="the language to write: sysml (SysML v2 text)")
     parser.add_argument("spec", metavar="SPEC", help="the .earl file, or a directory with a system.earl")

@@ -23,7 +23,7 @@ def register(commands: Any) -> None:
         "the parts of every subsystem in the manual's order, a blank line between two groups of them. Comments "
         "are kept, and so is one blank line where one or more were left between two members of a group.",
         epilog="exit codes: 0 done (or canonical with --check), 1 invalid, not canonical, or a file that could not "
-        "be put in canonical form or rewritten (it is left as it was), 2 usage error",
+        "be put in canonical form or rewritten (it is left as it was), 2 usage error, 130 interrupted (Ctrl-C)",
     )
     parser.add_argument("files", metavar="FILE", nargs="+", help=".earl files")
     mode = parser.add_mutually_exclusive_group()

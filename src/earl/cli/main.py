@@ -56,7 +56,8 @@ examples:
   earl run examples/pick_and_place --trace run.mcap   run it against MuJoCo, record a trace
   earl trace summary run.mcap                         time in each state, transitions, faults
 
-exit codes: 0 valid, 1 invalid specification, 2 usage error (missing file, bad option)
+exit codes: 0 valid, 1 invalid specification, 2 usage error (missing file, bad option), 130 interrupted
+(Ctrl-C); each command's --help says its own
 docs: docs/language.md (the language), docs/rules.md (the checks), docs/semantics.md (how a run
 behaves), docs/runtime.md (user code), docs/distributed.md, docs/diagrams.md, docs/sysml.md
 """

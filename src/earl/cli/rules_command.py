@@ -18,6 +18,9 @@ def register(commands: Any) -> None:
         "rules",
         help="list the rules of `earl check`, or explain one",
         description="Without CODE, list every rule with its manual reference; with CODE, explain that rule.",
+        epilog="examples:\n  earl rules\n  earl rules E060\n\nexit codes: 0 listed or explained, 2 usage error "
+        "(no such code, an empty CODE), 130 interrupted (Ctrl-C)",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("code", metavar="CODE", nargs="?", help="a code such as EARL-E060 (or just E060)")
     parser.set_defaults(run=run)

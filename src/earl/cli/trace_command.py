@@ -19,7 +19,8 @@ def register(commands: Any) -> None:
         "trace",
         help="read an MCAP trace written by `earl run --trace`",
         description="Read a trace written by `earl run --trace FILE.mcap`.",
-        epilog="example:\n  earl trace summary run.mcap\n\nexit codes: 0 ok, 1 not a readable earl trace, 2 usage error (no such file)",
+        epilog="example:\n  earl trace summary run.mcap\n\nexit codes: 0 ok, 1 not a readable earl trace, 2 usage error (no such file, no ACTION), "
+        "130 interrupted (Ctrl-C)",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     actions = trace.add_subparsers(dest="action", metavar="ACTION", parser_class=type(trace))
@@ -27,6 +28,9 @@ def register(commands: Any) -> None:
         "summary",
         help="per subsystem: time in each state, transitions taken, faults",
         description="Per subsystem: the time spent in each FSM state, the transitions taken and the faults.",
+        epilog="example:\n  earl trace summary run.mcap\n\nexit codes: 0 summarised, 1 not a readable earl trace, "
+        "2 usage error (no such file), 130 interrupted (Ctrl-C)",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     summary.add_argument("file", metavar="FILE.mcap")
     summary.set_defaults(run=run_summary)
@@ -45,7 +49,7 @@ def register(commands: Any) -> None:
         "from 0 (currentJointPos[0] is its first); [*] is every member or element.",
         epilog="example:\n  earl plot run.mcap --signal manip/a.cs.windingCurrent[1] -o current.png\n\n"
         "exit codes: 0 written, 1 the file is not a readable earl trace or lacks a signal, 2 usage error\n"
-        "(no such file, a malformed signal, an empty or unwritable -o)",
+        "(no such file, a malformed signal, an empty or unwritable -o), 130 interrupted (Ctrl-C)",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     plot.add_argument("file", metavar="FILE.mcap")
