@@ -1623,11 +1623,13 @@ def test_a_run_of_some_agents_plots_their_signals_of_run_toml_and_refuses_anothe
     assert "no signal of run.toml's `plot` is of an agent this process runs" in " ".join(none.stderr.split())
 
 
-def _interrupted_early(command: list[str], delay: float) -> tuple[int, list[str]] | None:
+def _interrupted_early(
+    command: list[str], delay: float, stop: signal.Signals = signal.SIGINT
+) -> tuple[int, list[str]] | None:
     """`command` (run with `python -X importtime`, which says on stderr each module as it is imported)
-    gets SIGINT `delay` seconds after the first module of earl's own is imported: past Python's start,
-    which no program can answer, somewhere in the imports, the parsing or the command itself. Its exit
-    code and what it said on stderr; None when it had ended before the signal."""
+    gets `stop` (SIGINT) `delay` seconds after the first module of earl's own is imported: past Python's
+    start, which no program can answer, somewhere in the imports, the parsing or the command itself. Its
+    exit code and what it said on stderr; None when it had ended before the signal."""
     child = subprocess.Popen(
         [sys.executable, "-X", "importtime", *command],
         stdout=subprocess.DEVNULL,
@@ -1648,7 +1650,7 @@ def _interrupted_early(command: list[str], delay: float) -> tuple[int, list[str]
         time.sleep(delay)
         if child.poll() is not None:
             return None
-        child.send_signal(signal.SIGINT)
+        child.send_signal(stop)
         rest = child.communicate(timeout=60)[1].decode(errors="replace")
     finally:
         if child.poll() is None:
@@ -1679,6 +1681,55 @@ def test_ctrl_c_at_any_moment_of_the_start_is_exit_130_with_one_line(tmp_path: P
         assert len(said) == 1 and "interrupted" in said[0], (delay, said)
         interrupted += 1
     assert interrupted >= 4
+
+
+@pytest.mark.parametrize("stop", [signal.SIGTERM, signal.SIGHUP])
+def test_sigterm_or_sighup_at_any_moment_of_the_start_of_earl_run_is_exit_130_with_one_line(
+    stop: signal.Signals,
+) -> None:
+    """A SIGTERM in the first few tenths of a second of `earl run` (`timeout`, a service manager), before the
+    run's own handler was in place, ended the program by the signal (-15, 143 in a shell), and a little later
+    it was exit 130 with one line; now it is 130 from the first line of earl on, as for Ctrl-C."""
+    spec = str(EXAMPLE)
+    interrupted = 0
+    for delay in (0.0, 0.0, 0.01, 0.02, 0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.6):
+        result = _interrupted_early(["-m", "earl", "run", spec, "--duration", "1s", "--no-progress"], delay, stop)
+        if result is None:
+            continue  # done before the signal
+        code, said = result
+        assert code == 130, (delay, said)
+        # once the run has started, it first says it stops after the instant running (docs/semantics.md)
+        assert said[:-1] in ([], ["earl run: stopping after this instant"]), (delay, said)
+        assert said and "interrupted" in said[-1], (delay, said)
+        interrupted += 1
+    assert interrupted >= 6
+
+
+def test_a_sigterm_the_shell_has_earl_run_ignore_stays_ignored_while_it_starts() -> None:
+    """`nohup` (SIGHUP) or `trap '' TERM`: earl's start-up handler must not replace the ignore."""
+
+    def ignoring() -> None:  # as `nohup` and `trap '' TERM` leave them to the program they start
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)
+        signal.signal(signal.SIGHUP, signal.SIG_IGN)
+
+    child = subprocess.Popen(
+        [sys.executable, "-m", "earl", "run", str(EXAMPLE), "--duration", "0.3s", "--no-progress"],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        start_new_session=True,
+        preexec_fn=ignoring,
+    )
+    try:
+        for _ in range(20):  # through the imports and the start of the run
+            time.sleep(0.05)
+            child.send_signal(signal.SIGTERM)
+            child.send_signal(signal.SIGHUP)
+        stderr = child.communicate(timeout=120)[1].decode(errors="replace")
+    finally:
+        if child.poll() is None:
+            child.kill()
+            child.wait()
+    assert child.returncode == 0, stderr
 
 
 #: the `earl` script as pip writes it, which sends itself the stop signal EARL_TEST_SIGNAL as Python starts to
@@ -1735,7 +1786,9 @@ def test_a_stop_signal_while_dds_compiled_module_initialises_is_exit_130(
     assert (result.returncode, lines[1:], result.stdout) == (130, [said], ""), result.stdout + result.stderr
 
 
-def test_ctrl_c_while_launch_starts_is_exit_130_without_a_traceback(tmp_path: Path) -> None:
+@pytest.mark.parametrize("stop", [signal.SIGINT, signal.SIGTERM, signal.SIGHUP])
+def test_ctrl_c_while_launch_starts_is_exit_130_without_a_traceback(tmp_path: Path, stop: signal.Signals) -> None:
+    """So is a SIGTERM or SIGHUP, which ended `earl launch` by the signal before its own handler was in place."""
     spec = Path(__file__).parent / "distributed_specs" / "pingpong"
     ports = []
     for _ in range(2):
@@ -1750,7 +1803,7 @@ def test_ctrl_c_while_launch_starts_is_exit_130_without_a_traceback(tmp_path: Pa
         )
     )
     for delay in (0.0, 0.02, 0.05, 0.1):
-        result = _interrupted_early(["-m", "earl", "launch", str(spec), "--deployment", str(deploy)], delay)
+        result = _interrupted_early(["-m", "earl", "launch", str(spec), "--deployment", str(deploy)], delay, stop)
         assert result is not None
         code, said = result
         assert code == 130, (delay, said)

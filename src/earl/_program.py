@@ -7,6 +7,11 @@ print its traceback. In the program (and only there: a library user's handlers a
 module's handler is in place from the package's first line until `earl.cli.main.main` takes over,
 and again once the command is done, while the interpreter ends. Importing this module puts it in
 place (`guard`): `earl/__init__.py` imports it first.
+
+`earl run` and `earl launch` end as Ctrl-C does on SIGTERM and SIGHUP too (docs/semantics.md,
+docs/distributed.md): for them the same holds of those two signals from the first line, not only once
+the command has put its own handler in place, so that a `timeout` or a service manager that stops
+one as it starts does not end it by the signal (143 in a shell).
 """
 
 from __future__ import annotations
@@ -47,24 +52,53 @@ def interrupted(*_: object) -> None:
 
 #: whether this interpreter runs the `earl` command (`guard` decides it)
 PROGRAM = False
+#: the commands that a SIGTERM or SIGHUP ends as Ctrl-C does (the run's `STOP_SIGNALS`)
+STOPPED_LIKE_CTRL_C = frozenset({"run", "launch"})
+#: SIGTERM and SIGHUP (not on Windows), when the command is one of STOPPED_LIKE_CTRL_C and the program
+#: was not started to ignore them (`nohup` ignores SIGHUP, `trap '' TERM` SIGTERM): `guard` decides it
+OTHER_STOPS: tuple[int, ...] = ()
+
+
+def command_named(words: list[str]) -> str | None:
+    """The command the program's arguments name: the first word that is not an option (as
+    `earl.cli.main` reads it); None for `earl --help` and the like."""
+    for word in words:
+        if word in ("-h", "--help", "--version"):
+            return None
+        if not word.startswith("-"):
+            return word
+    return None
 
 
 def guard() -> None:
     """`interrupted` for Ctrl-C, in the program only, and only where Ctrl-C would interrupt it: a SIGINT
     that the shell had the program ignore (`trap '' INT`, a job started with `&` by a non-interactive
-    shell, `nohup`) stays ignored."""
-    global PROGRAM
-    PROGRAM = is_program() and signal.getsignal(signal.SIGINT) is signal.default_int_handler
-    if PROGRAM:
-        with contextlib.suppress(ValueError, OSError):  # not the main thread: Python's handler stays
-            signal.signal(signal.SIGINT, interrupted)
+    shell, `nohup`) stays ignored. So too for SIGTERM and SIGHUP in `earl run` and `earl launch`."""
+    global PROGRAM, OTHER_STOPS
+    program = is_program()
+    PROGRAM = program and signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    if program and command_named(sys.argv[1:]) in STOPPED_LIKE_CTRL_C:
+        numbers = (getattr(signal, name, None) for name in ("SIGTERM", "SIGHUP"))
+        OTHER_STOPS = tuple(n for n in numbers if n is not None and signal.getsignal(n) == signal.SIG_DFL)
+    with contextlib.suppress(ValueError, OSError):  # not the main thread: Python's handlers stay
+        for number in _guarded():
+            signal.signal(number, interrupted)
+
+
+def _guarded() -> tuple[int, ...]:
+    """The stop signals the program answers with `interrupted` while no command handles them."""
+    return ((signal.SIGINT,) if PROGRAM else ()) + OTHER_STOPS
 
 
 def take_over() -> None:
-    """The command runs: Ctrl-C raises KeyboardInterrupt again, which the command handles."""
+    """The command runs: Ctrl-C raises KeyboardInterrupt again, which the command handles; so does a SIGTERM
+    or SIGHUP of `earl run` or `earl launch`, until the command puts its own handler in place."""
     with contextlib.suppress(ValueError, OSError):
         if signal.getsignal(signal.SIGINT) is interrupted:
             signal.signal(signal.SIGINT, signal.default_int_handler)
+        for number in OTHER_STOPS:
+            if signal.getsignal(number) is interrupted:
+                signal.signal(number, signal.default_int_handler)
 
 
 def hand_back(code: int) -> None:
@@ -76,9 +110,9 @@ def hand_back(code: int) -> None:
     for stream in (sys.stdout, sys.stderr):
         with contextlib.suppress(Exception):  # a reader gone, a full disk: said already, or not to be
             stream.flush()
-    if PROGRAM:
-        with contextlib.suppress(ValueError, OSError):
-            signal.signal(signal.SIGINT, interrupted)
+    with contextlib.suppress(ValueError, OSError):
+        for number in _guarded():
+            signal.signal(number, interrupted)
 
 
 #: the exit code of a command that Ctrl-C stopped
