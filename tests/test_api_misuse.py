@@ -28,6 +28,7 @@ from earl import (
     Kind,
     LinkNamePart,
     Literal,
+    Name,
     Predicate,
     PrimitiveType,
     Quantifier,
@@ -863,3 +864,38 @@ def test_stage_sets_and_links_named_as_keywords_in_the_text_are_read_as_written(
     assert not [d for d in check(system) if d.code == "EARL-R006"]
     monkeypatch.undo()
     assert earl.loads(system.to_earl(), "again.earl") == system
+
+
+@pytest.mark.parametrize("index", ["my K", "any", "not", "true", "J"])
+def test_the_index_of_any_built_in_python_is_said_when_it_would_not_read_back(index: str) -> None:
+    """`Quantifier("any", "my K", …)` passed check and `to_earl()` wrote `any(my K in 1..N: …)`, which does not
+    read back; `any(true in 1..2: true …)` reads back with a Boolean literal where the index was."""
+    from dataclasses import replace
+
+    from earl.model.validate import ModelNameError
+
+    system = earl.load(Path(__file__).parent.parent / "examples" / "pick_and_place")
+    [predicate] = [p for p in system.agents[1].subsystems[0].primitive_predicates if p.name == "emergencyStop"]
+    assert isinstance(predicate.expression, BooleanOperation)
+    written, quantifier = predicate.expression.operands
+    assert isinstance(quantifier, Quantifier) and isinstance(quantifier.body, Read)
+    target = replace(quantifier.body.target, indices=(Name(index),))
+    renamed = replace(quantifier, index=index, body=replace(quantifier.body, target=target))
+    predicate.expression = replace(predicate.expression, operands=(written, renamed))
+    said = [d for d in check(system) if d.code == "EARL-R006"]
+    if index == "J":  # a name: it reads back as written
+        assert not said
+        assert earl.loads(system.to_earl()) == system
+        return
+    expected = (
+        f"{index!r} is no EARL name (the index of `any`/`all`)"
+        if " " in index
+        else f"`{index}` is a keyword of EARL where it is declared (the index of `any`/`all`): the text would not "
+        "read back"
+    )
+    assert [d.message for d in said] == [expected]
+    assert said[0].location == quantifier.location
+    at = system.agents[1].subsystems[0].primitive_predicates.index(predicate)
+    path = f"system.agents[1].subsystems[0].primitive_predicates[{at}].expression.operands[1].index"
+    with pytest.raises(ModelNameError, match=re.escape(f"{path}: '{index}' (the index of `any`/`all`)")):
+        system.to_earl()

@@ -11,7 +11,7 @@ from __future__ import annotations
 import itertools
 import re
 from collections.abc import Iterable, Iterator, Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, is_dataclass, replace
 from typing import Any
 
 from earl.diagnostics import Diagnostic, Severity, SourceMap, did_you_mean
@@ -22,6 +22,7 @@ from earl.model.elements import (
     Link,
     LinkEnd,
     Parameter,
+    Predicate,
     Subsystem,
     System,
     duration_problems,
@@ -43,6 +44,7 @@ from earl.model.expressions import (
     children,
     evaluate_constant,
     evaluate_integer,
+    walk,
 )
 from earl.model.graphs import cycles
 from earl.model.kinds import KIND_TITLES, Kind
@@ -257,24 +259,28 @@ class Resolver:
         keyword where it stands: `period/m`); only a model built in Python can hold one, and `to_earl()`
         would write text that does not load."""
         for name, what, location, _ in unreadable_names(self.system):
-            if isinstance(name, str) and _NAME.fullmatch(name):  # a keyword where it stands
-                self.error(
-                    f"`{name}` is a keyword of EARL where it is declared ({what}): the text would not read back",
-                    location,
-                    "EARL-R006",
-                    f"rename it, e.g. `{name}_` or `my{name[:1].upper()}{name[1:]}`",
-                )
-                continue
-            if isinstance(name, str) and "/" in name and _NAME.fullmatch(name.split("/")[0]):
-                hint = f"write the name without its kind: `{name.split('/')[0]}` (the kind is the element's class)"
-            else:
-                suggestion = re.sub(r"\W", "_", name, flags=re.ASCII) if isinstance(name, str) and name else ""
-                if suggestion[:1].isdigit():
-                    suggestion = "_" + suggestion
-                hint = "a name is a letter or `_`, then letters, digits and `_`" + (
-                    f", e.g. `{suggestion}`" if suggestion else ""
-                )
-            self.error(f"{name!r} is no EARL name ({what})", location, "EARL-R006", hint)
+            self._unreadable(name, what, location)
+
+    def _unreadable(self, name: object, what: str, location: SourceLocation | None) -> None:
+        """EARL-R006 of one name."""
+        if isinstance(name, str) and _NAME.fullmatch(name):  # a keyword where it stands
+            self.error(
+                f"`{name}` is a keyword of EARL where it is declared ({what}): the text would not read back",
+                location,
+                "EARL-R006",
+                f"rename it, e.g. `{name}_` or `my{name[:1].upper()}{name[1:]}`",
+            )
+            return
+        if isinstance(name, str) and "/" in name and _NAME.fullmatch(name.split("/")[0]):
+            hint = f"write the name without its kind: `{name.split('/')[0]}` (the kind is the element's class)"
+        else:
+            suggestion = re.sub(r"\W", "_", name, flags=re.ASCII) if isinstance(name, str) and name else ""
+            if suggestion[:1].isdigit():
+                suggestion = "_" + suggestion
+            hint = "a name is a letter or `_`, then letters, digits and `_`" + (
+                f", e.g. `{suggestion}`" if suggestion else ""
+            )
+        self.error(f"{name!r} is no EARL name ({what})", location, "EARL-R006", hint)
 
     def _parameters(self, parameters: Sequence[Parameter], scope: Scope, overrides: Mapping[str, Value] = {}) -> None:
         seen: dict[str, Parameter] = {}
@@ -1133,6 +1139,8 @@ class Resolver:
                     self.unknown_name(node, node_scope)
                 continue
             if isinstance(node, Quantifier):
+                if _unreadable_index(node.index):  # built in Python: read from text, it is a name
+                    self._unreadable(node.index, _QUANTIFIER_INDEX, node.location)
                 if node.index in node_scope:  # it would hide the family's (or outer quantifier's) index
                     self.error(
                         _in_use(node.index, node_scope),
@@ -1429,8 +1437,6 @@ def _without_indices(name: str) -> str:
 
 
 def _names(expression: Expression) -> list[Name]:
-    from earl.model.expressions import walk
-
     return [node for node in walk(expression) if isinstance(node, Name)]
 
 
@@ -1684,6 +1690,71 @@ def _written_link_name(text: str) -> list[str]:
         match = _WRITTEN_NAME.match(head[start : end - 1].strip())
         parts.append(match.group(0) if match is not None else "")
     return parts
+
+
+#: what the index of `any(K in 1..N: …)` is called in EARL-R006
+_QUANTIFIER_INDEX = "the index of `any`/`all`"
+#: words the index of `any`/`all` cannot be: the reader takes them for an expression (`any(`, `not …`) or,
+#: in its body, for a Boolean literal (`true > 0`), so the text would not read back as the same system
+_NOT_AN_INDEX = frozenset({"any", "all", "not", "true", "false"})
+
+
+def _unreadable_index(index: object) -> bool:
+    """Whether the index of a quantifier, as `to_earl` writes it, would not read back as that index."""
+    return not isinstance(index, str) or not is_earl_name(index) or index in _NOT_AN_INDEX
+
+
+def unreadable_quantifier_indexes(system: System) -> list[tuple[object, str, SourceLocation | None, str]]:
+    """The index of every `any`/`all` of the system that would not read back (`Quantifier("any", "my K", …)`
+    built in Python), with its attribute path. Only `to_earl` asks: check says them as it resolves each
+    expression."""
+    found: list[tuple[object, str, SourceLocation | None, str]] = []
+    for root, at in _expressions(system):
+        if isinstance(root, Predicate):  # a condition: `tc = …`, a transition's `when …`
+            root, at = root.expression, f"{at}.expression"
+        if root is None or not any(
+            isinstance(node, Quantifier) and _unreadable_index(node.index) for node in walk(root)
+        ):
+            continue  # the usual case, asked without building the path of every node
+        stack: list[tuple[object, str]] = [(root, at)]
+        while stack:
+            node, where = stack.pop()
+            if isinstance(node, Quantifier) and _unreadable_index(node.index):
+                found.append((node.index, _QUANTIFIER_INDEX, node.location, f"{where}.index"))
+            if isinstance(node, list | tuple):
+                stack.extend(reversed([(item, f"{where}[{i}]") for i, item in enumerate(node)]))
+            elif is_dataclass(node) and not isinstance(node, type):
+                # what the model compares is what it means: a location is not walked
+                named = [(getattr(node, f.name, None), f"{where}.{f.name}") for f in fields(node) if f.compare]
+                stack.extend(reversed(named))  # in the order they are written
+    return found
+
+
+def _expressions(system: System) -> Iterator[tuple[Any, str]]:
+    """Every expression a quantifier can stand in (a value, a condition), with its attribute path; not the
+    sizes of arrays nor the bounds of families, which are integers."""
+    for i, parameter in enumerate(system.parameters):
+        yield parameter.value, f"system.parameters[{i}].value"
+    for i, agent in enumerate(system.agents):
+        at = f"system.agents[{i}]"
+        for j, parameter in enumerate(agent.parameters):
+            yield parameter.value, f"{at}.parameters[{j}].value"
+        for j, subsystem in enumerate(agent.subsystems):
+            held = f"{at}.subsystems[{j}]"
+            for k, parameter in enumerate(subsystem.parameters):
+                yield parameter.value, f"{held}.parameters[{k}].value"
+            for k, memory in enumerate(subsystem.memories):
+                yield memory.initial_value, f"{held}.memories[{k}].initial_value"
+            for k, predicate in enumerate(subsystem.primitive_predicates):
+                yield predicate.expression, f"{held}.primitive_predicates[{k}].expression"
+            for k, behaviour in enumerate(subsystem.basic_behaviours):
+                yield behaviour.terminal_condition, f"{held}.basic_behaviours[{k}].terminal_condition"
+                yield behaviour.error_condition, f"{held}.basic_behaviours[{k}].error_condition"
+            if subsystem.fsm is not None:
+                for k, transition in enumerate(subsystem.fsm.transitions):
+                    yield transition.condition, f"{held}.fsm.transitions[{k}].condition"
+                for k, assumption in enumerate(subsystem.fsm.assumptions):
+                    yield assumption.expression, f"{held}.fsm.assumptions[{k}].expression"
 
 
 def is_earl_name(text: str) -> bool:

@@ -592,11 +592,11 @@ class System:
     def to_earl(self) -> str:
         """This system as canonical `.earl` text (what `earl fmt` prints)."""
         from earl.lang.formatter import format_system  # the model itself imports no reader
-        from earl.lang.resolver import is_earl_name, unreadable_names
+        from earl.lang.resolver import is_earl_name, unreadable_names, unreadable_quantifier_indexes
         from earl.model.validate import ModelNameError, explaining
 
         with explaining(self):  # a model built in Python with a wrong value: said at its path
-            unreadable = unreadable_names(self)
+            unreadable = unreadable_names(self) or unreadable_quantifier_indexes(self)
         if unreadable:  # `System("my system")`, `Memory("period", …)`: a text that would not read back
             name, what, _, path = unreadable[0]
             why = (
