@@ -246,3 +246,21 @@ def test_another_tool_s_topics_are_listed_escaped_when_its_file_is_said_to_be_no
         read_signals(other, ["s/a.cs.x"])
     assert "not an earl trace: it has no /earl/run topic (its topics: /odom\\x1b[2J)" in str(caught.value)
     assert "\x1b" not in str(caught.value)
+
+
+def test_a_foxglove_message_path_given_as_a_signal_gets_earl_s_spelling(tmp_path: Path) -> None:
+    """The path docs/semantics.md gives for Foxglove, pasted as a signal: the caret at its `"` came
+    without a word on what earl calls that value (`earl plot --signal` and `earl run --signal` say
+    the same, `str` of the MalformedSignal)."""
+    trace = tmp_path / "t.mcap"
+    write_trace(trace, [(0.0, "idle")], [(0.1, {"ready": True})], GOAL)
+    with pytest.raises(TraceError) as caught:
+        read_signals(trace, ['"/manip/a.cs/memory".windingCurrent[1]'])
+    lines = str(caught.value).splitlines()
+    assert lines[0].startswith('`"/manip/a.cs/memory".windingCurrent[1]` is malformed at character 1')
+    assert lines[-1] == "this is a Foxglove message path; earl names that value `manip/a.cs.windingCurrent[1]`"
+    every = str(signal_syntax_error('"/manip/a.cs/memory".windingCurrent[:]'))
+    assert every.endswith("earl names that value `manip/a.cs.windingCurrent[*]`")
+    link = str(signal_syntax_error('"/link/task,manip".emergencyStopCommand'))
+    assert "earl names a value a link carries by the output buffer it leaves" in link
+    assert "Foxglove" not in str(signal_syntax_error("s/a.cs.cmd["))

@@ -33,7 +33,39 @@ class MalformedSignal:
         """The spot and what is wrong there, then the signal again with a caret under the spot."""
         shown = escape_controls(self.signal)
         column = len(escape_controls(self.signal[: self.at]))
-        return f"`{shown}` is malformed at character {column + 1}: {self.problem}\n  {shown}\n  {' ' * column}^"
+        said = f"`{shown}` is malformed at character {column + 1}: {self.problem}\n  {shown}\n  {' ' * column}^"
+        hint = foxglove_hint(self.signal)
+        return said if hint is None else f"{said}\n{hint}"
+
+
+#: a Foxglove message path of a trace's topic, as docs/semantics.md shows them: `"/manip/a.cs/memory".x[1]`
+_FOXGLOVE_PATH = re.compile(r'"?/(?P<topic>[^"]*)"?(?P<path>(?:\.[A-Za-z_][A-Za-z0-9_]*(?:\[[0-9:]*\])?)*)\Z')
+
+
+def foxglove_hint(signal: str) -> str | None:
+    """For a Foxglove message path pasted as a signal, how earl names what it plots; None for other text.
+
+    A memory topic's path is the subsystem's memory: `"/manip/a.cs/memory".windingCurrent[1]` is
+    `manip/a.cs.windingCurrent[1]`. A link's topic is named by the link, where a signal names the
+    output buffer it leaves, which only the trace knows."""
+    found = _FOXGLOVE_PATH.match(signal)
+    if found is None or not signal.startswith(('"/', "/")):
+        return None
+    topic, path = found.group("topic"), found.group("path").replace("[:]", "[*]")
+    if topic.endswith("/memory") and path:
+        spelled = f"{topic.removesuffix('/memory')}{path}"
+        return f"this is a Foxglove message path; earl names that value `{escape_controls(spelled)}`"
+    if topic.startswith("link/"):
+        return (
+            "this is a Foxglove message path; earl names a value a link carries by the output buffer it leaves, "
+            "`agent/a.subsystem.buffer.field` (the link's channel names it, `source`; `earl plot TRACE "
+            "--signal agent/a.subsystem` lists them)"
+        )
+    if topic.endswith("/fsm"):
+        return (
+            "this is a Foxglove message path; earl plot draws a subsystem's states as the shaded bands of its signals"
+        )
+    return None
 
 
 def signal_text_problem(signal: str) -> str | None:
