@@ -229,15 +229,19 @@ def write_another_tool_s_mcap(path: Path, encoding: str, data: bytes, topic: str
         writer.finish()
 
 
+@pytest.mark.parametrize("cut", [False, True], ids=["whole", "cut-short"])
 @pytest.mark.parametrize(("encoding", "data"), [("json", b'{"x": 1.5}'), ("protobuf", b"\x08\x96\x01")])
 def test_an_mcap_file_of_another_tool_is_said_not_to_be_an_earl_trace_by_summary_and_plot(
-    tmp_path: Path, encoding: str, data: bytes
+    tmp_path: Path, encoding: str, data: bytes, cut: bool
 ) -> None:
     """`earl plot` said "`/odom.x` does not start with a subsystem of this trace (none)", and of a file
     whose messages are not JSON `earl trace summary` said that a message is not JSON: both say what
-    the file is, in the same words, exit 1."""
+    the file is, in the same words, exit 1. Also of a file cut short, which has no summary section
+    listing its topics: summary decoded its messages first, "a message is not JSON text"."""
     other = tmp_path / "other.mcap"
     write_another_tool_s_mcap(other, encoding, data)
+    if cut:  # its end (the summary section, the footer) is lost; its channel and messages are whole
+        other.write_bytes(other.read_bytes()[:-40])
     said = (
         f"{other} is an MCAP file but not an earl trace: it has no /earl/run topic (its topics: /odom); "
         "`earl run --trace FILE.mcap` writes one"

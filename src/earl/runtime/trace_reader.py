@@ -174,22 +174,12 @@ def _not_an_earl_trace(path: Path, topics: Iterable[str]) -> TraceError:
     )
 
 
-def _indexed_topics(path: Path) -> set[str] | None:
-    """The topics of a file's summary section, read without its messages; None when it has none (cut
-    short) or cannot be read, which reading its messages then says."""
-    try:
-        with open(path, "rb") as stream:
-            summary = make_reader(stream, validate_crcs=True).get_summary()
-    except Exception:  # as in `_messages`: whatever a damaged file provokes
-        return None
-    return None if summary is None else {channel.topic for channel in summary.channels.values()}
-
-
 def summarise(path: Path) -> TraceSummary:
-    # another tool's file is said to be one before its messages are read: they need not be JSON
-    indexed = _indexed_topics(path)
-    if indexed is not None and trace_topics.RUN not in indexed:
-        raise _not_an_earl_trace(path, indexed)
+    # another tool's file is said to be one before its messages are read, as `earl plot` says it: they
+    # need not be JSON, and a file cut short has no summary section listing its topics
+    channels = _channels(path)
+    if trace_topics.RUN not in channels:
+        raise _not_an_earl_trace(path, channels)
     summariser = _Summariser()
     cut: list[bool] = []
     seen: set[str] = set()
