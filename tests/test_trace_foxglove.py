@@ -16,19 +16,24 @@ The rules are Foxglove's, written here from its sources, not from earl's code:
 from __future__ import annotations
 
 import json
+import math
 import re
 import subprocess
 import sys
 from pathlib import Path
 from typing import Any
 
+import jsonschema
+import pytest
 from mcap.reader import make_reader
 from mcap.writer import Writer
 
-from earl.runtime.trace_reader import read_signals
+from earl.runtime import trace_topics
+from earl.runtime.trace_reader import TraceError, read_signals, summarise
 
 ROOT = Path(__file__).resolve().parents[1]
 PICK_AND_PLACE = ROOT / "examples" / "pick_and_place"
+MOBILE_ROBOT = ROOT / "examples" / "mobile_robot"
 
 # ---------------------------------------------------------------- Foxglove's message path grammar
 ID = r"[a-zA-Z0-9_]+"
@@ -343,3 +348,162 @@ def test_a_struct_inside_itself_is_traced_and_its_schema_ends(tmp_path: Path) ->
     assert messages["/link/t,u"][-1]["children"][0]["label"] == 2.0
     [series] = read_signals(trace, ["t/a.cs.out.children[0].label"]).series
     assert series.values[-1] == 2.0
+
+
+# ---------------------------------------------------------------- every message fits its channel's schema
+def messages_not_fitting_their_schema(path: Path) -> dict[str, str]:
+    """Each topic with a message that its channel's JSON schema refuses, as `jsonschema` (the reference
+    implementation) says it, with the first such message's first error; each schema is checked to be
+    one (`check_schema`) first."""
+    validators: dict[str, Any] = {}
+    refused: dict[str, str] = {}
+    with open(path, "rb") as stream:
+        for schema, channel, message in make_reader(stream).iter_messages():
+            validator = validators.get(channel.topic)
+            if validator is None:
+                assert schema is not None and schema.encoding == "jsonschema", channel.topic
+                document = json.loads(schema.data)
+                kind = jsonschema.validators.validator_for(document)
+                kind.check_schema(document)
+                validator = validators[channel.topic] = kind(document)
+            error = next(validator.iter_errors(json.loads(message.data)), None)
+            if error is not None and channel.topic not in refused:
+                refused[channel.topic] = f"{error.message} at {list(error.absolute_path)}"
+    assert validators, f"{path} has no message"
+    return refused
+
+
+def test_every_message_of_the_flagship_trace_is_valid_against_its_channel_s_schema(tmp_path: Path) -> None:
+    """19 of 84 topics of this trace had messages their schemas refuse: the first state change's `from`
+    and `transition` were null against `"type": "string"`, an absent optional field (`jointPosSetpoint`
+    of `/link/task,manip`) null against its type. They are left out of the message, as the schema leaves
+    them out of `required`, and `earl plot` still says such a field was never sent."""
+    trace = tmp_path / "run.mcap"
+    ran = run_earl(
+        "run", PICK_AND_PLACE, "--duration", "1s", "--trace", trace, "--record-memory", "all", "--record-links", "*"
+    )
+    assert ran.returncode == 0, ran.stderr
+    assert messages_not_fitting_their_schema(trace) == {}
+    channels, messages = channels_and_messages(trace)
+    for topic, (_, _, schema) in channels.items():
+        assert_foxglove_takes(schema, topic)
+    assert messages["/manip/a.cs/fsm"][0] == {"to": "idle"}
+    assert all("jointPosSetpoint" not in message for message in messages["/link/task,manip"])
+    start = messages["/earl/run"][0]
+    assert start["event"] == "start" and start["format"] == trace_topics.FORMAT
+    signals = read_signals(trace, ["task/a.cs.manipulatorCommand.jointPosSetpoint[0]", "manip/a.cs.windingCurrent[1]"])
+    assert signals.empty == [
+        "`task/a.cs.manipulatorCommand.jointPosSetpoint[0]` had no value in this run (an optional field never sent)"
+    ]
+    # the first state change, without `from` and `transition`, is the entry into the initial state
+    manip = summarise(trace).subsystems["manip/a.cs"]
+    assert set(manip.transitions) == {"idle,operationalMove"}
+    assert manip.state_time["idle"] > 0
+
+
+def test_every_message_of_a_mobile_robot_trace_is_valid_and_an_infinite_real_is_a_number(tmp_path: Path) -> None:
+    """`nearestObstacle`, infinite while nothing is in view, was written null against `"type": "number"`:
+    JSON has no infinity, and `1e999`, a number beyond every double, is read as one by JSON readers."""
+    trace = tmp_path / "run.mcap"
+    ran = run_earl(
+        "run", MOBILE_ROBOT, "--duration", "1s", "--trace", trace, "--record-memory", "all", "--record-links", "*"
+    )
+    assert ran.returncode == 0, ran.stderr
+    assert messages_not_fitting_their_schema(trace) == {}
+    with open(trace, "rb") as stream:
+        texts = [message.data for _, _, message in make_reader(stream).iter_messages(topics=["/link/base,coordinator"])]
+    assert any(b'"nearestObstacle":1e999' in text for text in texts)
+    assert any(json.loads(text)["nearestObstacle"] == math.inf for text in texts)
+
+
+INFINITIES = """\
+system inf
+infRobot/r {
+    f/a
+}
+f/a {
+    cs {
+        period 10 ms
+        grid/m: double[2][2] = [[1e999, 2.0], [3.0, 4.0]]
+        rows[J in 1..2]/m: double[2] = [-1e999, 2.0]
+        level[J in 0..1]/m: double = 1.0
+        go/pp = true
+        run/bb {
+            tf = {}
+            tc = go/pp
+        }
+        fsm {
+            initial run
+            state run: run/bb
+            run -> run when go/pp
+        }
+    }
+}
+"""
+
+
+def test_an_infinite_real_inside_a_part_the_schema_leaves_out_is_a_value(tmp_path: Path) -> None:
+    """`rows[1][0]` and `grid[0][0]` (arrays of arrays, in no schema) were null, read as "an optional
+    field never sent" (exit 1): an infinite real is written `1e999` now, and is a value, a gap in its line."""
+    (tmp_path / "system.earl").write_text(INFINITIES)
+    trace = tmp_path / "i.mcap"
+    ran = run_earl("run", tmp_path, "--duration", "0.05s", "--trace", trace, "--record-memory", "all")
+    assert ran.returncode == 0, ran.stderr
+    assert messages_not_fitting_their_schema(trace) == {}
+    _, messages = channels_and_messages(trace)
+    last = messages["/f/a.cs/memory"][-1]
+    assert last["grid"][0][0] == math.inf and last["rows"] == [None, [-math.inf, 2.0], [-math.inf, 2.0]]
+    signals = read_signals(trace, ["f/a.cs.rows[1][0]", "f/a.cs.grid[0][0]", "f/a.cs.rows[2][1]"])
+    assert not signals.empty
+    assert [series.name for series in signals.series] == ["rows[1][0]", "grid[0][0]", "rows[2][1]"]
+    assert all(math.isnan(value) for value in signals.series[0].values + signals.series[1].values)
+    assert signals.series[2].values[-1] == 2.0
+    plot = run_earl("plot", trace, "--signal", "f/a.cs.rows[1][0]", "-o", tmp_path / "i.png")
+    assert plot.returncode == 0, plot.stderr
+
+
+def test_a_subsystem_named_alone_lists_its_memory_families_with_their_star(tmp_path: Path) -> None:
+    """A family is one array, which its schema cannot tell from an array: the memory channel's metadata
+    names the families (`{"level":0,"rows":1}`), and `earl plot --signal f/a.cs` lists `level[*]`, as it
+    did of traces whose members were fields `level[0]`, and `rows[*]`, a family of arrays in no schema."""
+    (tmp_path / "system.earl").write_text(INFINITIES)
+    trace = tmp_path / "i.mcap"
+    assert run_earl("run", tmp_path, "--duration", "0.05s", "--trace", trace, "--record-memory", "all").returncode == 0
+    plot = run_earl("plot", trace, "--signal", "f/a.cs", "-o", tmp_path / "i.png")
+    assert plot.returncode == 1
+    assert "(the trace has `level[*]`, `rows[*]`)" in plot.stderr, plot.stderr
+
+
+def write_trace_of_format(path: Path, start: dict[str, Any], memory_schema: dict[str, Any], memory: Any) -> None:
+    """A trace with topics as this earl names them, the start message `start` and one memory message."""
+    with open(path, "wb") as stream:
+        writer = Writer(stream)
+        writer.start()
+        run_schema = writer.register_schema("earl.Run", "jsonschema", b'{"type": "object", "title": "earl.Run"}')
+        run = writer.register_channel("/earl/run", "json", run_schema, {})
+        fsm_schema = writer.register_schema("earl.StateChange", "jsonschema", b'{"type": "object"}')
+        fsm = writer.register_channel("/s/a.cs/fsm", "json", fsm_schema, {"subsystem": "s/a.cs"})
+        schema = writer.register_schema("earl.Memory.s/a.cs", "jsonschema", json.dumps(memory_schema).encode())
+        snapshots = writer.register_channel("/s/a.cs/memory", "json", schema, {"subsystem": "s/a.cs"})
+        writer.add_message(run, 0, json.dumps(start).encode(), 0)
+        writer.add_message(fsm, 0, b'{"from": null, "to": "idle", "transition": null}', 0)
+        writer.add_message(snapshots, 10_000_000, json.dumps(memory).encode(), 10_000_000)
+        writer.add_message(run, 20_000_000, b'{"event": "end", "faults": 0, "iterations": []}', 20_000_000)
+        writer.finish()
+
+
+def test_a_trace_without_a_format_reads_a_null_element_of_an_array_the_schema_leaves_out_as_infinite(
+    tmp_path: Path,
+) -> None:
+    """Traces written before the format was numbered (format 1) wrote an infinite real null: inside an
+    array of arrays, which the schema leaves out, it was read as an optional field never sent. An array
+    has no optional elements; the nulls before a family of arrays' first member stay no value."""
+    trace = tmp_path / "f1.mcap"
+    start = {"event": "start", "earl": "0.1.0", "system": "s", "seed": 0}
+    memory = {"grid": [[None, 2.0], [3.0, 4.0]], "rows": [None, [None, 2.0]], "note": None, "x": 1.0}
+    schema = {"type": "object", "properties": {"note": {"type": "string"}, "x": {"type": "number"}}, "required": ["x"]}
+    write_trace_of_format(trace, start, schema, memory)
+    signals = read_signals(trace, ["s/a.cs.grid[0][0]", "s/a.cs.rows[1][0]", "s/a.cs.x"])
+    assert [series.name for series in signals.series] == ["grid[0][0]", "rows[1][0]", "x"] and not signals.empty
+    with pytest.raises(TraceError, match=r"`s/a\.cs\.rows\[0\]` had no value in this run"):
+        read_signals(trace, ["s/a.cs.rows[0]"])

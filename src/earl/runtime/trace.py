@@ -29,6 +29,7 @@ from __future__ import annotations
 import contextlib
 import fcntl
 import json
+import math
 import os
 import re
 import select
@@ -56,9 +57,9 @@ _STATE_SCHEMA = {
     "type": "object",
     "title": "earl.StateChange",
     "properties": {
-        "from": {"type": "string", "description": "null at the first state"},
+        "from": {"type": "string", "description": "left out at the first state"},
         "to": {"type": "string"},
-        "transition": {"type": "string", "description": "null at the first state"},
+        "transition": {"type": "string", "description": "left out at the first state"},
     },
     "required": ["to"],
 }
@@ -89,6 +90,7 @@ _RUN_SCHEMA = {
     "title": "earl.Run",
     "properties": {
         "event": {"type": "string", "enum": ["start", "end"]},
+        "format": {"type": "integer", "description": "the trace format, at the start (none: format 1)"},
         "earl": {"type": "string"},
         "system": {"type": "string"},
         "seed": {"type": "integer"},
@@ -155,6 +157,8 @@ class MemoryLayout:
             if schema is not None:
                 self.properties[name] = schema
         self.has_families = any(isinstance(source, list) for _, source in self.plan)
+        #: each family with its first index, for the channel's metadata (`{"windingCurrent": 1}`)
+        self.families = {name: min(members) for name, members in families.items()}
 
     def snapshot(self, memory: dict[str, Any]) -> dict[str, Any]:
         """The message for `memory`: a copy, since the engine goes on changing its memory."""
@@ -194,17 +198,58 @@ _to_json_text = _c_encoder()
 
 
 def _encode(value: Any) -> bytes:
-    """A run-time value (or a dict of them) as JSON.
+    """A run-time value (or a dict of them) as JSON, every message valid against its channel's schema.
 
-    Run-time values are JSON as they are (tuples become arrays, Records objects), except
-    bytes and infinite floats: those two make the encoder raise, and only then is the
-    value converted by `to_json`. A message is written for every send, so the common case
-    must not walk the value in Python first.
+    Run-time values are JSON as they are (tuples become arrays, Records objects), except for three
+    things: an absent optional field (None), left out of its object, as the schema leaves it out of
+    `required`; bytes, a list of numbers; and an infinite real, which JSON has no word for: written
+    `1e999` or `-1e999`, a number beyond every double, which JSON readers read as infinity. The
+    last two make the encoder raise, and only then is the value walked in Python (`_json_data`). A
+    message is written for every send (and a memory snapshot for every iteration), so the common
+    case must not walk the value: an absent field is taken out of the text, where `null` is found.
     """
     try:
-        return _to_json_text(value).encode()
+        text = _to_json_text(value)
     except (TypeError, ValueError):  # UnicodeEncodeError too: a lone surrogate is written as JSON's `\udcff`
-        return _ENCODER.encode(to_json(value)).encode("utf-8", "backslashreplace")
+        text = _text_of(_json_data(value))
+    else:
+        if "null" in text:  # in an array, a null stays: the elements before a memory family's first member
+            text = _FIRST_ABSENT.sub("{", _LATER_ABSENT.sub("", text))
+    return text.encode("utf-8", "backslashreplace")
+
+
+# A field written `"name":null` after `{` or `,`, before `,` or `}`. Inside a string every `"` is written
+# `\"`, so neither pattern matches in one. Every field but the first of its object goes with the comma
+# before it; then a first field, with the comma after it (no absent field follows it any more).
+_LATER_ABSENT = re.compile(r',"\w+":null(?=[,}])')
+_FIRST_ABSENT = re.compile(r'\{"\w+":null(?:,|(?=\}))')
+
+
+def _json_data(value: Any) -> Any:
+    """`value` as plain JSON data: an object without its None fields (absent optional fields), bytes as
+    a list of numbers; None in an array stays null (the elements before a memory family's first member)."""
+    if isinstance(value, dict):
+        return {key: _json_data(inner) for key, inner in value.items() if inner is not None}
+    if isinstance(value, (list, tuple)):
+        return [_json_data(inner) for inner in value]
+    if isinstance(value, (bytes, bytearray)):
+        return list(value)
+    return value
+
+
+def _text_of(data: Any) -> str:
+    """JSON text of plain data, an infinite real as `1e999` or `-1e999` (Python's `json` refuses it)."""
+    try:
+        return _to_json_text(data)
+    except ValueError:
+        pass
+    if isinstance(data, float) and not math.isfinite(data):
+        return "null" if math.isnan(data) else ("1e999" if data > 0 else "-1e999")
+    if isinstance(data, dict):
+        return "{" + ",".join(f"{_to_json_text(str(key))}:{_text_of(inner)}" for key, inner in data.items()) + "}"
+    if isinstance(data, list):
+        return "[" + ",".join(_text_of(inner) for inner in data) + "]"
+    return _to_json_text(data)
 
 
 class McapSink:
@@ -368,7 +413,7 @@ class TraceWriter(Recorder):
     # ------------------------------------------------------------------ events
     def run_started(self, settings: dict[str, Any]) -> None:
         # the file's header names the SDK that wrote it; which earl ran is said here
-        start = {"event": "start", "earl": __version__, **settings}
+        start = {"event": "start", "format": trace_topics.FORMAT, "earl": __version__, **settings}
         self._write(self._channel(trace_topics.RUN, "earl.Run", _RUN_SCHEMA, {}), 0, start)
 
     def state_changed(
@@ -463,9 +508,11 @@ class TraceWriter(Recorder):
                 "properties": layout.properties,
                 "required": list(layout.properties),
             }
-            channel = self._channel(
-                trace_topics.memory(subsystem), f"earl.Memory.{subsystem}", schema, {"subsystem": subsystem}
-            )
+            metadata = {"subsystem": subsystem}
+            if layout.families:
+                # a family is an array as an array is: the schema cannot say which fields are families
+                metadata["families"] = json.dumps(layout.families, separators=(",", ":"))
+            channel = self._channel(trace_topics.memory(subsystem), f"earl.Memory.{subsystem}", schema, metadata)
             found = self._memories[subsystem] = (channel, layout)
         channel, layout = found
         self._write(channel, time, layout.snapshot(memory))

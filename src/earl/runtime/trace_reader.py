@@ -221,7 +221,8 @@ class _Summariser:
         if kind == "run":
             self.seen_run = True
             if data.get("event") == "start":
-                self.settings = {k: v for k, v in data.items() if k != "event"}
+                # the trace's format is no setting of the run
+                self.settings = {k: v for k, v in data.items() if k not in ("event", "format")}
             elif data.get("event") == "end":
                 self.ended = True
                 for subsystem, count in _iterations(data.get("iterations", [])):
@@ -301,24 +302,54 @@ def _schema_of(schema: Schema | None) -> Any:
 
 def _null_is_absent(schema: Any, leaf: str) -> bool:
     """Whether a null at `leaf` of a message (`ball.note`, `log[2]`, `value[0]`) is an optional field
-    that was absent, rather than an infinite real: JSON writes both as null, and only the channel's
-    schema tells them apart. A null that the schema does not show to be a real (no schema, or an
-    optional real, whose absence is the likelier) counts as absent. An optional field is one its
-    object's `required` leaves out; earlier traces wrote it `anyOf: [T, null]`."""
+    that was absent, rather than an infinite real: traces of format 1 wrote both as null, and only the
+    channel's schema tells them apart (format 2 leaves an absent field out and writes an infinity
+    `1e999`). A null that the schema does not show to be a real (an optional real, whose absence is the
+    likelier, or a field the schema does not show) counts as absent; an element of an array never does,
+    an array having no optional elements, even inside a part the schema leaves out (`grid[0][1]` of a
+    `double[2][2]`). An optional field is one its object's `required` leaves out; earlier traces wrote
+    it `anyOf: [T, null]`."""
     found, optional = _leaf_schema(schema, leaf)
-    if optional or not isinstance(found, dict):
+    if optional:
         return True
+    if not isinstance(found, dict):
+        return not leaf.endswith("]")
     options = found.get("anyOf", [])
     if any(isinstance(option, dict) and option.get("type") == "null" for option in options):
         return True
     return bool(found.get("type") != "number")
 
 
-def _is_padding(schema: Any, leaf: str) -> bool:
-    """Whether `leaf` is one of the nulls before a memory family's first member (`windingCurrent[0]` of
-    `windingCurrent[K in 1..6]`): no value of the run, which the schema's `prefixItems` say."""
+#: a memory field's element, `windingCurrent[0]`: where the nulls before a family's first member are
+_FIELD_ELEMENT = re.compile(r"(\w+)\[(\d+)\]\Z")
+
+
+def _is_padding(schema: Any, leaf: str, families: dict[str, int] | None = None) -> bool:
+    """Whether `leaf` of a memory message is one of the nulls before a memory family's first member
+    (`windingCurrent[0]` of `windingCurrent[K in 1..6]`): no value of the run, which the channel's
+    metadata says (`families`, None when it has none), or the schema's `prefixItems`. A trace of
+    format 1 has no such metadata, and a family of arrays is in no schema: an element of a memory
+    field left out of the schema is no array's element there, since a value the schema leaves out
+    is an array of arrays (or a struct inside itself, an object), whose elements are never null."""
+    element = _FIELD_ELEMENT.match(leaf)
+    if families is not None and element is not None and element.group(1) in families:
+        return int(element.group(2)) < families[element.group(1)]
     found, _ = _leaf_schema(schema, leaf)
-    return isinstance(found, dict) and found.get("type") == "null"
+    if isinstance(found, dict):
+        return found.get("type") == "null"
+    return element is not None and _leaf_schema(schema, element.group(1))[0] is None
+
+
+def _families(metadata: dict[str, str]) -> dict[str, int] | None:
+    """The memory families a memory channel's metadata names, each with its first index; None when it
+    names none (a trace of format 1, or a damaged entry)."""
+    try:
+        found = json.loads(metadata["families"])
+    except (KeyError, ValueError):
+        return None
+    if not isinstance(found, dict) or not all(isinstance(first, int) for first in found.values()):
+        return None
+    return found
 
 
 def _leaf_schema(schema: Any, leaf: str) -> tuple[Any, bool]:
@@ -353,6 +384,33 @@ def _leaf_schema(schema: Any, leaf: str) -> tuple[Any, bool]:
             current = before[position] if isinstance(before, list) and position < len(before) else current.get("items")
             optional, rest = False, rest[index.end() :].removeprefix(".")
     return current, optional
+
+
+def _raw_leaf(inner: str, buffer: str) -> str | None:
+    """`inner` (a signal's name inside its subsystem) as a leaf of the messages of a topic whose leaves
+    start with `buffer` (a link's output buffer; "" for memory), `[*]` as `[0]`; None when it is none."""
+    inner = inner.replace("[*]", "[0]")
+    if not buffer:
+        return inner
+    if inner == buffer or inner.startswith(f"{buffer}["):
+        return "value" + inner[len(buffer) :]
+    return inner[len(buffer) + 1 :] if inner.startswith(f"{buffer}.") else None
+
+
+def _under_optional(schema: Any, leaf: str | None) -> Any:
+    """The schema of `leaf` when the schema shows it at or under an optional field (`jointPosSetpoint[0]`),
+    else None."""
+    if not leaf:
+        return None
+    ends = [match.start() for match in re.finditer(r"[.\[]", leaf)] + [len(leaf)]
+    for end in ends:
+        found, optional = _leaf_schema(schema, leaf[:end])
+        if found is None:
+            return None
+        if optional:
+            found, _ = _leaf_schema(schema, leaf)
+            return found if isinstance(found, dict) else None
+    return None
 
 
 def _present_branch(schema: Any) -> Any:
@@ -418,7 +476,10 @@ def read_signals(path: Path, names: list[str]) -> Signals:
 
     def elements_of(subsystem: str) -> list[str]:
         memory_topic = by_kind.get(("memory", subsystem))
-        return _elements_in(subsystem, None if memory_topic is None else channels[memory_topic][1], links)
+        if memory_topic is None:
+            return _elements_in(subsystem, None, links)
+        metadata, schema = channels[memory_topic]
+        return _elements_in(subsystem, schema, links, _families(metadata) or {})
 
     for name in names:
         malformed = signal_syntax_error(name)
@@ -464,6 +525,7 @@ def read_signals(path: Path, names: list[str]) -> Signals:
                     wanted.setdefault(topic, (subsystem, buffer))
         wanted[by_kind[("fsm", subsystem)]] = (subsystem, "")
     fsm_topics = {by_kind[("fsm", subsystem)] for _, subsystem, _ in owners}
+    memory_channels = set(memory_topics.values())
     leaves: dict[tuple[str, str], tuple[list[float], list[float]]] = {}
     #: the leaves that had a value at least once: a number, a Boolean, or an infinite real (null)
     valued: set[tuple[str, str]] = set()
@@ -507,8 +569,8 @@ def read_signals(path: Path, names: list[str]) -> Signals:
                 if value is None:
                     meaning = null_meaning.get((topic, raw))
                     if meaning is None:
-                        schema = channels[topic][1]
-                        if _is_padding(schema, raw):
+                        metadata, schema = channels[topic]
+                        if topic in memory_channels and _is_padding(schema, raw, _families(metadata)):
                             meaning = null_meaning[(topic, raw)] = (True, False, True)
                         else:
                             text = _present_branch(_leaf_schema(schema, raw)[0])
@@ -526,6 +588,8 @@ def read_signals(path: Path, names: list[str]) -> Signals:
                         numeric.add(key)
                 else:
                     number = float(value)
+                    if math.isinf(number):  # format 2's `1e999`: a gap, as format 1's null
+                        number = math.nan
                     valued.add(key)
                     if not isinstance(value, bool):
                         numeric.add(key)
@@ -559,7 +623,18 @@ def read_signals(path: Path, names: list[str]) -> Signals:
         if not matched:
             if any(owner == subsystem and pattern.match(leaf) for owner, leaf in texts):
                 raise TraceError(f"`{name}` is not a number but text; a plot draws numbers and Booleans")
-            if named:  # in the trace as null only: an optional field absent from every message
+            # in the trace as null only (format 1), or in the schema only, under an optional field that no
+            # message has (format 2 leaves an absent field out): an optional field absent from every message
+            never_sent = [
+                _under_optional(channels[topic][1], _raw_leaf(inner, buffer))
+                for topic, (owner, buffer) in wanted.items()
+                if owner == subsystem and topic not in fsm_topics
+            ]
+            if not named and any(
+                isinstance(found, dict) and _present_branch(found).get("type") == "string" for found in never_sent
+            ):  # an optional string never sent is no number either: the channel's schema says it is text
+                raise TraceError(f"`{name}` is not a number but text; a plot draws numbers and Booleans")
+            if named or any(found is not None for found in never_sent):
                 empty.append(f"`{name}` had no value in this run (an optional field never sent)")
                 leaf_hints.append(empty[-1])
                 continue
@@ -605,14 +680,18 @@ def read_signals(path: Path, names: list[str]) -> Signals:
     return Signals(series, bands, end, empty, bool(cut))
 
 
-def _elements_in(subsystem: str, memory_schema: Any, links: list[tuple[str, dict[str, str]]]) -> list[str]:
+def _elements_in(
+    subsystem: str, memory_schema: Any, links: list[tuple[str, dict[str, str]]], families: dict[str, int] | None = None
+) -> list[str]:
     """What a signal of `subsystem` can go on to in this trace: its recorded memory (`memory_schema`,
-    the schema of its memory topic, None when it has none) and the output buffers whose links are
-    recorded (`links`: every link topic of the trace with its metadata), a family written `name[*]`."""
-    names: list[str] = []
+    the schema of its memory topic, None when it has none, and the `families` its metadata names) and
+    the output buffers whose links are recorded (`links`: every link topic of the trace with its
+    metadata), a family written `name[*]`: in format 1 a member was a field, `windingCurrent[1]`; in
+    format 2 a family is one array, which only the metadata tells from an array."""
+    names: list[str] = [f"{name}[*]" for name in families or {}]
     properties = memory_schema.get("properties") if isinstance(memory_schema, dict) else None
     if isinstance(properties, dict):
-        names += [str(key) for key in properties]
+        names += [str(key) for key in properties if key not in (families or {})]
     for _, metadata in links:
         source = metadata.get("source", "")
         if source.startswith(subsystem + "."):

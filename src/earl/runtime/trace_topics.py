@@ -8,6 +8,12 @@ both, so that `earl trace summary` and `earl plot` read the traces users already
 
 from __future__ import annotations
 
+#: the trace format this earl writes, in the `/earl/run` start message (`format`), and the newest it
+#: reads. A trace without it is format 1: earl before formats were numbered (fields that were absent or
+#: infinite written `null`, anyOf schemas). Format 2: an absent optional field is left out of its
+#: message, an infinite real is `1e999`, a memory channel's metadata names its families.
+FORMAT = 2
+
 RUN = "/earl/run"
 FAULTS = "/earl/faults"
 
