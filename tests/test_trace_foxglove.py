@@ -507,3 +507,26 @@ def test_a_trace_without_a_format_reads_a_null_element_of_an_array_the_schema_le
     assert [series.name for series in signals.series] == ["grid[0][0]", "rows[1][0]", "x"] and not signals.empty
     with pytest.raises(TraceError, match=r"`s/a\.cs\.rows\[0\]` had no value in this run"):
         read_signals(trace, ["s/a.cs.rows[0]"])
+
+
+@pytest.mark.parametrize("command", ["summary", "plot"])
+def test_a_trace_of_a_newer_format_is_said_to_be_one_not_damaged(tmp_path: Path, command: str) -> None:
+    """A trace whose start message says a format newer than this earl reads: said plainly, exit 1,
+    rather than "a message on … is not one earl writes (the file is damaged …)" once a message of the
+    new format met this earl's reader."""
+    trace = tmp_path / "new.mcap"
+    newer = trace_topics.FORMAT + 1
+    start = {"event": "start", "format": newer, "earl": "9.0.0", "system": "s", "seed": 0}
+    write_trace_of_format(trace, start, {"type": "object", "properties": {}}, ["written otherwise"])
+    said = (
+        f"{trace} was written by a newer earl (trace format {newer}; this earl reads up to {trace_topics.FORMAT}): "
+        "read it with that earl, or a newer one"
+    )
+    if command == "summary":
+        ran = run_earl("trace", "summary", trace)
+    else:
+        ran = run_earl("plot", trace, "--signal", "s/a.cs.x", "-o", tmp_path / "p.png")
+    assert ran.returncode == 1 and ran.stderr == f"earl {'trace' if command == 'summary' else 'plot'}: {said}\n"
+    # the same trace in the format this earl writes is read
+    write_trace_of_format(trace, {**start, "format": trace_topics.FORMAT}, {"type": "object"}, {"x": 1.0})
+    assert [series.values for series in read_signals(trace, ["s/a.cs.x"]).series] == [[1.0]]

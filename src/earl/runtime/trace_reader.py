@@ -180,6 +180,7 @@ def summarise(path: Path) -> TraceSummary:
     channels = _channels(path)
     if trace_topics.RUN not in channels:
         raise _not_an_earl_trace(path, channels)
+    _refuse_a_newer_format(path)
     summariser = _Summariser()
     cut: list[bool] = []
     seen: set[str] = set()
@@ -194,6 +195,20 @@ def summarise(path: Path) -> TraceSummary:
     summary = summariser.summary()
     summary.cut = bool(cut)
     return summary
+
+
+def _refuse_a_newer_format(path: Path) -> None:
+    """A trace of a newer format than this earl reads is said to be one, before its messages are read
+    as this earl's: they may be written otherwise, which would read as damage. The format is in the
+    `/earl/run` start message, the first message earl writes; a trace without it is format 1."""
+    for _, _, _, data in _messages(path, [trace_topics.RUN]):
+        written = data.get("format", 1) if isinstance(data, dict) and data.get("event") == "start" else 1
+        if isinstance(written, int) and not isinstance(written, bool) and written > trace_topics.FORMAT:
+            raise TraceError(
+                f"{path} was written by a newer earl (trace format {written}; this earl reads up to "
+                f"{trace_topics.FORMAT}): read it with that earl, or a newer one"
+            )
+        return
 
 
 class _Summariser:
@@ -221,7 +236,7 @@ class _Summariser:
         if kind == "run":
             self.seen_run = True
             if data.get("event") == "start":
-                # the trace's format is no setting of the run
+                # the format is said only when it is newer than this earl reads (`_refuse_a_newer_format`)
                 self.settings = {k: v for k, v in data.items() if k not in ("event", "format")}
             elif data.get("event") == "end":
                 self.ended = True
@@ -459,6 +474,7 @@ def read_signals(path: Path, names: list[str]) -> Signals:
     channels = _channels(path)
     if trace_topics.RUN not in channels:  # before its signals are looked for: another tool's file has none
         raise _not_an_earl_trace(path, channels)
+    _refuse_a_newer_format(path)
     available = {topic: metadata for topic, (metadata, _) in channels.items()}
     #: (kind, subsystem) -> topic, whichever way this trace's earl named its topics
     by_kind: dict[tuple[str, str], str] = {}
