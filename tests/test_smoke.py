@@ -1,6 +1,9 @@
 from pathlib import Path
 
+import pytest
+
 import earl
+import earl.cli.main as main_module
 
 
 def test_load_and_format_round_trip(tmp_path: Path) -> None:
@@ -111,3 +114,27 @@ def test_every_command_s_help_says_its_exit_codes() -> None:
         assert "exit codes:" in shown.stdout, f"`earl {' '.join(words)} --help` says no exit codes"
         assert said.startswith("0 "), (words, said)
         assert "2 usage error" in said and "130 interrupted" in said, (words, said)
+
+
+def test_an_interrupt_that_python_wraps_in_another_error_is_still_exit_130_with_one_line(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """CPython 3.11 turns a KeyboardInterrupt raised while a class is made (in a descriptor's
+    `__set_name__`, as Lark's classes have while `lark` is imported) into a RuntimeError whose cause is
+    the interrupt: a Ctrl-C, or a SIGTERM of `earl run`, at that moment of the start printed a traceback
+    and exit 1. A real error that no interrupt caused still goes up as it is."""
+    (tmp_path / "interrupted_command.py").write_text(
+        "class Interrupting:\n"
+        "    def __set_name__(self, owner, name):\n"
+        "        raise KeyboardInterrupt\n"
+        "class Made:\n"
+        "    field = Interrupting()\n"
+    )
+    (tmp_path / "failing_command.py").write_text("raise RuntimeError('a real error')\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.setitem(main_module.COMMANDS, "check", "interrupted_command")
+    assert main_module.main(["check", "x.earl"]) == 130
+    assert capsys.readouterr().err == "earl: interrupted\n"
+    monkeypatch.setitem(main_module.COMMANDS, "check", "failing_command")
+    with pytest.raises(RuntimeError, match="a real error"):
+        main_module.main(["check", "x.earl"])
