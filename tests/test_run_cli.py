@@ -1411,6 +1411,88 @@ def test_a_stop_before_the_run_never_removes_a_file_this_command_did_not_create(
     assert "interrupted before the run started; nothing was executed\n" in capsys.readouterr().err
 
 
+def _writers_of(trace: Path) -> list[str]:
+    """The processes (Linux) whose command line names `trace`: its writer, while it runs."""
+    found = []
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                command = (entry / "cmdline").read_bytes()
+            except OSError:
+                continue  # ended meanwhile
+            if b"earl.runtime.trace_process" in command and os.fsencode(trace) in command:
+                found.append(entry.name)
+    return found
+
+
+def _after_the_writer(trace: Path) -> bool:
+    """Whether the trace exists once its writer, if one is left, has ended (within 30 s)."""
+    deadline = time.monotonic() + 30
+    while _writers_of(trace) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    return trace.exists()
+
+
+@pytest.mark.skipif(not Path("/proc/self/cmdline").exists(), reason="finds the writer in /proc")
+def test_a_stop_as_the_run_is_set_up_after_the_trace_is_opened_leaves_no_trace(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Ctrl-C (or SIGTERM) after the trace's writer started and before the run was set up: the command
+    removed the file and said it wrote none, and the writer, left running, then wrote an empty trace there."""
+    import earl.runtime.simulation
+    from earl.cli.main import main
+
+    def interrupted(*_: object, **__: object) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(earl.runtime.simulation, "Scheduler", interrupted)
+    trace = tmp_path / "run.mcap"
+    assert main(["run", str(SPECS / "counter"), "--duration", "1s", "--trace", str(trace)]) == 130
+    said = f"interrupted before the run started; nothing was executed; no trace was written to {trace}\n"
+    assert said in capsys.readouterr().err
+    assert _writers_of(trace) == []  # stopped and waited for, not left to end when it will
+    assert not _after_the_writer(trace)
+
+
+def test_a_trace_writer_sent_nothing_leaves_no_file(tmp_path: Path) -> None:
+    """A stop signal inside Popen, once the writer has started, leaves it unknown to the run, which removes
+    the file: the writer, its input ended before anything came, made the file again with an empty trace."""
+    trace = tmp_path / "run.mcap"
+    writer = subprocess.run(
+        [sys.executable, "-m", "earl.runtime.trace_process", str(trace)],
+        stdin=subprocess.DEVNULL,
+        capture_output=True,
+        timeout=60,
+        check=False,
+    )
+    assert (writer.returncode, writer.stderr, trace.exists()) == (0, b"", False)
+
+
+@pytest.mark.skipif(not Path("/proc/self/cmdline").exists(), reason="finds the writer in /proc")
+def test_a_simulation_stopped_while_it_is_set_up_closes_its_environment_and_leaves_no_trace(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import earl.runtime.simulation
+
+    def interrupted(*_: object, **__: object) -> None:
+        raise KeyboardInterrupt
+
+    class Environment:
+        closed = False
+
+        def close(self) -> None:
+            self.closed = True
+
+    monkeypatch.setattr(earl.runtime.simulation, "Scheduler", interrupted)
+    trace = tmp_path / "run.mcap"
+    environment = Environment()
+    with pytest.raises(KeyboardInterrupt):
+        earl.simulate(earl.load(str(SPECS / "counter")), environment=environment, trace=trace)
+    assert environment.closed
+    assert _writers_of(trace) == []
+    assert not _after_the_writer(trace)
+
+
 def test_a_trace_cut_before_its_first_whole_record_says_so(tmp_path: Path) -> None:
     trace = tmp_path / "run.mcap"
     assert earl_cli("run", str(SPECS / "counter"), "--duration", "300ms", "--trace", str(trace)).returncode == 0

@@ -324,13 +324,15 @@ def _run(arguments: argparse.Namespace) -> int:
 
 def _remove_unrun_trace(arguments: argparse.Namespace, trace_was_there: bool) -> str:
     """Remove the trace of a run stopped before its first instant, when this command created it (it
-    holds no run); what to say of it: `; no trace was written to FILE`, or nothing."""
+    holds no run); what to say of it: `; no trace was written to FILE`, or nothing. A run stopped while
+    it was set up has removed it already (`Simulation` does, once the trace's writer has ended)."""
     trace = Path(arguments.trace) if arguments.trace else None
-    if trace is not None and not trace_was_there and trace.is_file() and not trace.is_symlink():
+    if trace is None or trace_was_there:
+        return ""
+    if trace.is_file() and not trace.is_symlink():
         with contextlib.suppress(OSError):
             trace.unlink()
-            return f"; no trace was written to {arguments.trace}"
-    return ""
+    return "" if os.path.lexists(trace) else f"; no trace was written to {arguments.trace}"
 
 
 @dataclass

@@ -134,65 +134,74 @@ class Simulation:
         self.environment = _environment(environment, self.expanded, seed, directories, *self._environment_named)
         _refuse_unfit_methods(self.environment, *self._environment_named)
         _bind(self.environment, self.expanded, *self._environment_named)
-        self.statistics = StatisticsRecorder()
-        self._faults = _FaultList()
-        own: list[Recorder] = [self.statistics, self._faults, *(recorders or [])]
-        self.recorder = Recorders(own)
-        self.network: Network = build_network(
-            self.expanded,
-            recorder=self.recorder,
-            environment=self.environment,
-            seed=seed,
-            code_directories=directories,
-            agents=set(agents) if agents else None,
-            remote=transport,
-        )
-        self.transport = transport
-        memory = set(record_memory or [])
-        if "all" in memory:
-            memory = set(self.network.by_name)
-        unknown = sorted(memory - set(self.network.by_name))
-        if unknown:
-            raise ValueError(
-                f"record_memory (--record-memory, run.toml's record_memory) names no subsystem of this run: {', '.join(unknown)} "
-                f"(subsystems are named like {next(iter(self.network.by_name), 'manip/a.cs')})"
-            )
-        _refuse_unknown_outputs(record_outputs, self.expanded)
-        _warn_of_patterns_matching_nothing(record_links, self.network.link_types)
-        if transport is not None:
-            # last of what the spec and the options can get wrong (its code bound, the environment started):
-            # only now does this process open its links and show itself to its peers
-            transport.start(model_digest(self.expanded))
         self.trace: TraceWriter | None = None
-        if trace is not None:
-            self.trace = TraceWriter(
-                trace,
-                self.network.types,
-                self.network.link_types,
-                self.network.memory_types,
-                record_links,
-                self.network.link_sources,
+        try:
+            self.statistics = StatisticsRecorder()
+            self._faults = _FaultList()
+            own: list[Recorder] = [self.statistics, self._faults, *(recorders or [])]
+            self.recorder = Recorders(own)
+            self.network: Network = build_network(
+                self.expanded,
+                recorder=self.recorder,
+                environment=self.environment,
+                seed=seed,
+                code_directories=directories,
+                agents=set(agents) if agents else None,
+                remote=transport,
             )
-            # the links leaving these output buffers (`manip/a.cs.manipulatorState`), whatever record_links
-            # says: what `earl run --plot` draws of an output buffer is the messages on its links
-            wanted = set(record_outputs or [])
-            self.trace.links_also_recorded = {
-                link
-                for link, source in self.network.link_sources.items()
-                if source in wanted or source.rsplit("[", 1)[0] in wanted  # a family named whole: each member
-            }
-            self.recorder.add(self.trace)
-            self.trace.run_started(
-                {"system": system.name, "seed": seed, "parameters": parameters, "realtime": realtime}
+            self.transport = transport
+            memory = set(record_memory or [])
+            if "all" in memory:
+                memory = set(self.network.by_name)
+            unknown = sorted(memory - set(self.network.by_name))
+            if unknown:
+                raise ValueError(
+                    f"record_memory (--record-memory, run.toml's record_memory) names no subsystem of this run: {', '.join(unknown)} "
+                    f"(subsystems are named like {next(iter(self.network.by_name), 'manip/a.cs')})"
+                )
+            _refuse_unknown_outputs(record_outputs, self.expanded)
+            _warn_of_patterns_matching_nothing(record_links, self.network.link_types)
+            if transport is not None:
+                # last of what the spec and the options can get wrong (its code bound, the environment started):
+                # only now does this process open its links and show itself to its peers
+                transport.start(model_digest(self.expanded))
+            if trace is not None:
+                self.trace = TraceWriter(
+                    trace,
+                    self.network.types,
+                    self.network.link_types,
+                    self.network.memory_types,
+                    record_links,
+                    self.network.link_sources,
+                )
+                # the links leaving these output buffers (`manip/a.cs.manipulatorState`), whatever record_links
+                # says: what `earl run --plot` draws of an output buffer is the messages on its links
+                wanted = set(record_outputs or [])
+                self.trace.links_also_recorded = {
+                    link
+                    for link, source in self.network.link_sources.items()
+                    if source in wanted or source.rsplit("[", 1)[0] in wanted  # a family named whole: each member
+                }
+                self.recorder.add(self.trace)
+                self.trace.run_started(
+                    {"system": system.name, "seed": seed, "parameters": parameters, "realtime": realtime}
+                )
+            self.scheduler = Scheduler(
+                self.network,
+                self.recorder,
+                _Guarded(self.environment, *self._environment_named),
+                realtime=realtime,
+                record_memory=memory,
+                inbox=None if transport is None else transport.inbox,
             )
-        self.scheduler = Scheduler(
-            self.network,
-            self.recorder,
-            _Guarded(self.environment, *self._environment_named),
-            realtime=realtime,
-            record_memory=memory,
-            inbox=None if transport is None else transport.inbox,
-        )
+        except BaseException:
+            # Ctrl-C (or a failure) before the run could start: the trace's writer, in a session of its own,
+            # would otherwise outlive this and write its file after `earl run` had removed it, and what the
+            # environment opened (a viewer) would stay open
+            if self.trace is not None:
+                self.trace.abandon()
+            _close_refused(self.environment)
+            raise
         self.closed = False
         #: why `advance_to` ended inside an instant, after which the run cannot go on
         self._stopped_inside: str | None = None

@@ -545,6 +545,14 @@ class TraceWriter(Recorder):
         self._write(self._channel(trace_topics.RUN, "earl.Run", _RUN_SCHEMA, {}), end_time, end)
         self._sink.finish()
 
+    def abandon(self) -> None:
+        """The run did not start: no file is left (a stream given is left as it is)."""
+        if self.closed:
+            return
+        self.closed = True
+        if isinstance(self._sink, BackgroundSink):
+            self._sink.abandon()
+
 
 class TraceWriteError(OSError):
     """The trace file could not be written (a full disk, a removed directory): the message says why."""
@@ -579,7 +587,7 @@ class BackgroundSink:
     as the plain values they are in JSON, where pickle would call back into Python for each
     (their classes are made at run time, so the writer could not find them by name anyway).
     If this process ends without `finish` (killed), the writer sees its input end and
-    finishes the file, which therefore stays readable.
+    finishes the file, which therefore stays readable (a writer sent nothing leaves the file alone).
     """
 
     #: messages per batch: large enough to make the hand-over cheap, small enough to stay in flight
@@ -593,27 +601,54 @@ class BackgroundSink:
     def __init__(self, path: Path) -> None:
         self.path = path
         refuse_to_replace(path)
+        #: whether this sink made the file, which `abandon` then removes
+        self._created = not os.path.lexists(path)
+        self._finished = False
         open(path, "wb").close()  # only to fail now if the file cannot be written
         # the writer imports earl from where this process found it, installed or not
         package_root = str(Path(__file__).resolve().parents[2])
         search_path = os.pathsep.join(p for p in (package_root, os.environ.get("PYTHONPATH", "")) if p)
-        self._process = subprocess.Popen(
-            # -P: the current directory is not searched first, so that a spec's `msgpack.py` cannot stand in
-            [sys.executable, "-P", "-m", "earl.runtime.trace_process", str(path)],
-            stdin=subprocess.PIPE,
-            stdout=subprocess.DEVNULL,
-            stderr=subprocess.PIPE,
-            env={**os.environ, "PYTHONPATH": search_path},
-            # A session of its own: a stop signal for the run's process group or session (Ctrl-C,
-            # `timeout`, `earl launch`'s SIGKILL) never reaches it, not even while it starts and has not
-            # yet set its signals aside. It ends when the run says so, or when the pipe closes.
-            start_new_session=True,
-        )
-        _widen(self._process.stdin)
-        self._due = _clock() + self.LATEST
-        self._finished = False
-        self._packer = msgpack.Packer(use_bin_type=True, default=_plain)
-        self._start_batch()
+        try:
+            self._process = subprocess.Popen(
+                # -P: the current directory is not searched first, so that a spec's `msgpack.py` cannot stand in
+                [sys.executable, "-P", "-m", "earl.runtime.trace_process", str(path)],
+                stdin=subprocess.PIPE,
+                stdout=subprocess.DEVNULL,
+                stderr=subprocess.PIPE,
+                env={**os.environ, "PYTHONPATH": search_path},
+                # A session of its own: a stop signal for the run's process group or session (Ctrl-C,
+                # `timeout`, `earl launch`'s SIGKILL) never reaches it, not even while it starts and has not
+                # yet set its signals aside. It ends when the run says so, or when the pipe closes. (Ctrl-C
+                # inside Popen, once the writer is started, leaves it unknown here: it then ends when its
+                # input does, without a word, having been sent nothing.)
+                start_new_session=True,
+            )
+            _widen(self._process.stdin)
+            self._due = _clock() + self.LATEST
+            self._packer = msgpack.Packer(use_bin_type=True, default=_plain)
+            self._start_batch()
+        except BaseException:
+            self.abandon()
+            raise
+
+    def abandon(self) -> None:
+        """The run will not start (Ctrl-C while it is set up): stop the writer and wait for it, and remove
+        the file this sink made, which holds no run. Left to itself, the writer would see its input end and
+        write an empty trace, after `earl run` had removed the file and said that it wrote none."""
+        self._finished = True
+        process: subprocess.Popen[bytes] | None = getattr(self, "_process", None)  # None: it was not started
+        if process is not None:
+            process.kill()  # it has set the stop signals aside
+            for pipe in (process.stdin, process.stderr):
+                if pipe is not None:
+                    with contextlib.suppress(OSError):
+                        pipe.close()
+            process.wait()
+        with contextlib.suppress(OSError):
+            if self._created:
+                self.path.unlink()
+            elif self.path.is_file():
+                open(self.path, "wb").close()  # what the writer began is no trace: emptied, as it was opened
 
     def _start_batch(self) -> None:
         # Three lists, not a tuple per message: appending what exists allocates nothing that Python's

@@ -28,10 +28,15 @@ def _read_exactly(stream: BinaryIO, size: int) -> bytes | None:
 
 
 def write(path: str, source: BinaryIO) -> None:
+    header = _read_exactly(source, _LENGTH.size)
+    if header is None:
+        # Nothing came: the run was stopped as it was set up (Ctrl-C as this process started), and its
+        # process has removed the file it made, or will. Opening it now would make it again, and write an
+        # empty trace where `earl run` said it wrote none.
+        return
     with open(path, "wb") as output:
         sink = McapSink(output)
         while True:
-            header = _read_exactly(source, _LENGTH.size)
             data = None if header is None else _read_exactly(source, _LENGTH.unpack(header)[0])
             if data is None:  # the run ended without saying so (killed): keep what came
                 break
@@ -50,6 +55,7 @@ def write(path: str, source: BinaryIO) -> None:
             sink.output.raise_error()  # a write that failed (a full disk) ends the run's trace now
             if finish:
                 break
+            header = _read_exactly(source, _LENGTH.size)
         sink.finish()
 
 
