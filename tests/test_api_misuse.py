@@ -304,6 +304,18 @@ def test_a_plotted_member_of_an_output_family_is_recorded_by_its_member_name(sig
     assert what_to_record(expand(earl.loads(FAMILY), {}), [signal]) == ([], outputs)
 
 
+def test_a_signal_index_of_digits_that_are_not_ascii_is_refused() -> None:
+    """`\\d` took `٢` (and `int` reads it as 2): the signal was recorded as member 2, where no spec writes it."""
+    from earl.model.expand import expand
+    from earl.runtime.plot import what_to_record
+
+    with pytest.raises(ValueError, match=re.escape("`out` is a family of output buffers; name a member")):
+        what_to_record(expand(earl.loads(FAMILY), {}), ["w[1]/a.cs.out[٢]"])
+    pick_and_place = expand(earl.load(Path(__file__).parent.parent / "examples" / "pick_and_place"), {})
+    with pytest.raises(ValueError, match=re.escape("`[٢]` is not a path of `[index]` and `.field` steps")):
+        what_to_record(pick_and_place, ["manip/a.cs.currentJointPos[٢]"])
+
+
 def test_a_family_of_outputs_named_whole_is_every_member_to_record_and_a_member_to_plot(tmp_path: Path) -> None:
     from earl.model.expand import expand
     from earl.runtime.plot import what_to_record

@@ -606,7 +606,7 @@ fleetRobot/r {
     assert "worker[1]/a" in drawn and "worker[5]/a" in drawn and "worker[7]/a" not in drawn
 
 
-@pytest.mark.parametrize("index", ["J", "foo bar", "K + 1"])
+@pytest.mark.parametrize("index", ["J", "foo bar", "K + 1", "٢", "２"])
 def test_a_family_target_with_an_index_that_is_neither_its_letter_nor_a_member_is_refused(
     index: str, tmp_path: Path
 ) -> None:

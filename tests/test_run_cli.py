@@ -915,7 +915,7 @@ def test_run_toml_is_read_next_to_the_spec_a_symbolic_link_points_to(
     assert "unknown setting `colour`" in capsys.readouterr().err
 
 
-@pytest.mark.parametrize("seed", ["-1", "x", "1.5"])
+@pytest.mark.parametrize("seed", ["-1", "x", "1.5", "٣", "1_000", "²"])
 def test_a_seed_that_is_not_a_whole_number_from_zero_is_a_usage_error(seed: str) -> None:
     result = earl_cli("run", str(SPECS / "counter"), f"--seed={seed}", "--duration", "10ms")
     assert result.returncode == 2

@@ -196,6 +196,20 @@ def test_a_map_that_misnames_the_family_is_refused_once(tmp_path: Path) -> None:
     assert diagnostic.location is not None and diagnostic.location.file.endswith("run.toml")
 
 
+def test_a_map_naming_a_member_by_a_digit_that_is_not_ascii_is_refused(tmp_path: Path) -> None:
+    """`\\d` took `٢`: the map was read as naming a member beyond the family's range, and skipped without a word."""
+    copy = pendulum_copy(
+        tmp_path,
+        "swinging/environment.py",
+        old="encoder=True)",
+        new='encoder=True)\n    plant.map_actuator("arm/a.motor[٢]/re", "motor2")',
+    )
+    with pytest.raises(EarlError) as refused:
+        earl.simulate(earl.load(copy))
+    [diagnostic] = refused.value.diagnostics
+    assert diagnostic.message.startswith("the environment maps `arm/a.motor[٢]/re` to `motor2`, but the system has no")
+
+
 def test_maps_that_name_the_actuators_otherwise_run_without_a_fault(tmp_path: Path) -> None:
     """The check is the lookup the effectors make during the run: whatever the names, a map that finds them runs."""
     copy = pendulum_copy(tmp_path, "swinging/environment.py", old='"motor{K}"', new='"drive{K}"')

@@ -541,10 +541,10 @@ def _close(transport: Any) -> None:
 
 def _seed(text: str) -> int:
     """`--seed`: what NumPy's seed sequences take, refused at the command line rather than in a function."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"`{text}` is not a whole number") from None
+    # ASCII digits, as run.toml's seed and --param take: `int` would also read `٣` and `1_000`
+    if not (text.isascii() and text.removeprefix("-").isdigit()):
+        raise argparse.ArgumentTypeError(f"`{text}` is not a whole number")
+    value = int(text)
     if value < 0:
         raise argparse.ArgumentTypeError(f"`{text}`: a seed is a whole number >= 0")
     return value

@@ -55,7 +55,8 @@ Environment = Mapping[str, bool | int | float | str]
 
 def _number(written: str) -> int | None:
     """A member's number as written, read as a number (`02` is member 2) by both matchers alike."""
-    return int(written) if re.fullmatch(r"-?\d+", written) else None
+    # ASCII digits: `\d` (and `int`) also take `٢` and `２`, which no spec writes for a member
+    return int(written) if re.fullmatch(r"-?[0-9]+", written) else None
 
 
 def _matches(

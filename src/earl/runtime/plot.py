@@ -85,7 +85,7 @@ def what_to_record(expanded: System, signals: list[str]) -> tuple[list[str], lis
                 sending.append(f"{owner}.{element}")
             else:  # a family of output buffers: the member the signal names (`out[1]`), or every one (`out[*]`)
                 rest = signal[len(owner) + 1 + len(element) :]
-                chosen = re.match(r"\[(\d+)\]", rest)
+                chosen = re.match(r"\[([0-9]+)\]", rest)  # ASCII: `\d` takes `٢` too, which `int` reads as 2
                 if chosen is None and not rest.startswith("[*]"):
                     raise ValueError(
                         f"`{signal}`: `{element}` is a family of output buffers; name a member, "
@@ -106,7 +106,8 @@ def what_to_record(expanded: System, signals: list[str]) -> tuple[list[str], lis
     return sorted(set(record)), sorted(set(sending))
 
 
-_STEP = re.compile(r"\[(\*|\d+)\]|\.([A-Za-z_]\w*)")
+#: `[2]`, `[*]` or `.name` (ASCII digits: `\d` takes `٢` too, which `int` reads as 2)
+_STEP = re.compile(r"\[(\*|[0-9]+)\]|\.([A-Za-z_]\w*)")
 
 
 def _path_problem(expanded: System, subsystem: Subsystem, element: str, path: str) -> str | None:

@@ -633,7 +633,8 @@ class _Map:
     def names_beyond(self, subsystem: str, parameters: Mapping[str, Any]) -> bool:
         """`arm/a.motor[6]/re` names a member of the family of `arm/a.motor[2]/re`, by a number that may be
         outside the family's range in this run (each `[NAME]` by its parameter, as `matches`)."""
-        if not re.search(r"\[\d+\]", self.subsystem):
+        # ASCII digits: `\d` takes `٢` too, which names no member (a slip, said as a map that maps nothing)
+        if not re.search(r"\[[0-9]+\]", self.subsystem):
             return False
 
         def index(found: re.Match[str]) -> str:
@@ -641,7 +642,7 @@ class _Map:
             return found[0] if value is None else f"[{value}]"
 
         named = re.escape(re.sub(r"\[([A-Za-z_]\w*)\]", index, self.subsystem))
-        return re.fullmatch(re.sub(r"\\\[\d+\\\]", r"\\[\\d+\\]", named), subsystem) is not None
+        return re.fullmatch(re.sub(r"\\\[[0-9]+\\\]", r"\\[[0-9]+\\]", named), subsystem) is not None
 
     def name_for(self, subsystem: str, parameters: Mapping[str, Any]) -> str:
         try:
