@@ -583,6 +583,30 @@ def test_to_earl_writes_no_blank_line_first_in_a_body() -> None:
     assert earl.loads(text, "s.earl").to_earl() == text
 
 
+@pytest.mark.parametrize(
+    ("closing", "written"),
+    [
+        ([""], ""),
+        (["", ""], ""),
+        (["", "// end", ""], "\n        // end\n"),
+        (["// end", "", "", "// more", "", ""], "        // end\n\n        // more\n"),
+    ],
+)
+def test_to_earl_writes_no_blank_line_last_in_a_body(closing: list[str], written: str) -> None:
+    """A model built in Python with a blank line asked for last among a body's closing comments: it was
+    written before the `}`, and read back as no comment, so that the text was written otherwise the second
+    time. A blank line between the comments stays, once."""
+    from earl.model import Agent, ControlSubsystem, Memory, PrimitiveType, System
+    from earl.model.location import Comments
+
+    memory = Memory("m", PrimitiveType("int"))
+    subsystem = ControlSubsystem(memories=[memory], comments=Comments(closing=closing))
+    agent = Agent("a", subsystems=[subsystem])
+    text = System("s", agents=[agent], order=[agent]).to_earl()
+    assert text == f"system s\n\na/a {{\n    cs {{\n        m/m: int\n{written}    }}\n}}\n"
+    assert earl.loads(text, "s.earl").to_earl() == text
+
+
 def test_fmt_keeps_a_blank_line_after_the_member_written_before_when_it_reorders(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -84,8 +84,14 @@ class _Printer:
             self.blank()
 
     def close(self, depth: int, comments: Comments) -> None:
-        """A block's `}`, after the comments that ended its body, and with the comment written after it."""
-        for comment in comments.closing:
+        """A block's `}`, after the comments that ended its body, and with the comment written after it.
+
+        A blank line before the `}` is left out: a file never has one there (the "" a model built in
+        Python put last would come back as no comment, and the text be written otherwise the second time)."""
+        closing = list(comments.closing)
+        while closing and not closing[-1].strip():
+            closing.pop()
+        for comment in closing:
             self.comment(depth + 1, comment)
         self.line(depth, "}" + (f"  {comments.after.rstrip()}" if comments.after else ""))
 
