@@ -90,15 +90,35 @@ def _guarded() -> tuple[int, ...]:
     return ((signal.SIGINT,) if PROGRAM else ()) + OTHER_STOPS
 
 
+#: the stop signal that `raise_interrupt` turned into a KeyboardInterrupt, 0 while none came. Compiled code
+#: that imports a module may swallow the interrupt or say it in other words (a Cython module's
+#: initialisation clears it; pybind11's, as MuJoCo's, turns it into "ImportError: generic_type: …"), so the
+#: command asks this rather than trusting that the KeyboardInterrupt reached it (`stop_received`).
+STOP_RECEIVED = 0
+
+
+def raise_interrupt(number: int, frame: object) -> None:
+    """Python's own Ctrl-C handler, which also remembers that a stop signal came."""
+    global STOP_RECEIVED
+    STOP_RECEIVED = number
+    raise KeyboardInterrupt
+
+
+def stop_received() -> bool:
+    """Whether a stop signal came while the command had not put its own handler in place: whatever failed
+    meanwhile failed because of it (never true outside the `earl` program)."""
+    return STOP_RECEIVED != 0
+
+
 def take_over() -> None:
     """The command runs: Ctrl-C raises KeyboardInterrupt again, which the command handles; so does a SIGTERM
     or SIGHUP of `earl run` or `earl launch`, until the command puts its own handler in place."""
     with contextlib.suppress(ValueError, OSError):
         if signal.getsignal(signal.SIGINT) is interrupted:
-            signal.signal(signal.SIGINT, signal.default_int_handler)
+            signal.signal(signal.SIGINT, raise_interrupt)
         for number in OTHER_STOPS:
             if signal.getsignal(number) is interrupted:
-                signal.signal(number, signal.default_int_handler)
+                signal.signal(number, raise_interrupt)
 
 
 def hand_back(code: int) -> None:

@@ -102,17 +102,20 @@ def main(argv: Sequence[str] | None = None) -> int:
     point is exit 130 with one line (a command that stops in order says its own)."""
     try:
         _program.take_over()
-        return _main(argv)
+        code = _main(argv)
     except KeyboardInterrupt:  # while the command's modules are imported, its arguments parsed
-        with contextlib.suppress(OSError):
-            sys.stderr.write("earl: interrupted\n")
-        return EXIT_INTERRUPTED
+        code = EXIT_INTERRUPTED
     except Exception as error:
-        if not caused_by_an_interrupt(error):
+        if not (caused_by_an_interrupt(error) or _program.stop_received()):
             raise
-        with contextlib.suppress(OSError):
-            sys.stderr.write("earl: interrupted\n")
-        return EXIT_INTERRUPTED
+        code = EXIT_INTERRUPTED
+    else:
+        if not _program.stop_received() or code == EXIT_INTERRUPTED:
+            return code
+        # a stop signal came and some compiled code swallowed its KeyboardInterrupt: the command went on
+    with contextlib.suppress(OSError):
+        sys.stderr.write("earl: interrupted\n")
+    return EXIT_INTERRUPTED
 
 
 def caused_by_an_interrupt(error: BaseException) -> bool:

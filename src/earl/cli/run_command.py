@@ -21,6 +21,7 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 from rich.text import Text
 
+from earl import _program
 from earl.cli.common import (
     UsageError,
     brief,
@@ -503,9 +504,9 @@ def _stopped_like_ctrl_c() -> Iterator[_StopRequest]:
     """Ctrl-C, SIGTERM and SIGHUP raise KeyboardInterrupt meanwhile, so that the run ends in order (exit 130)."""
     request = _StopRequest()
 
-    def stop(*_: object) -> None:
+    def stop(number: int, frame: object) -> None:
         request.requested = True
-        raise KeyboardInterrupt
+        _program.raise_interrupt(number, frame)  # remembered, should compiled code swallow the interrupt
 
     with handling_stop_signals(stop):
         yield request

@@ -19,6 +19,7 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
+from earl import _program
 from earl.diagnostics import Diagnostic, Severity
 from earl.model.elements import PartialTransitionFunction
 from earl.model.location import SourceLocation
@@ -233,6 +234,8 @@ def _importing(module_name: str) -> _Imported | Callable[[str, SourceLocation | 
     except KeyboardInterrupt:
         raise
     except BaseException as error:  # the user's module failed while importing, sys.exit() included
+        if _program.stop_received():  # a Ctrl-C that a compiled module's initialisation put in other words
+            raise KeyboardInterrupt from error
         failure = error
     said = f"{_import_failure(failure)}{_where(failure)}"
     return lambda what, location: Diagnostic(

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
+from earl import _program
 from earl.diagnostics import Diagnostic, EarlError, Severity, SourceMap
 from earl.model.digest import model_digest
 from earl.model.elements import Duration, System
@@ -194,6 +195,10 @@ class Simulation:
                 record_memory=memory,
                 inbox=None if transport is None else transport.inbox,
             )
+            if _program.stop_received():
+                # in the `earl` program, a Ctrl-C that compiled code swallowed while the environment or the
+                # spec's modules were imported (a Cython module's initialisation clears it): still a stop
+                raise KeyboardInterrupt
         except BaseException:
             # Ctrl-C (or a failure) before the run could start: the trace's writer, in a session of its own,
             # would otherwise outlive this and write its file after `earl run` had removed it, and what the
