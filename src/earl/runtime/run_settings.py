@@ -7,9 +7,6 @@ that names the file, the line and the key, says what is expected and shows what 
 
 from __future__ import annotations
 
-import json
-import math
-import re
 import tomllib
 from dataclasses import dataclass, field
 from difflib import get_close_matches
@@ -17,6 +14,7 @@ from pathlib import Path
 
 from earl.diagnostics import SourceMap
 from earl.model.location import SourceLocation
+from earl.toml_lines import as_written, invalid_toml, key_lines
 
 #: the file's name, next to the spec
 RUN_TOML = "run.toml"
@@ -73,53 +71,6 @@ class RunSettings:
         return sources
 
 
-_KEY = r"""(?:"([^"]*)"|'([^']*)'|([A-Za-z0-9_-]+))"""
-#: `key = …`, `"key" = …`, and the first part of a dotted key (`plot.x = …` sets the top-level `plot`)
-_ASSIGNMENT = re.compile(rf"\s*{_KEY}\s*[=.]")
-#: `[table]`, `[[table]]`, `[table.sub]`: a top-level key too
-_TABLE = re.compile(rf"\s*\[\[?\s*{_KEY}")
-
-
-def _key_lines(text: str) -> dict[str, int]:
-    """The line each top-level key of a run.toml is set on (`report = "…"`, `"report" = "…"`, `[table]`)."""
-    lines: dict[str, int] = {}
-    in_table = False
-    for number, line in enumerate(text.split("\n"), start=1):
-        table = _TABLE.match(line)
-        found = table or (None if in_table else _ASSIGNMENT.match(line))
-        in_table = in_table or table is not None  # the keys after a table header are that table's
-        if found:
-            lines.setdefault(next(group for group in found.groups() if group is not None), number)
-    return lines
-
-
-def _as_written(value: object) -> str:
-    """A value as TOML writes it (`true`, `"x"`, `["a"]`), not as Python prints it (`True`, `'x'`);
-    control characters escaped, and cut when long."""
-    if isinstance(value, bool):
-        shown = "true" if value else "false"
-    elif isinstance(value, str):
-        shown = json.dumps(value, ensure_ascii=False)
-    elif isinstance(value, float) and not math.isfinite(value):
-        shown = "nan" if math.isnan(value) else ("inf" if value > 0 else "-inf")
-    elif isinstance(value, list):
-        shown = "[" + ", ".join(_as_written(item) for item in value) + "]"
-    elif isinstance(value, dict):
-        shown = "a table"
-    else:  # a number, a date or a time
-        shown = value.isoformat() if hasattr(value, "isoformat") else str(value)
-    return shown if len(shown) <= 60 else shown[:59] + "…"
-
-
-def _invalid_toml(shown: str, error: tomllib.TOMLDecodeError) -> ValueError:
-    """`run.toml:3:5: not valid TOML: Invalid value`: tomllib says where at the end of its message."""
-    message = str(error)
-    at = re.fullmatch(r"(.*) \(at line (\d+), column (\d+)\)", message, re.DOTALL)
-    if at is None:
-        return ValueError(f"{shown}: not valid TOML: {message}")
-    return ValueError(f"{shown}:{at.group(2)}:{at.group(3)}: not valid TOML: {at.group(1)}")
-
-
 def read_run_settings(spec: Path) -> RunSettings:
     """The run.toml next to `spec`, if there is one; ValueError for one that cannot be used."""
     path = spec.resolve().parent / RUN_TOML  # next to the file itself, as its modules and imports
@@ -137,8 +88,8 @@ def read_run_settings(spec: Path) -> RunSettings:
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
-        raise _invalid_toml(shown, error) from None
-    lines = _key_lines(text)
+        raise ValueError(invalid_toml(shown, error)) from None
+    lines = key_lines(text)
 
     def where(key: str) -> str:
         return f"{shown}:{lines[key]}" if key in lines else shown
@@ -150,7 +101,7 @@ def read_run_settings(spec: Path) -> RunSettings:
             raise ValueError(f"{where(key)}: unknown setting `{key}`{guess} (known: {', '.join(sorted(KNOWN))})")
 
     def refuse(key: str, wanted: str) -> ValueError:
-        return ValueError(f"{where(key)}: `{key}` is {wanted}, not {_as_written(data[key])}")
+        return ValueError(f"{where(key)}: `{key}` is {wanted}, not {as_written(data[key])}")
 
     duration = data.get("duration")
     if duration is not None:
@@ -182,7 +133,7 @@ def read_run_settings(spec: Path) -> RunSettings:
             raise refuse(key, f"a list of strings, e.g. {example}")
         if any(not item.strip() for item in data[key]):  # a pattern that matched nothing, a signal of no one
             raise ValueError(
-                f"{where(key)}: `{key}` has an empty string in {_as_written(data[key])}: each names a {what}, "
+                f"{where(key)}: `{key}` has an empty string in {as_written(data[key])}: each names a {what}, "
                 f"e.g. {example}"
             )
     return RunSettings(
