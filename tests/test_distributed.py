@@ -655,7 +655,11 @@ def test_launch_refuses_to_split_the_robots_effectors_from_their_environment(tmp
         check=False,
     )
     assert result.returncode == 1, result.stderr
-    assert "process 3 runs `grip/a`, whose Real Effectors or Receptors act on the environment" in result.stderr
+    assert (
+        f"earl launch: {deploy}:12: process 3 runs `grip/a`, whose Real Effectors or Receptors act on the environment"
+        in result.stderr
+    ), result.stderr
+    assert result.stderr.count("\n") == 1, result.stderr
     assert "started" not in result.stdout and "Traceback" not in result.stderr
 
 
@@ -857,7 +861,8 @@ def test_launch_checks_each_processs_args_before_starting_any(tmp_path: Path, ar
     deploy.write_text(deploy.read_text().replace("environment = false\n", f"environment = false\nargs = {args}\n", 1))
     result = subprocess.run(launch_command(deploy, "1s"), capture_output=True, text=True, timeout=60, check=False)
     assert result.returncode == 1, result.stdout + result.stderr
-    assert f"{deploy}: process 1 (sender/a) cannot run with its `args`: {said}" in result.stderr, result.stderr
+    # at the line of its `args`
+    assert f"{deploy}:5: process 1 (sender/a) cannot run with its `args`: {said}" in result.stderr, result.stderr
     assert "nothing was started" in result.stderr
     assert "started" not in result.stdout and "Traceback" not in result.stderr
 
@@ -940,7 +945,8 @@ def test_a_deployment_named_with_a_zenoh_config_is_read_and_checked(tmp_path: Pa
         text=True,
         timeout=120,
     )
-    assert result.returncode == 1 and f"{broken}: not valid TOML" in result.stderr, result.stderr
+    assert result.returncode == 1 and f"earl run: {broken}:1:10: not valid TOML" in result.stderr, result.stderr
+    assert result.stderr.count("\n") == 1, result.stderr
     # the environment with the task agent, apart from the agents acting on it
     misplaced = deployment(tmp_path, [(["manip/a", "grip/a"], False), (["task/a"], True)])
     result = subprocess.run(
@@ -950,6 +956,7 @@ def test_a_deployment_named_with_a_zenoh_config_is_read_and_checked(tmp_path: Pa
         timeout=120,
     )
     assert result.returncode == 1, result.stdout + result.stderr
+    assert f"earl run: {misplaced}:2: process 1 runs `manip/a`" in result.stderr, result.stderr
     assert "but the environment lives in process 2 (task/a)" in result.stderr
     assert "over Zenoh" not in result.stderr  # refused before Zenoh starts
 

@@ -167,125 +167,192 @@ def test_the_environment_goes_to_the_process_whose_agents_act_on_it_unless_the_f
 
 
 @pytest.mark.parametrize(
-    ("processes", "fragment"),
+    ("processes", "line", "fragment"),
     [
-        (
+        (  # said at the second process that would hold it
             [(TASK, ""), (["manip/a"], ""), (["grip/a"], "")],
+            11,
             "the environment would run in process 2 (manip/a) and in process 3 (grip/a), each simulating a "
             "world of its own",
         ),
         (
             [(TASK, "environment = true"), (ROBOT, "")],
+            7,
             "process 2 runs `manip/a`, whose Real Effectors or Receptors act on the environment, but the "
             "environment lives in process 1 (task/a); run `manip/a` in process 1",
         ),
         (
             [(TASK, ""), (ROBOT, "environment = false")],
+            9,
             "no process runs the environment, but `manip/a` (process 2) has Real Effectors or Receptors",
         ),
         (
             [(["manip/a"], "environment = true"), (["grip/a", "task/a"], "")],
+            7,
             "process 2 runs `grip/a`, whose Real Effectors or Receptors act on the environment, but the "
             "environment lives in process 1 (manip/a)",
         ),
     ],
 )
 def test_an_environment_that_would_run_twice_or_apart_from_its_effectors_is_refused(
-    tmp_path: Path, processes: list[tuple[list[str], str]], fragment: str
+    tmp_path: Path, processes: list[tuple[list[str], str]], line: int, fragment: str
 ) -> None:
     with pytest.raises(DeploymentError) as raised:
         _placed(tmp_path, processes, ROBOT)
+    assert str(raised.value).startswith(f"{tmp_path / 'deploy.toml'}:{line}: "), str(raised.value)
     assert fragment in str(raised.value)
 
 
 @pytest.mark.parametrize(
-    ("text", "fragment"),
+    ("text", "line", "fragment"),
     [
-        ("", "no `[[process]]` table"),
-        ("[[process]]\nagents = []\nlisten = 'tcp/127.0.0.1:1'\n", "`agents` is empty; list the agents it runs"),
-        ("[[process]]\nagents = 'a'\nlisten = 'tcp/127.0.0.1:1'\n", "`agents` must be a list"),
-        ("[process]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:1'\n", "write `[[process]]`, with two brackets"),
+        ("", 1, "no `[[process]]` table"),
+        ("[[process]]\nagents = []\nlisten = 'tcp/127.0.0.1:1'\n", 2, "`agents` is empty; list the agents it runs"),
+        (
+            "[[process]]\nagents = 'a'\nlisten = 'tcp/127.0.0.1:1'\n",
+            2,
+            '`agents` is a list of agent names, e.g. ["manip/a", "grip/a"], not "a"',
+        ),
+        ("[process]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:1'\n", 1, "write `[[process]]`, with two brackets"),
         (
             "[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:1'\nargs = ['--transport', 'inproc']\n",
+            4,
             "`args` sets `--transport`, which `earl launch` sets for each process itself (always zenoh)",
         ),
         (
             "[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:1'\nargs = ['--agents=b/a']\n",
+            4,
             "`args` sets `--agents`, which `earl launch` sets for each process itself",
         ),
         (
             "[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:1'\nargs = ['--agent', 'b/a']\n",
+            4,
             "`args` sets `--agents` (as `--agent`)",
         ),
         (
             "[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:1'\nargs = ['--trans=inproc']\n",
+            4,
             "`args` sets `--transport` (as `--trans`)",
         ),
         (
             "[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:1'\nargs = ['--dep', 'x.toml']\n",
+            4,
             "`args` sets `--deployment` (as `--dep`)",
         ),
-        ("[[process]]\nagents = ['a']\n", "`listen` must be a Zenoh endpoint"),
-        ("[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:1'\nspeed = 3\n", "unknown key `speed`"),
+        ("[[process]]\nagents = ['a']\n", 1, "process 1: no `listen` endpoint"),
+        ("[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:1'\nspeed = 3\n", 4, "unknown key `speed`"),
         (
             "[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:1'\n[[process]]\nagents = ['a/a']\nlisten = 'tcp/x:2'\n",
+            5,
             "`a/a` already runs in process 1",
         ),
         (
             "[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:1'\n[[process]]\nagents = ['b']\nlisten = 'tcp/127.0.0.1:1'\n",
+            6,
             "the same endpoint as process 1's",
         ),
         (
             "[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:7'\n[[process]]\nagents = ['b']\nlisten = 'tcp/localhost:7'\n",
+            6,
             "`tcp/localhost:7` and process 1's `tcp/127.0.0.1:7` cannot both listen on port 7 (`localhost` is "
             "127.0.0.1 or ::1, as this host resolves it)",
         ),
         (
             "[[process]]\nagents = ['a']\nlisten = 'tcp/[::1]:7'\n[[process]]\nagents = ['b']\nlisten = 'tcp/localhost:7'\n",
+            6,
             "`tcp/localhost:7` and process 1's `tcp/[::1]:7` cannot both listen on port 7 (`localhost` is",
         ),
         (
             "[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:7'\n[[process]]\nagents = ['b']\nlisten = 'tcp/0.0.0.0:7'\n",
+            6,
             "cannot both listen on port 7 (`0.0.0.0` listens on every IPv4 address of this host)",
         ),
         (
             "[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:7'\n[[process]]\nagents = ['b']\nlisten = 'tcp/[::]:7'\n",
+            6,
             "cannot both listen on port 7 (`[::]` listens on every address of this host, IPv4 too)",
         ),
         (
             "[[process]]\nagents = ['a']\nlisten = 'tcp/[0:0:0:0:0:0:0:1]:7'\n[[process]]\nagents = ['b']\nlisten = 'tcp/[::1]:7'\n",
+            6,
             "`tcp/[::1]:7` is the same endpoint as process 1's",
         ),
         (
             "[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:7'\n[[process]]\nagents = ['b']\nlisten = 'tls/127.0.0.1:7'\n",
+            6,
             "`tls/127.0.0.1:7` is the same endpoint as process 1's",  # both bind TCP port 7
         ),
         (
             "[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:7451'\n[[process]]\nagents = ['b']\nlisten = 'tcp/127.0.0.1:07451'\n",
+            6,
             "the same endpoint as process 1's",
         ),
         (
             "[[process]]\nagents = ['a']\nlisten = 'tpc/127.0.0.1:7451'\n",
+            3,
             "`tpc` is not a protocol of Zenoh; did you mean `tcp`",
         ),
-        ("[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:notaport'\n", "`notaport` is not a port"),
-        ("[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:99999'\n", "`99999` is not a port"),
+        ("[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:notaport'\n", 3, "`notaport` is not a port"),
+        ("[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:99999'\n", 3, "`99999` is not a port"),
         # digits of other scripts: Zenoh would refuse them only as the process opens, and `int` the superscripts
-        ("[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:\u0661\u0667\u0664\u0665\u0661'\n", "is not a port"),
-        ("[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:7\u00b2'\n", "is not a port"),
-        ("[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1'\n", "write it as tcp/HOST:PORT"),
-        ("[[process]]\nagents = ['a', 'a/a']\nlisten = 'tcp/127.0.0.1:1'\n", "`a/a` is listed twice"),
-        ("[[process]\n", "not valid TOML"),
-        ("mode = 'peer'\n", "unknown setting `mode`"),
+        ("[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:\u0661\u0667\u0664\u0665\u0661'\n", 3, "is not a port"),
+        ("[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:7\u00b2'\n", 3, "is not a port"),
+        ("[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1'\n", 3, "write it as tcp/HOST:PORT"),
+        ("[[process]]\nagents = ['a', 'a/a']\nlisten = 'tcp/127.0.0.1:1'\n", 2, "`a/a` is listed twice"),
+        ("[[process]\n", 1, "not valid TOML"),
+        ("mode = 'peer'\n", 1, "unknown setting `mode`"),
+        ("# processes\n\nproces = []\n", 3, "unknown setting `proces`; did you mean `process`?"),
+        (
+            "[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:1'\nagent = ['b']\n",
+            4,
+            "process 1: unknown key `agent`; did you mean `agents`? (known: agents, listen, environment, host, args)",
+        ),
+        ("[[process]]\nlisten = 'tcp/127.0.0.1:1'\n", 1, "process 1: no `agents`; list the agents it runs"),
+        (  # an agent named twice: at the second, on its own line of the list
+            "[[process]]\nagents = [\n  'a',\n  'b',\n  'a/a',\n]\nlisten = 'tcp/127.0.0.1:1'\n",
+            5,
+            "process 1: `a/a` is listed twice in its `agents`",
+        ),
+        ("[[process]]\nagents = [\n  'a',\n  'a',\n]\nlisten = 'tcp/127.0.0.1:1'\n", 4, "`a/a` is listed twice"),
+        (
+            "[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:1'\n\n[[process]]\nagents = [\n  'b',\n  'a',\n]\n"
+            "listen = 'tcp/127.0.0.1:2'\n",
+            8,
+            "process 2: `a/a` already runs in process 1",
+        ),
+        (  # endpoints that clash: at the second, whatever comes between
+            "[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:7451'\n# the task\n[[process]]\nagents = ['b']\n"
+            "host = 'localhost'\n\nlisten = 'tcp/0.0.0.0:7451'\n",
+            9,
+            "process 2: `tcp/0.0.0.0:7451` and process 1's `tcp/127.0.0.1:7451` cannot both listen on port 7451",
+        ),
+        ("[[process]]\nagents = ['a']\nlisten = 7451\n", 3, "`listen` is a Zenoh endpoint such as"),
+        ("[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:1'\nenvironment = 'yes'\n", 4, 'not "yes"'),
+        ("[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:1'\nhost = 1\n", 4, "`host` is a host name"),
+        ("[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:1'\nargs = '--trace'\n", 4, "`args` is a list"),
+        (
+            "[[process]]\nagents = ['a']\nlisten = 'tcp/127.0.0.1:1'\nargs = [\n  '--seed', '1',\n  '--agents', 'b'\n]\n",
+            6,
+            "`args` sets `--agents`",
+        ),
+        ("process = [1]\n", 1, "process 1 is 1, not a table"),
+        (  # written inline, every process is said at the `process` line
+            "# two\nprocess = [{agents = ['a'], listen = 'tcp/127.0.0.1:1'}, {agents = ['a'], listen = 'tcp/127.0.0.1:2'}]\n",
+            2,
+            "process 2: `a/a` already runs in process 1",
+        ),
+        ("\n\nx = [\n1,,\n]\n", 4, "4:3: not valid TOML: Invalid value"),
     ],
 )
-def test_a_bad_deployment_file_is_one_located_sentence(tmp_path: Path, text: str, fragment: str) -> None:
+def test_a_bad_deployment_file_is_one_located_sentence(tmp_path: Path, text: str, line: int, fragment: str) -> None:
+    """`FILE:LINE: …`, the line of the key that is wrong (the second of two that clash), as run.toml's."""
     path = tmp_path / "deploy.toml"
     path.write_text(text)
     with pytest.raises(DeploymentError) as error:
         read_deployment(path)
-    assert str(error.value).startswith(str(path))
+    assert str(error.value).startswith(f"{path}:{line}:"), str(error.value)
     assert fragment in str(error.value)
+    assert "\n" not in str(error.value)
 
 
 @pytest.mark.parametrize(
@@ -364,12 +431,19 @@ def test_a_deployment_must_cover_the_agents_of_the_system(tmp_path: Path) -> Non
     path = tmp_path / "deploy.toml"
     path.write_text("[[process]]\nagents = ['sender']\nlisten = 'tcp/127.0.0.1:1'\n")
     deployment = read_deployment(path)
-    with pytest.raises(DeploymentError, match="the agent `receiver/a` runs in no process"):
+    with pytest.raises(DeploymentError, match=r"deploy\.toml:1: the agent `receiver/a` runs in no process"):
         deployment.check_agents(["sender/a", "receiver/a"])
-    with pytest.raises(DeploymentError, match="`sender/a` is not an agent of this system"):
-        deployment.check_agents(["receiver/a"])
-    with pytest.raises(DeploymentError, match="no process runs exactly the agents receiver/a"):
+    with pytest.raises(DeploymentError, match=r"deploy\.toml:1: no process runs exactly the agents receiver/a"):
         deployment.group_of(["receiver/a"])
+    # an unknown agent is said at its line of the process's `agents`, as it is written there
+    path.write_text(
+        "[[process]]\nagents = ['sender']\nlisten = 'tcp/127.0.0.1:1'\n[[process]]\nagents = [\n  'x',\n  'sender2',\n]\n"
+        "listen = 'tcp/127.0.0.1:2'\n"
+    )
+    with pytest.raises(DeploymentError, match=r"deploy\.toml:7: process 2: `sender2/a` is not an agent of this system"):
+        read_deployment(path).check_agents(["sender/a", "x/a"])
+    with pytest.raises(DeploymentError, match=r"deploy\.toml:6: no process runs exactly the agents x/a"):
+        read_deployment(path).group_of(["x"])
 
 
 def packed(values: Any) -> bytes:
@@ -639,28 +713,28 @@ def test_a_stale_input_reads_as_timed_out_until_its_sender_returns() -> None:
     ("deployment", "code", "fragment"),
     [
         (None, 2, "no deployment file"),
-        ("[[process]\n", 1, "not valid TOML"),
+        ("[[process]\n", 1, "deploy.toml:1:10: not valid TOML"),
         (
             "[[process]]\nagents = ['sender']\nlisten = 'tcp/127.0.0.1:1'\n",
             1,
-            "the agent `receiver/a` runs in no process",
+            "deploy.toml:1: the agent `receiver/a` runs in no process",
         ),
         (
             "[[process]]\nagents = ['sender', 'receiver']\nlisten = 'tcp/192.0.2.1:1'\nhost = 'elsewhere.invalid'\n",
             1,
-            "has no process for this host, `",
+            "deploy.toml:4: no process for this host, `",
         ),
         (
             "[[process]]\nagents = ['sender']\nlisten = 'tcp/127.0.0.1:1'\nargs = ['--trace', 'same.mcap']\n"
             "[[process]]\nagents = ['receiver']\nlisten = 'tcp/127.0.0.1:2'\nargs = ['--trace=same.mcap']\n",
             1,
-            "receiver/a writes same.mcap (--trace), as sender/a does",
+            "deploy.toml:8: process 2 (receiver/a) writes same.mcap (--trace), as sender/a does",
         ),
         (
             "[[process]]\nagents = ['sender']\nlisten = 'tcp/127.0.0.1:1'\nargs = ['--tra', 'p.mcap']\n"
             "[[process]]\nagents = ['receiver']\nlisten = 'tcp/127.0.0.1:2'\nargs = ['--plot', 'p.png']\n",
             1,
-            "receiver/a writes p.mcap (--plot's trace), as sender/a does",
+            "deploy.toml:8: process 2 (receiver/a) writes p.mcap (--plot's trace), as sender/a does",
         ),
     ],
 )
@@ -677,6 +751,7 @@ def test_launch_refuses_a_deployment_it_cannot_run_before_starting_anything(
     assert main(arguments) == code
     captured = capsys.readouterr()
     assert fragment in captured.err and "started" not in captured.out
+    assert captured.err.count("\n") == 1, captured.err  # one line, `deploy.toml:LINE: …`
 
 
 SERVED_SPEC = """\

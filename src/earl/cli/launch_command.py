@@ -38,6 +38,7 @@ from earl.cli.common import (
 from earl.cli.output import print_diagnostics
 from earl.cli.run_command import handling_stop_signals
 from earl.diagnostics import EarlError
+from earl.transport.deployment import Deployment
 
 EXIT_OK, EXIT_FAILED, EXIT_INTERRUPTED = 0, 1, 130
 #: seconds a process gets to finish its trace after SIGTERM before it is killed
@@ -131,14 +132,14 @@ def run(arguments: argparse.Namespace) -> int:
 
         hosts = ", ".join(sorted({process.host for process in deployment.processes}))
         print(
-            f"earl launch: {deployment_path} has no process for this host, `{this_host_name()}` "
+            f"earl launch: {deployment.at(1, 'host')}: no process for this host, `{this_host_name()}` "
             f"(its processes run on {hosts})",
             file=sys.stderr,
         )
         return EXIT_FAILED
-    shared = _shared_output(local)
+    shared = _shared_output(deployment)
     if shared is not None:
-        print(f"earl launch: {deployment_path}: {shared}; nothing was started", file=sys.stderr)
+        print(f"earl launch: {shared}; nothing was started", file=sys.stderr)
         return EXIT_FAILED
     if arguments.duration is not None:  # `--duration=` too: the processes would run the default
         from earl.runtime.durations import parse_duration
@@ -158,7 +159,8 @@ def run(arguments: argparse.Namespace) -> int:
         problem = _args_problem([*common, "--agents", process.label, *process.args])
         if problem is not None:
             print(
-                f"earl launch: {deployment_path}: process {number} ({process.label}) cannot run with its `args`: "
+                f"earl launch: {deployment.at(number, 'args')}: process {number} ({process.label}) cannot run "
+                f"with its `args`: "
                 f"{problem}; nothing was started",
                 file=sys.stderr,
             )
@@ -227,15 +229,18 @@ def _args_problem(command: list[str]) -> str | None:
     return None
 
 
-def _shared_output(processes: list[Any]) -> str | None:
-    """Two processes whose `args` write one file: a `--trace`, a `--plot`, or the trace a `--plot`
-    implies (`p.png` → `p.mcap`). The later would refuse it (an existing file) or, started at the same
-    moment, overwrite the other's. The args are read as `earl run` reads them (abbreviations too)."""
+def _shared_output(deployment: Deployment) -> str | None:
+    """Two of this host's processes whose `args` write one file: a `--trace`, a `--plot`, or the trace a
+    `--plot` implies (`p.png` → `p.mcap`), said at the second one's `args`. The later would refuse it (an
+    existing file) or, started at the same moment, overwrite the other's. The args are read as `earl run`
+    reads them (abbreviations too)."""
     reader = argparse.ArgumentParser(add_help=False, exit_on_error=False)
     reader.add_argument("--trace")
     reader.add_argument("--plot")
     written: dict[Path, str] = {}
-    for process in processes:
+    for number, process in enumerate(deployment.processes, start=1):
+        if not process.is_local:
+            continue
         try:
             options, _ = reader.parse_known_args(list(process.args))
         except (argparse.ArgumentError, SystemExit):
@@ -247,7 +252,10 @@ def _shared_output(processes: list[Any]) -> str | None:
         for option, value in files:
             target = Path(value).resolve()
             if target in written:
-                return f"{process.label} writes {value} ({option}), as {written[target]} does: give each its own file"
+                return (
+                    f"{deployment.at(number, 'args')}: process {number} ({process.label}) writes {value} "
+                    f"({option}), as {written[target]} does: give each its own file"
+                )
             written[target] = process.label
     return None
 

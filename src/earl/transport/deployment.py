@@ -32,7 +32,8 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from earl.diagnostics import did_you_mean
-from earl.transport.listeners import Listener, clash, listener
+from earl.toml_lines import TomlTable, as_written, invalid_toml, key_lines, toml_tables, value_line
+from earl.transport.listeners import clash, listener
 
 LOCAL_HOSTS = frozenset({"localhost", "127.0.0.1", "::1"})
 
@@ -102,6 +103,24 @@ def this_host_name() -> str:
 class Deployment:
     path: Path
     processes: tuple[ProcessGroup, ...] = field(default_factory=tuple)
+    #: the file's text and where each process is written in it, for messages that say `FILE:LINE:`
+    text: str = field(default="", compare=False, repr=False)
+    tables: tuple[TomlTable, ...] = field(default=(), compare=False, repr=False)
+
+    def at(self, number: int, key: str | None = None, value: str | None = None, nth: int = 1) -> str:
+        """`deploy.toml:7`: where process `number` sets `key` (its string `value` in a list, the `nth`
+        time it is written there), or where the process begins."""
+        if not 1 <= number <= len(self.tables):
+            return str(self.path)
+        table = self.tables[number - 1]
+        line = table.keys.get(key, table.line) if key is not None else table.line
+        if key is not None and value is not None:
+            line = value_line(self.text, table, key, value, nth) or line
+        return f"{self.path}:{line}"
+
+    def first_line(self) -> str:
+        """`deploy.toml:1`, where the first process begins: said of what no process has."""
+        return self.at(1) if self.tables else str(self.path)
 
     def group_of(self, agents: list[str]) -> ProcessGroup:
         """The process that runs exactly `agents` (in any order)."""
@@ -110,9 +129,25 @@ class Deployment:
             if set(process.agents) == wanted:
                 return process
         known = "; ".join(process.label for process in self.processes)
+        # said at the process that runs one of them (it runs others too, or not all), else at the first
+        nearest = next((n for n, p in enumerate(self.processes, start=1) if not wanted.isdisjoint(p.agents)), None)
+        where = self.first_line()
+        if nearest is not None:
+            agent = next(a for a in self.processes[nearest - 1].agents if a in wanted)
+            where = self.at(nearest, "agents", self._written_agent(nearest, agent))
         raise DeploymentError(
-            f"{self.path}: no process runs exactly the agents {', '.join(sorted(wanted))} (its processes: {known})"
+            f"{where}: no process runs exactly the agents {', '.join(sorted(wanted))} (its processes: {known})"
         )
+
+    def _written_agent(self, number: int, agent: str) -> str:
+        """How process `number`'s `agents` writes `agent` (`task` for `task/a`), to find its line."""
+        table = self.tables[number - 1] if 1 <= number <= len(self.tables) else None
+        start = table.keys.get("agents") if table is not None else None
+        if table is None or start is None:
+            return agent
+        plain = agent.removesuffix("/a")
+        text = "\n".join(self.text.split("\n")[start - 1 : table.end])
+        return plain if f'"{plain}"' in text or f"'{plain}'" in text else agent
 
     def connect_for(self, process: ProcessGroup) -> list[str]:
         """The endpoints `process` connects to: every other process's."""
@@ -126,13 +161,14 @@ class Deployment:
             for agent in process.agents:
                 if agent not in known:
                     raise DeploymentError(
-                        f"{self.path}: process {number}: `{agent}` is not an agent of this system "
+                        f"{self.at(number, 'agents', self._written_agent(number, agent))}: process {number}: "
+                        f"`{agent}` is not an agent of this system "
                         f"(its agents: {', '.join(system_agents)})"
                     )
         missing = [agent for agent in system_agents if agent not in deployed]
         if missing:
             raise DeploymentError(
-                f"{self.path}: the agent `{missing[0]}` runs in no process; add it to a process's `agents`"
+                f"{self.first_line()}: the agent `{missing[0]}` runs in no process; add it to a process's `agents`"
             )
 
     def place_environment(self, acting: Collection[str]) -> Deployment:
@@ -166,7 +202,7 @@ class Deployment:
         if len(holders) > 1:
             (first, one), (second, other) = holders[0], holders[1]
             raise DeploymentError(
-                f"{self.path}: the environment would run in process {first} ({one.label}) and in process "
+                f"{self.at(second, 'environment')}: the environment would run in process {first} ({one.label}) and in process "
                 f"{second} ({other.label}), each simulating a world of its own; give it to one process "
                 "(`environment = false` in the others) and run every agent with Real Effectors or Receptors there"
             )
@@ -175,7 +211,7 @@ class Deployment:
             if unheld:
                 number, agent = unheld[0]
                 raise DeploymentError(
-                    f"{self.path}: no process runs the environment, but `{agent}` (process {number}) has Real "
+                    f"{self.at(number, 'environment')}: no process runs the environment, but `{agent}` (process {number}) has Real "
                     f"Effectors or Receptors that act on it; give process {number} `environment = true`, or "
                     'its own environment in its `args` (`args = ["--environment", "module:factory"]`)'
                 )
@@ -185,7 +221,8 @@ class Deployment:
             away = [agent for agent in process.agents if agent in acting]
             if process is not holder and away:
                 raise DeploymentError(
-                    f"{self.path}: process {other_number} runs `{away[0]}`, whose Real Effectors or Receptors "
+                    f"{self.at(other_number, 'agents', self._written_agent(other_number, away[0]))}: "
+                    f"process {other_number} runs `{away[0]}`, whose Real Effectors or Receptors "
                     f"act on the environment, but the environment lives in process {number} ({holder.label}); "
                     f"run `{away[0]}` in process {number}"
                 )
@@ -255,6 +292,8 @@ def _launch_option(arg: str) -> str | None:
 
 
 def read_deployment(path: Path) -> Deployment:
+    """The deployment file at `path`; a DeploymentError, `FILE:LINE: …` with the key or process that is
+    wrong and what is expected, when it cannot be used."""
     try:
         text = path.read_text(encoding="utf-8")
     except OSError as error:
@@ -264,80 +303,119 @@ def read_deployment(path: Path) -> Deployment:
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
-        raise DeploymentError(f"{path}: not valid TOML: {error}") from None
-    unknown = sorted(set(data) - {"process"})
+        raise DeploymentError(invalid_toml(str(path), error)) from None
+    tables = toml_tables(text)
+    top = key_lines(text)
+    unknown = [key for key in data if key != "process"]
     if unknown:
-        raise DeploymentError(f"{path}: unknown setting `{unknown[0]}` (a deployment has `[[process]]` tables)")
-    tables = data.get("process")
-    if isinstance(tables, dict):
+        hint = did_you_mean(unknown[0], ["process"]) or "a deployment has only `[[process]]` tables"
+        raise DeploymentError(f"{path}:{top.get(unknown[0], 1)}: unknown setting `{unknown[0]}`; {hint}")
+    processes_line = top.get("process", 1)
+    written = data.get("process")
+    if isinstance(written, dict):
         raise DeploymentError(
-            f"{path}: `[process]` is one table; write `[[process]]`, with two brackets, before each process"
+            f"{path}:{processes_line}: `[process]` is one table; write `[[process]]`, with two brackets, "
+            "before each process"
         )
-    if not isinstance(tables, list) or not tables:
-        raise DeploymentError(f"{path}: no `[[process]]` table; each names its `agents` and `listen` endpoint")
+    if not isinstance(written, list) or not written:
+        shown = "" if written is None else f" (`process = {as_written(written)}`)"
+        raise DeploymentError(
+            f"{path}:{processes_line}: no `[[process]]` table{shown}; each names its `agents` and `listen` endpoint"
+        )
+    headers = [table for table in tables if table.name == "process" and table.in_array]
+    if len(headers) != len(written):  # `process = [{…}, {…}]` inline: every process is said at that line
+        headers = [TomlTable("process", processes_line) for _ in written]
+    deployment = Deployment(path, text=text, tables=tuple(headers))
     processes: list[ProcessGroup] = []
-    seen_agents: dict[str, int] = {}
-    #: each process's `listen` endpoint so far, the socket it binds, and the host it runs on
-    seen_endpoints: list[tuple[int, str, Listener, str]] = []
-    for number, table in enumerate(tables, start=1):
-        where = f"{path}: process {number}"
-        listed: set[str] = set()
+    for number, table in enumerate(written, start=1):
         if not isinstance(table, dict):
-            raise DeploymentError(f"{where} is not a table")
-        extra = sorted(set(table) - {"agents", "listen", "environment", "host", "args"})
-        if extra:
-            raise DeploymentError(f"{where}: unknown key `{extra[0]}` (known: agents, listen, environment, host, args)")
-        agents = table.get("agents")
-        if agents == []:
-            raise DeploymentError(f'{where}: `agents` is empty; list the agents it runs, e.g. ["manip/a", "grip/a"]')
-        if not isinstance(agents, list) or not all(isinstance(a, str) and a.strip() for a in agents):
-            raise DeploymentError(f'{where}: `agents` must be a list of agent names, e.g. ["manip/a", "grip/a"]')
-        names = tuple(normalise_agent(a) for a in agents)
-        for agent in names:
-            if agent in listed:
-                raise DeploymentError(f"{where}: `{agent}` is listed twice in its `agents`")
-            if agent in seen_agents:
-                raise DeploymentError(f"{where}: `{agent}` already runs in process {seen_agents[agent]}")
-            listed.add(agent)
-            seen_agents[agent] = number
-        listen = table.get("listen")
-        if not isinstance(listen, str) or "/" not in listen:
-            raise DeploymentError(f'{where}: `listen` must be a Zenoh endpoint such as "tcp/127.0.0.1:7451"')
-        problem = endpoint_problem(listen)
-        if problem is not None:
-            raise DeploymentError(f"{where}: `listen = {listen!r}`: {problem}")
-        host = table.get("host", "localhost")
-        if not isinstance(host, str) or not host:
-            raise DeploymentError(f"{where}: `host` must be a host name")
-        this = listener(listen)
-        for other_number, other, bound, other_host in seen_endpoints:
-            if not same_host(host, other_host):
-                continue  # each computer has its own ports: `0.0.0.0:7451` on one, `192.168.1.20:7451` on another
-            why = clash(this, bound)
-            if why == "":
-                raise DeploymentError(
-                    f"{where}: `{listen}` is the same endpoint as process {other_number}'s; give each its own port"
-                )
-            if why is not None:
-                raise DeploymentError(
-                    f"{where}: `{listen}` and process {other_number}'s `{other}` cannot both listen on port "
-                    f"{this.port} ({why}); give each its own port"
-                )
-        seen_endpoints.append((number, listen, this, host))
-        environment = table.get("environment")
-        args = table.get("args", [])
-        if environment is not None and not isinstance(environment, bool):
-            raise DeploymentError(f"{where}: `environment` must be true or false")
-        if not isinstance(args, list) or not all(isinstance(a, str) for a in args):
-            raise DeploymentError(f'{where}: `args` must be a list of `earl run` options, e.g. ["--trace", "x.mcap"]')
-        for arg in args:
-            option = _launch_option(arg)
-            if option is not None:
-                written = arg.split("=", 1)[0]
-                shortened = f" (as `{written}`)" if written != option else ""
-                raise DeploymentError(
-                    f"{where}: `args` sets `{option}`{shortened}, which `earl launch` sets for each process itself "
-                    f"({LAUNCH_SETS[option]})"
-                )
-        processes.append(ProcessGroup(names, listen, environment, host, tuple(args)))
-    return Deployment(path, tuple(processes))
+            raise DeploymentError(
+                f"{deployment.at(number)}: process {number} is {as_written(table)}, not a table; "
+                "write each as `[[process]]` with its keys below"
+            )
+        processes.append(_read_process(deployment, number, table, processes))
+    return replace(deployment, processes=tuple(processes))
+
+
+#: the keys of a `[[process]]` table
+_PROCESS_KEYS = ("agents", "listen", "environment", "host", "args")
+
+
+def _read_process(
+    deployment: Deployment, number: int, table: dict[str, object], before: list[ProcessGroup]
+) -> ProcessGroup:
+    """Process `number` of the file, checked against the processes `before` it."""
+
+    def refuse(key: str | None, message: str, value: str | None = None, nth: int = 1) -> DeploymentError:
+        return DeploymentError(f"{deployment.at(number, key, value, nth)}: process {number}: {message}")
+
+    extra = [key for key in table if key not in _PROCESS_KEYS]
+    if extra:
+        hint = did_you_mean(extra[0], _PROCESS_KEYS)
+        hint = f"; {hint}" if hint else ""
+        raise refuse(extra[0], f"unknown key `{extra[0]}`{hint} (known: {', '.join(_PROCESS_KEYS)})")
+    example = '["manip/a", "grip/a"]'
+    agents = table.get("agents")
+    if agents is None:
+        raise refuse(None, f"no `agents`; list the agents it runs, e.g. `agents = {example}`")
+    if agents == []:
+        raise refuse("agents", f"`agents` is empty; list the agents it runs, e.g. {example}")
+    if not isinstance(agents, list) or not all(isinstance(a, str) and a.strip() for a in agents):
+        raise refuse("agents", f"`agents` is a list of agent names, e.g. {example}, not {as_written(agents)}")
+    runs = {agent: other for other, process in enumerate(before, start=1) for agent in process.agents}
+    names: list[str] = []
+    for written in agents:
+        agent = normalise_agent(written)
+        if agent in names:
+            again = agents[: len(names)].count(written) + 1  # the message points at this writing
+            raise refuse("agents", f"`{agent}` is listed twice in its `agents`", written, again)
+        if agent in runs:
+            raise refuse("agents", f"`{agent}` already runs in process {runs[agent]}", written)
+        names.append(agent)
+    listen = table.get("listen")
+    endpoint = '"tcp/127.0.0.1:7451"'
+    if listen is None:
+        raise refuse(None, f"no `listen` endpoint; give it one such as `listen = {endpoint}`")
+    if not isinstance(listen, str) or "/" not in listen:
+        raise refuse("listen", f"`listen` is a Zenoh endpoint such as {endpoint}, not {as_written(listen)}")
+    problem = endpoint_problem(listen)
+    if problem is not None:
+        raise refuse("listen", f"`listen = {as_written(listen)}`: {problem}")
+    host = table.get("host", "localhost")
+    if not isinstance(host, str) or not host:
+        raise refuse("host", f'`host` is a host name such as "robot" or "localhost", not {as_written(host)}')
+    this = listener(listen)
+    for other_number, other in enumerate(before, start=1):
+        if not same_host(host, other.host):
+            continue  # each computer has its own ports: `0.0.0.0:7451` on one, `192.168.1.20:7451` on another
+        why = clash(this, listener(other.listen))
+        if why == "":
+            raise refuse(
+                "listen", f"`{listen}` is the same endpoint as process {other_number}'s; give each its own port"
+            )
+        if why is not None:
+            raise refuse(
+                "listen",
+                f"`{listen}` and process {other_number}'s `{other.listen}` cannot both listen on port "
+                f"{this.port} ({why}); give each its own port",
+            )
+    environment = table.get("environment")
+    if environment is not None and not isinstance(environment, bool):
+        raise refuse("environment", f"`environment` is true or false, not {as_written(environment)}")
+    args = table.get("args", [])
+    if not isinstance(args, list) or not all(isinstance(a, str) for a in args):
+        raise refuse(
+            "args", f'`args` is a list of `earl run` options, e.g. ["--trace", "x.mcap"], not {as_written(args)}'
+        )
+    for arg in args:
+        option = _launch_option(arg)
+        if option is not None:
+            written = arg.split("=", 1)[0]
+            shortened = f" (as `{written}`)" if written != option else ""
+            raise refuse(
+                "args",
+                f"`args` sets `{option}`{shortened}, which `earl launch` sets for each process itself "
+                f"({LAUNCH_SETS[option]})",
+                arg,
+            )
+    return ProcessGroup(tuple(names), listen, environment, host, tuple(args))
