@@ -915,11 +915,34 @@ def test_run_toml_is_read_next_to_the_spec_a_symbolic_link_points_to(
     assert "unknown setting `colour`" in capsys.readouterr().err
 
 
-@pytest.mark.parametrize("seed", ["-1", "x", "1.5", "٣", "1_000", "²"])
+@pytest.mark.parametrize("seed", ["-1", "x", "1.5", "٣", "1_000", "²", "-+5", "+-5", "5 "])
 def test_a_seed_that_is_not_a_whole_number_from_zero_is_a_usage_error(seed: str) -> None:
     result = earl_cli("run", str(SPECS / "counter"), f"--seed={seed}", "--duration", "10ms")
     assert result.returncode == 2
     assert "argument --seed" in result.stderr and "Traceback" not in result.stderr
+
+
+def test_a_seed_written_with_a_plus_sign_is_taken_as_param_and_run_toml_take_it() -> None:
+    plus = earl_cli("run", str(SPECS / "counter"), "--seed=+5", "--duration", "10ms")
+    plain = earl_cli("run", str(SPECS / "counter"), "--seed=5", "--duration", "10ms")
+    assert plus.returncode == 0, plus.stderr
+
+    def table(result: subprocess.CompletedProcess[str]) -> list[str]:  # the wall time differs run to run
+        return [line for line in result.stdout.splitlines() if "wall time" not in line]
+
+    assert table(plus) == table(plain)
+
+
+def test_an_empty_trace_file_is_said_to_be_empty_with_why_a_run_leaves_one(tmp_path: Path) -> None:
+    """The run's process makes the trace file and its writer fills it from the first batch: a run killed
+    with SIGKILL before that (in its first 0.2 s, or while it waited for its peers) leaves 0 bytes, which
+    was said as "it ends early"."""
+    empty = tmp_path / "t.mcap"
+    empty.write_bytes(b"")
+    for command in (["trace", "summary", str(empty)], ["plot", str(empty), "--signal", "a/a.cs.x", "-o", "p.png"]):
+        result = earl_cli(*command)
+        assert result.returncode == 1, result.stderr
+        assert "is empty: nothing was recorded in it" in result.stderr and "Traceback" not in result.stderr
 
 
 def test_a_stop_signal_ends_the_run_between_two_instants(tmp_path: Path) -> None:

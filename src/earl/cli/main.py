@@ -122,14 +122,15 @@ def caused_by_an_interrupt(error: BaseException) -> bool:
     """Whether a KeyboardInterrupt is what `error` wraps. CPython 3.11 turns one raised while a class is
     made (in a descriptor's `__set_name__`, as Lark's classes have while `lark` is imported) into a
     RuntimeError "Error calling __set_name__", with the KeyboardInterrupt as its cause: a Ctrl-C or a
-    stopped `earl run` at that moment of the start is an interrupt all the same, not a traceback."""
+    stopped `earl run` at that moment of the start is an interrupt all the same, not a traceback.
+    Only causes count: an error raised while an interrupt was being handled (its context) is an error."""
     seen: set[int] = set()
     cause: BaseException | None = error
     while cause is not None and id(cause) not in seen:
         if isinstance(cause, KeyboardInterrupt):
             return True
         seen.add(id(cause))
-        cause = cause.__cause__ or cause.__context__
+        cause = cause.__cause__
     return False
 
 

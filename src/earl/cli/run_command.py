@@ -6,6 +6,7 @@ import argparse
 import contextlib
 import gc
 import os
+import re
 import signal
 import statistics
 import sys
@@ -543,7 +544,7 @@ def _close(transport: Any) -> None:
 def _seed(text: str) -> int:
     """`--seed`: what NumPy's seed sequences take, refused at the command line rather than in a function."""
     # ASCII digits, as run.toml's seed and --param take: `int` would also read `٣` and `1_000`
-    if not (text.isascii() and text.removeprefix("-").isdigit()):
+    if re.fullmatch(r"[+-]?[0-9]+", text) is None:  # `+5` too, as --param N=+6 and run.toml's seed take it
         raise argparse.ArgumentTypeError(f"`{text}` is not a whole number")
     value = int(text)
     if value < 0:

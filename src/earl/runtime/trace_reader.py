@@ -138,7 +138,21 @@ def _nothing_readable(path: Path, error: BaseException) -> TraceError:
             f"{path} is not a readable MCAP trace: it was cut short (or damaged) before its first whole "
             "record (a run killed in its first 0.2 s, or a copy cut short)"
         )
+    if start == b"" and _is_empty(path):
+        # the run's process makes the file and its writer fills it from the first batch: a run killed
+        # (SIGKILL) before that batch went out, or while it waited for its peers, leaves it empty
+        return TraceError(
+            f"{path} is empty: nothing was recorded in it (a run killed before its first 0.2 s, or while it "
+            "waited for its peers, leaves its trace so)"
+        )
     return _unreadable(path, error)
+
+
+def _is_empty(path: Path) -> bool:
+    try:
+        return path.stat().st_size == 0
+    except OSError:
+        return False
 
 
 def _unreadable(path: Path, error: BaseException) -> TraceError:
