@@ -37,6 +37,7 @@ from earl import (
 )
 from earl.check import check
 from earl.diagnostics import EarlError
+from earl.model.location import Comments
 
 TEXT = """\
 system demo
@@ -911,3 +912,41 @@ def test_the_index_of_any_built_in_python_is_said_when_it_would_not_read_back(in
     path = f"system.agents[1].subsystems[0].primitive_predicates[{at}].expression.operands[1].index"
     with pytest.raises(ModelNameError, match=re.escape(f"{path}: '{index}' (the index of `any`/`all`)")):
         system.to_earl()
+
+
+@pytest.mark.parametrize(
+    ("where", "comments", "path"),
+    [
+        ("agent", Comments(closing=["/* x */"]), r"system\.agents\[0\]\.comments\.closing\[0\]: '/\* x \*/'"),
+        ("agent", Comments(leading=["just words"]), r"system\.agents\[0\]\.comments\.leading\[0\]: 'just words'"),
+        ("memory", Comments(trailing="// one\n// two"), r"\.subsystems\[0\]\.memories\[0\]\.comments\.trailing: "),
+        ("memory", Comments(after="# hash"), r"\.memories\[0\]\.comments\.after: '# hash'"),
+    ],
+)
+def test_a_comment_the_language_cannot_hold_is_refused_where_it_is(where: str, comments: Comments, path: str) -> None:
+    """`Comments(closing=["/* x */"])` was written as is, and the text did not read back: EARL has `//`
+    comments only, one line each."""
+    from earl.model.validate import ModelCommentError
+
+    system = earl.load(Path(__file__).parent / "runtime_specs" / "counter")
+    element: Any = system.agents[0] if where == "agent" else system.agents[0].subsystems[0].memories[0]
+    element.comments = comments
+    [said] = [d for d in check(system) if d.code == "EARL-R007"]
+    assert re.search(path, said.message) and "is no EARL comment" in said.message
+    with pytest.raises(ModelCommentError, match=path + r".* is no EARL comment"):
+        system.to_earl()
+
+
+def test_spaces_around_a_comment_set_in_python_are_dropped_so_it_reads_back() -> None:
+    """`Comments(closing=[" // b "])` was written one space deeper than its block's body, and read back
+    as `// b`; blank comments ("", spaces) stay blank lines."""
+    system = earl.load(Path(__file__).parent / "runtime_specs" / "counter")
+    agent = system.agents[0]
+    agent.comments = Comments(leading=["  // a "], trailing=" // t ", closing=[" // b ", "  ", "// b2"], after="\t// c")
+    text = system.to_earl()
+    assert "\n    // b\n\n    // b2\n}  // c\n" in text
+    read = earl.loads(text)
+    assert read == system
+    said = read.agents[0].comments
+    assert (said.leading, said.trailing, said.closing, said.after) == (["// a"], "// t", ["// b", "", "// b2"], "// c")
+    assert read.to_earl() == text

@@ -67,9 +67,9 @@ class _Printer:
             for comment in comments.leading:
                 self.comment(depth, comment)
             if comments.trailing:
-                text = f"{text}  {comments.trailing.rstrip()}"
+                text = f"{text}  {comments.trailing.strip()}"
             if closed and comments.after:
-                text = f"{text}  {comments.after.rstrip()}"
+                text = f"{text}  {comments.after.strip()}"
         self.lines.append(f"{INDENT * depth}{text}")
         if code.endswith("{"):
             self.opened = len(self.lines)
@@ -77,7 +77,9 @@ class _Printer:
     def comment(self, depth: int, comment: str) -> None:
         """A whole-line comment; "" is the blank line that kept it apart from what follows (one, however
         many are asked for in a row)."""
-        comment = comment.rstrip()  # trailing space, and the `\r` a CRLF file leaves in a comment
+        # trailing space, the `\r` a CRLF file leaves in a comment, and leading space a model built in Python
+        # gave it (which would indent it past its line's depth and read back without it)
+        comment = comment.strip()
         if comment:
             self.lines.append(f"{INDENT * depth}{comment}")
         else:
@@ -93,7 +95,7 @@ class _Printer:
             closing.pop()
         for comment in closing:
             self.comment(depth + 1, comment)
-        self.line(depth, "}" + (f"  {comments.after.rstrip()}" if comments.after else ""))
+        self.line(depth, "}" + (f"  {comments.after.strip()}" if comments.after else ""))
 
     def text(self) -> str:
         while self.lines and self.lines[-1] == "":

@@ -243,6 +243,7 @@ class Resolver:
                     did_you_mean(name, known) or f"system parameters: {', '.join(known) or 'none'}",
                 )
         self._names()
+        self._comments()
         self._types(scope)
         for agent in self.system.agents:
             self._declare_agent(agent, scope)
@@ -260,6 +261,19 @@ class Resolver:
         would write text that does not load."""
         for name, what, location, _ in unreadable_names(self.system):
             self._unreadable(name, what, location)
+
+    def _comments(self) -> None:
+        """EARL-R007: a comment `.earl` text cannot hold (`/* x */`, two lines); only a model built in Python
+        can hold one, and `to_earl()` would write text that does not load."""
+        from earl.model.comment_text import unwritable_comments
+
+        for path, comment in unwritable_comments(self.system):
+            self.error(
+                f"{path}: {comment!r} is no EARL comment: the text would not read back",
+                None,
+                "EARL-R007",
+                'a comment is one line starting with `//` ("" for a blank line); write one string per line',
+            )
 
     def _unreadable(self, name: object, what: str, location: SourceLocation | None) -> None:
         """EARL-R006 of one name."""

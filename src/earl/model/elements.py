@@ -605,6 +605,16 @@ class System:
                 else "no EARL name (a letter or `_`, then letters, digits and `_`)"
             )
             raise ModelNameError(f"{path}: {name!r} ({what}) is {why}: the text would not read back; rename it")
+        from earl.model.comment_text import unwritable_comments
+        from earl.model.validate import ModelCommentError
+
+        unwritable = next(unwritable_comments(self), None)  # `Comments(closing=["/* x */"])`
+        if unwritable is not None:
+            path, comment = unwritable
+            raise ModelCommentError(
+                f'{path}: {comment!r} is no EARL comment (one line starting with `//`, or "" for a blank line):'
+                " the text would not read back; write it as `// …`, one line each"
+            )
         try:
             with explaining(self):
                 return format_system(self)

@@ -215,6 +215,11 @@ class ModelNameError(ValueError):
     `period`): `to_earl()` refuses to write it; the message says where it is."""
 
 
+class ModelCommentError(ValueError):
+    """A comment of a model built in Python that `.earl` text cannot hold (`/* x */`, two lines): `to_earl()`
+    refuses to write it; the message says where it is."""
+
+
 def explained(system: object, error: Exception, path: str = "system") -> Exception:
     """What to raise for `error`, met while reading `system`: a ModelTypeError naming the first value of
     a wrong type, when there is one (the likely cause), else `error` itself."""
