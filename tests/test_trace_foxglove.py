@@ -465,13 +465,24 @@ def test_an_infinite_real_inside_a_part_the_schema_leaves_out_is_a_value(tmp_pat
 def test_a_subsystem_named_alone_lists_its_memory_families_with_their_star(tmp_path: Path) -> None:
     """A family is one array, which its schema cannot tell from an array: the memory channel's metadata
     names the families (`{"level":0,"rows":1}`), and `earl plot --signal f/a.cs` lists `level[*]`, as it
-    did of traces whose members were fields `level[0]`, and `rows[*]`, a family of arrays in no schema."""
+    did of traces whose members were fields `level[0]`, and `rows[*]`, a family of arrays in no schema.
+    `grid/m: double[2][2]`, an array of arrays the schema leaves out, was not listed: the metadata names
+    it (`unschemed`), and `grid[0][1]` plots."""
     (tmp_path / "system.earl").write_text(INFINITIES)
     trace = tmp_path / "i.mcap"
     assert run_earl("run", tmp_path, "--duration", "0.05s", "--trace", trace, "--record-memory", "all").returncode == 0
+    with open(trace, "rb") as stream:
+        summary = make_reader(stream).get_summary()
+    assert summary is not None
+    [memory] = [channel for channel in summary.channels.values() if channel.topic == "/f/a.cs/memory"]
+    schema = json.loads(summary.schemas[memory.schema_id].data)
+    assert "grid" not in schema["properties"] and json.loads(memory.metadata["unschemed"]) == ["grid"]
     plot = run_earl("plot", trace, "--signal", "f/a.cs", "-o", tmp_path / "i.png")
     assert plot.returncode == 1
-    assert "(the trace has `level[*]`, `rows[*]`)" in plot.stderr, plot.stderr
+    assert "(the trace has `grid`, `level[*]`, `rows[*]`)" in plot.stderr, plot.stderr
+    plot = run_earl("plot", trace, "--signal", "f/a.cs.grid[0][1]", "-o", tmp_path / "grid.png")
+    assert plot.returncode == 0, plot.stderr
+    assert (tmp_path / "grid.png").stat().st_size > 0
 
 
 def write_trace_of_format(path: Path, start: dict[str, Any], memory_schema: dict[str, Any], memory: Any) -> None:

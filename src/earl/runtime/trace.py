@@ -137,6 +137,9 @@ class MemoryLayout:
             families[name][index] = key
         self.plan: list[tuple[str, str | list[str | None]]] = []
         self.properties: dict[str, Any] = {}
+        #: the memories (not families) in the messages but not in the schema (`grid/m: double[2][2]`), for
+        #: the channel's metadata: earl plot lists a subsystem's values from the schema and the metadata
+        self.unschemed: list[str] = []
         for name, family in order:
             schema = schemas[name]
             if family:
@@ -156,6 +159,8 @@ class MemoryLayout:
                 self.plan.append((name, name))
             if schema is not None:
                 self.properties[name] = schema
+            elif not family:
+                self.unschemed.append(name)
         self.has_families = any(isinstance(source, list) for _, source in self.plan)
         #: each family with its first index, for the channel's metadata (`{"windingCurrent": 1}`)
         self.families = {name: min(members) for name, members in families.items()}
@@ -512,6 +517,9 @@ class TraceWriter(Recorder):
             if layout.families:
                 # a family is an array as an array is: the schema cannot say which fields are families
                 metadata["families"] = json.dumps(layout.families, separators=(",", ":"))
+            if layout.unschemed:
+                # an array of arrays, or a struct inside itself: no schema Foxglove takes says it is there
+                metadata["unschemed"] = json.dumps(layout.unschemed, separators=(",", ":"))
             channel = self._channel(trace_topics.memory(subsystem), f"earl.Memory.{subsystem}", schema, metadata)
             found = self._memories[subsystem] = (channel, layout)
         channel, layout = found

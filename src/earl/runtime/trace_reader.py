@@ -381,6 +381,18 @@ def _families(metadata: dict[str, str]) -> dict[str, int] | None:
     return found
 
 
+def _unschemed(metadata: dict[str, str]) -> list[str]:
+    """The memories a memory channel's metadata names as in its messages but not in its schema (an array
+    of arrays: `grid/m: double[2][2]`); none when it names none (a trace written before it did)."""
+    try:
+        found = json.loads(metadata["unschemed"])
+    except (KeyError, ValueError):
+        return []
+    if not isinstance(found, list):
+        return []
+    return [name for name in found if isinstance(name, str)]
+
+
 def _leaf_schema(schema: Any, leaf: str) -> tuple[Any, bool]:
     """The part of a channel's schema for `leaf` of its messages (None when the schema does not show
     it), and whether that leaf is an optional field (one its object's `required` list leaves out)."""
@@ -509,7 +521,7 @@ def read_signals(path: Path, names: list[str]) -> Signals:
         if memory_topic is None:
             return _elements_in(subsystem, None, links)
         metadata, schema = channels[memory_topic]
-        return _elements_in(subsystem, schema, links, _families(metadata) or {})
+        return _elements_in(subsystem, schema, links, _families(metadata) or {}, _unschemed(metadata))
 
     for name in names:
         malformed = signal_syntax_error(name)
@@ -711,17 +723,23 @@ def read_signals(path: Path, names: list[str]) -> Signals:
 
 
 def _elements_in(
-    subsystem: str, memory_schema: Any, links: list[tuple[str, dict[str, str]]], families: dict[str, int] | None = None
+    subsystem: str,
+    memory_schema: Any,
+    links: list[tuple[str, dict[str, str]]],
+    families: dict[str, int] | None = None,
+    unschemed: list[str] | None = None,
 ) -> list[str]:
     """What a signal of `subsystem` can go on to in this trace: its recorded memory (`memory_schema`,
     the schema of its memory topic, None when it has none, and the `families` its metadata names) and
     the output buffers whose links are recorded (`links`: every link topic of the trace with its
     metadata), a family written `name[*]`: in format 1 a member was a field, `windingCurrent[1]`; in
-    format 2 a family is one array, which only the metadata tells from an array."""
+    format 2 a family is one array, which only the metadata tells from an array; and the memories the
+    metadata names as `unschemed` (an array of arrays, which Foxglove refuses in a schema)."""
     names: list[str] = [f"{name}[*]" for name in families or {}]
     properties = memory_schema.get("properties") if isinstance(memory_schema, dict) else None
     if isinstance(properties, dict):
         names += [str(key) for key in properties if key not in (families or {})]
+    names += unschemed or []
     for _, metadata in links:
         source = metadata.get("source", "")
         if source.startswith(subsystem + "."):
