@@ -246,7 +246,7 @@ def load(path: str | Path, parameters: Mapping[str, ParameterValue] | None = Non
         root, imported = load_files(spec, sources)
         system = merge(root, imported, sources)
         system.source_file = root.path
-        diagnostics = resolve(system, parameters or {})
+        diagnostics = resolve(system, parameters or {}, comments_from_text=True)
     errors = [d for d in diagnostics if d.severity is Severity.ERROR]
     if errors:
         raise EarlError(errors, sources)
@@ -386,7 +386,7 @@ def _loads(text: str, path: str, parameters: Mapping[str, ParameterValue] | None
         imported = []
     system = merge(root, imported, sources)
     system.source_file = path
-    errors = [d for d in resolve(system, parameters or {}) if d.severity is Severity.ERROR]
+    errors = [d for d in resolve(system, parameters or {}, comments_from_text=True) if d.severity is Severity.ERROR]
     if errors:
         raise EarlError(errors, sources)
     system.sources = sources

@@ -192,6 +192,9 @@ class _Within:
 
 
 class Resolver:
+    #: whether every comment came from the reader (`resolve`)
+    comments_from_text = False
+
     def __init__(self, system: System, overrides: Mapping[str, Value]) -> None:
         self.system = system
         self.overrides = dict(overrides)
@@ -243,7 +246,8 @@ class Resolver:
                     did_you_mean(name, known) or f"system parameters: {', '.join(known) or 'none'}",
                 )
         self._names()
-        self._comments()
+        if not self.comments_from_text:
+            self._comments()
         self._types(scope)
         for agent in self.system.agents:
             self._declare_agent(agent, scope)
@@ -1496,9 +1500,16 @@ def _product_size(ranges: Sequence[range]) -> int:
     return size
 
 
-def resolve(system: System, overrides: Mapping[str, Value] | None = None) -> list[Diagnostic]:
-    """Every name-resolution problem of a declared system, in the order found."""
-    return Resolver(system, overrides or {}).run()
+def resolve(
+    system: System, overrides: Mapping[str, Value] | None = None, *, comments_from_text: bool = False
+) -> list[Diagnostic]:
+    """Every name-resolution problem of a declared system, in the order found. `comments_from_text`: every
+    comment of the system came from the reader, so none needs EARL-R007's walk over the whole model
+    (the reader's own resolve, and `check` of a system loaded from a file: a comment edited in Python
+    there is still refused by `to_earl()`)."""
+    resolver = Resolver(system, overrides or {})
+    resolver.comments_from_text = comments_from_text
+    return resolver.run()
 
 
 _ELEMENT_LISTS = {

@@ -26,32 +26,84 @@ def is_writable_comment(comment: object) -> bool:
 
 def unwritable_comments(root: object, path: str = "system") -> Iterator[tuple[str, object]]:
     """Each comment of `root`'s model tree that is not writable, with its path
-    (`system.agents[0].subsystems[1].comments.closing[0]`), in the order of the tree."""
-    stack: list[tuple[object, str]] = [(root, path)]
+    (`system.agents[0].subsystems[1].comments.closing[0]`), in the order of the tree.
+
+    `earl check` walks every model it checks, a 1,000-agent one included: the way to each value is kept as
+    a chain of steps and put in words only for a comment that is reported, and only values that can hold
+    a comment are visited."""
+    stack: list[tuple[object, _Steps]] = [(root, None)]
     seen: set[int] = set()
     while stack:
-        value, where = stack.pop()
+        value, steps = stack.pop()
         if isinstance(value, Comments):
-            yield from _in_comments(value, where)
+            for where, comment in _in_comments(value):
+                yield _spelled(path, steps) + where, comment
         elif isinstance(value, list | tuple):
-            stack.extend((item, f"{where}[{i}]") for i, item in reversed(list(enumerate(value))))
+            for index in range(len(value) - 1, -1, -1):
+                item = value[index]
+                if not isinstance(item, _LEAVES):
+                    stack.append((item, (steps, index)))
         elif isinstance(value, dict):
-            stack.extend((item, f"{where}[{key!r}]") for key, item in reversed(list(value.items())))
+            for key, item in reversed(list(value.items())):
+                if not isinstance(item, _LEAVES):
+                    stack.append((item, (steps, _Key(key))))
         elif dataclasses.is_dataclass(value) and not isinstance(value, type) and id(value) not in seen:
             seen.add(id(value))
-            fields = [f for f in dataclasses.fields(value) if f.compare or f.name in _COMMENT_FIELDS]
-            stack.extend((getattr(value, f.name, None), f"{where}.{f.name}") for f in reversed(fields))
+            for name in reversed(_walked_fields(type(value))):
+                item = getattr(value, name, None)
+                if not isinstance(item, _LEAVES):
+                    stack.append((item, (steps, name)))
 
 
-def _in_comments(comments: Comments, where: str) -> Iterator[tuple[str, object]]:
+#: values that hold no comment, left out of the walk
+_LEAVES = (str, int, float, type(None))
+
+
+class _Key:
+    """A step into a dict, by its key."""
+
+    __slots__ = ("key",)
+
+    def __init__(self, key: object) -> None:
+        self.key = key
+
+
+#: the way from the root: (the way to the parent, a step: an attribute name, an index or a _Key)
+_Steps = tuple["_Steps", "str | int | _Key"] | None
+
+_FIELDS: dict[type, tuple[str, ...]] = {}
+
+
+def _walked_fields(cls: type) -> tuple[str, ...]:
+    names = _FIELDS.get(cls)
+    if names is None:
+        fields = dataclasses.fields(cls)  # type: ignore[arg-type]
+        names = _FIELDS[cls] = tuple(f.name for f in fields if f.compare or f.name in _COMMENT_FIELDS)
+    return names
+
+
+def _spelled(path: str, steps: _Steps) -> str:
+    words: list[str] = []
+    while steps is not None:
+        steps, step = steps
+        if isinstance(step, str):
+            words.append(f".{step}")
+        elif isinstance(step, _Key):
+            words.append(f"[{step.key!r}]")
+        else:
+            words.append(f"[{step}]")
+    return path + "".join(reversed(words))
+
+
+def _in_comments(comments: Comments) -> Iterator[tuple[str, object]]:
     for attribute in ("leading", "closing"):
         lines = getattr(comments, attribute)
         if isinstance(lines, list | tuple):
             for i, comment in enumerate(lines):
                 if not is_writable_comment(comment):
-                    yield f"{where}.{attribute}[{i}]", comment
+                    yield f".{attribute}[{i}]", comment
     for attribute in ("trailing", "after"):
         comment = getattr(comments, attribute)
         # a comment after code cannot be a blank line: "" and None both mean none
         if comment is not None and not is_writable_comment(comment):
-            yield f"{where}.{attribute}", comment
+            yield f".{attribute}", comment
