@@ -1919,30 +1919,41 @@ def test_ctrl_c_while_launch_starts_is_exit_130_without_a_traceback(tmp_path: Pa
         assert len(said) <= 1 and "Traceback" not in "".join(said), (delay, said)
 
 
+def _run_with_an_environment_that_is_stopped_while_imported(
+    tmp_path: Path, then: str
+) -> subprocess.CompletedProcess[str]:
+    """`earl run` of the counter spec whose environment module sends its own process a SIGTERM while it is
+    imported, and then does `then` with the KeyboardInterrupt, as compiled code may: the moment is the
+    test's, not a race."""
+    spec = tmp_path / "counter"
+    shutil.copytree(SPECS / "counter", spec)
+    (spec / "stopped.py").write_text(
+        "import os, signal, time\n"
+        "try:\n"
+        "    os.kill(os.getpid(), signal.SIGTERM)\n"
+        "    time.sleep(5)  # the handler raises here\n"
+        "except KeyboardInterrupt:\n"
+        f"    {then}\n"
+        "def make(system, seed):\n"
+        "    return None\n"
+    )
+    return subprocess.run(
+        [sys.executable, "-m", "earl", "run", str(spec), "--environment", "stopped:make", "--duration", "0.1s"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+
+
 def test_a_stop_that_a_compiled_module_s_import_puts_in_other_words_is_exit_130_not_its_error(
     tmp_path: Path,
 ) -> None:
     """pybind11 (MuJoCo's bindings) turns a KeyboardInterrupt raised while its module initialises into
     "ImportError: generic_type: …": a SIGTERM at that moment of `earl run`'s start (a CI run sent it at
     0.4 s, as the environment imported mujoco) was said as EARL-X003, the environment's import failing, and
-    exit 1. The environment here does what such a module does, at a moment the test chooses."""
-    spec = tmp_path / "counter"
-    shutil.copytree(SPECS / "counter", spec)
-    (spec / "rewording.py").write_text(
-        "import os, signal, time\n"
-        "try:\n"
-        "    os.kill(os.getpid(), signal.SIGTERM)\n"
-        "    time.sleep(5)  # the handler raises here\n"
-        "except KeyboardInterrupt:\n"
-        "    raise ImportError('generic_type: type is already registered') from None\n"
-        "def make(system, seed):\n"
-        "    return None\n"
-    )
-    result = subprocess.run(
-        [sys.executable, "-m", "earl", "run", str(spec), "--environment", "rewording:make", "--duration", "0.1s"],
-        capture_output=True,
-        text=True,
-        timeout=120,
+    exit 1."""
+    result = _run_with_an_environment_that_is_stopped_while_imported(
+        tmp_path, "raise ImportError('generic_type: type is already registered') from None"
     )
     said = result.stderr.splitlines()
     assert result.returncode == 130, result.stderr
@@ -1954,23 +1965,8 @@ def test_a_stop_that_compiled_code_swallows_while_a_command_starts_still_ends_it
     """A Cython module's initialisation clears a KeyboardInterrupt (dd's did: `earl check` printed ok and
     exit 0). Whatever code swallows it while the run is set up, a stop signal that came then stops the run
     before its first instant, with 130 and one line."""
-    spec = tmp_path / "counter"
-    shutil.copytree(SPECS / "counter", spec)
-    (spec / "swallowing.py").write_text(
-        "import os, signal, time\n"
-        "try:\n"
-        "    os.kill(os.getpid(), signal.SIGTERM)\n"
-        "    time.sleep(5)\n"
-        "except KeyboardInterrupt:\n"
-        "    pass  # as compiled code that clears the error\n"
-        "def make(system, seed):\n"
-        "    return None\n"
-    )
-    result = subprocess.run(
-        [sys.executable, "-m", "earl", "run", str(spec), "--environment", "swallowing:make", "--duration", "0.1s"],
-        capture_output=True,
-        text=True,
-        timeout=120,
+    result = _run_with_an_environment_that_is_stopped_while_imported(
+        tmp_path, "pass  # as compiled code that clears it"
     )
     assert result.returncode == 130, result.stderr
     assert "Traceback" not in result.stderr
