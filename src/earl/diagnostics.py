@@ -79,7 +79,12 @@ class SourceMap:
 
 def did_you_mean(name: str, candidates: Iterable[str]) -> str | None:
     """A hint naming the closest candidate, for misspelt names."""
-    matches = difflib.get_close_matches(name, sorted(set(candidates)), n=1, cutoff=0.6)
+    names = sorted(set(candidates))
+    # a slip of case only (`PLAN` for `plan`) is the closest of all, though difflib sees no letter alike
+    same_but_case = [candidate for candidate in names if candidate.casefold() == name.casefold()]
+    if same_but_case and name not in names:
+        return f"did you mean `{same_but_case[0]}`?"
+    matches = difflib.get_close_matches(name, names, n=1, cutoff=0.6)
     return f"did you mean `{matches[0]}`?" if matches else None
 
 

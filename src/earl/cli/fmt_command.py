@@ -69,7 +69,7 @@ def run(arguments: argparse.Namespace) -> int:
         elif arguments.write:
             if original != canonical:
                 try:
-                    save(system, path)
+                    save(system, path, warn_of_main=False)
                 except OSError as error:  # a read-only directory, a full disk, a device: the file is as it was
                     sys.stderr.write(f"earl fmt: cannot rewrite {path}: {error.strerror or error}\n")
                     status = 1

@@ -5,8 +5,11 @@ from __future__ import annotations
 import errno
 import fcntl
 import os
+import re
 import shutil
+import sys
 import tempfile
+import warnings
 from collections.abc import Mapping
 from pathlib import Path
 from typing import BinaryIO
@@ -299,13 +302,15 @@ def parse_source(text: str, path: str) -> System:
     return merge(parse_text(text, path, sources), [], sources, library=True)
 
 
-def save(system: System, path: str | Path) -> None:
+def save(system: System, path: str | Path, *, warn_of_main: bool = True) -> None:
     """Write the system as canonical `.earl` text, replacing the file atomically.
 
     The text goes to a temporary file beside the target, which is then renamed over it: a full
     disk or a crash leaves the old file whole.  A symbolic link is followed (the link stays a
     link), the file keeps its permissions, and only a regular file is ever replaced — renaming
     over `/dev/null` would put a file in the device's place.  An OSError says what went wrong.
+    With `warn_of_main`, a text naming functions of `__main__` is written with a warning (`earl fmt`,
+    which rewrites a file as it was, does not warn).
     """
     if not isinstance(system, System):
         raise TypeError(
@@ -318,6 +323,8 @@ def save(system: System, path: str | Path) -> None:
     if target.exists() and not target.is_file():
         raise OSError(errno.EINVAL, "not a regular file (a device, a pipe or a directory); only files are rewritten")
     text = system.to_earl()
+    if warn_of_main:
+        _warn_of_main(text, target)
     if target.exists():
         if not os.access(target, os.W_OK) or not target.stat().st_mode & 0o222:
             # renaming over it would succeed, since that needs only the directory (and root may write
@@ -341,6 +348,36 @@ def save(system: System, path: str | Path) -> None:
     except BaseException:
         temporary.unlink(missing_ok=True)
         raise
+
+
+#: `python "__main__:NAME"` as `to_earl()` writes it
+_MAIN_FUNCTION = re.compile(r'python\s+"__main__:([^"]*)"')
+
+
+def _warn_of_main(text: str, target: Path) -> None:
+    """A saved spec naming functions of `__main__` (as a model built and run in one script does) cannot be run
+    from its file: `__main__` is then another program. Saved all the same (it may be edited), with a warning."""
+    names = list(dict.fromkeys(_MAIN_FUNCTION.findall(text)))
+    if names:
+        shown = ", ".join(f"`{name}`" for name in names[:4]) + (", …" if len(names) > 4 else "")
+        warnings.warn(
+            f"{target} names functions of `__main__` ({shown}), which exist only while the script that built the "
+            f"model runs: `earl run {target.name}` or earl.load(…) from another script cannot find them. Move "
+            'them into a module beside the file and name it, `python "module:function"`',
+            UserWarning,
+            stacklevel=_caller_level(),
+        )
+
+
+def _caller_level() -> int:
+    """The `stacklevel` of a warning that points at the first frame outside earl (`earl.save(…)`'s line)."""
+    package = str(Path(__file__).resolve().parents[1])
+    frame = sys._getframe(1)
+    level = 1
+    while frame is not None and frame.f_code.co_filename.startswith(package):
+        frame = frame.f_back  # type: ignore[assignment]
+        level += 1
+    return level
 
 
 def _umask() -> int:

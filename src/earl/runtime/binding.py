@@ -146,19 +146,7 @@ def resolve_callable(
     module = _import(module_name, what, location)
     function = getattr(module, function_name, _ABSENT)
     if function is _ABSENT:
-        available = sorted(n for n, v in vars(module).items() if callable(v) and not n.startswith("_"))
-        from earl.diagnostics import did_you_mean
-
-        suggestion = did_you_mean(function_name, available)
-        raise BindingProblem(
-            Diagnostic(
-                Severity.ERROR,
-                f"{what} names `{function_name}`, but the module `{module_name}` has no such function",
-                location,
-                code="EARL-X004",
-                hint=suggestion or f"define `{signature.replace('NAME', function_name)}` in `{module.__file__}`",
-            )
-        )
+        raise BindingProblem(_no_such_function(module, module_name, function_name, what, location, signature))
     kind = None if classes and inspect.isclass(function) else _not_a_plain_function(function)
     if kind is not None:
         written = f"write it as `{signature.replace('NAME', function_name)}`"
@@ -178,6 +166,63 @@ def resolve_callable(
 
 
 _ABSENT = object()
+
+
+def _no_such_function(
+    module: Any, module_name: str, function_name: str, what: str, location: SourceLocation | None, signature: str
+) -> Diagnostic:
+    """EARL-X004 for a module without the function: a near name, else where to define it."""
+    from earl.diagnostics import did_you_mean
+
+    available = sorted(n for n, v in vars(module).items() if callable(v) and not n.startswith("_"))
+    message = f"{what} names `{function_name}`, but the module `{module_name}` has no such function"
+    defined = f"`{signature.replace('NAME', function_name)}`"
+    if module_name == "__main__":
+        if _program.PROGRAM:
+            # a model saved from the script that built it (`earl.save`): that script's functions went with it
+            return Diagnostic(
+                Severity.ERROR,
+                f"{what} names `__main__:{function_name}`, but `__main__` is the program that is running, here "
+                "the `earl` command: a function defined in the script that built the model exists only while "
+                "that script runs",
+                location,
+                code="EARL-X004",
+                hint=f"move `{function_name}` into a module beside the spec (e.g. `functions.py`) and name it "
+                f'`python "functions:{function_name}"`',
+            )
+        if not isinstance(getattr(module, "__file__", None), str):
+            # `python -c`, the REPL, a notebook's kernel: `__main__` is the session itself, which has no file
+            return Diagnostic(
+                Severity.ERROR,
+                message,
+                location,
+                code="EARL-X004",
+                hint=did_you_mean(function_name, available)
+                or f"`__main__` is this interactive session (a notebook, the REPL, `python -c`): define {defined} "
+                "in it (run the cell that defines it) before the run, or name a function of a module",
+            )
+    hint = did_you_mean(function_name, available) or _define_in(module, defined)
+    if module_name == "__main__":
+        hint += (
+            " (`__main__` is the script being run: the functions of another script, one that built and saved the "
+            "model, are not there; move them into a module and name that)"
+        )
+    return Diagnostic(Severity.ERROR, message, location, code="EARL-X004", hint=hint)
+
+
+def _define_in(module: Any, defined: str) -> str:
+    """Where to define a missing function: the module's file, or for a package without `__init__.py` (a
+    namespace package, which has no file to hold one) a module in it."""
+    file = getattr(module, "__file__", None)
+    if isinstance(file, str):
+        return f"define {defined} in `{file}`"
+    name = getattr(module, "__name__", "module")
+    places = _locations(module)
+    where = f" ({places[0]})" if places else ""
+    return (
+        f"`{name}` is a directory without `__init__.py`{where}, which can define no function: define {defined} "
+        f'in a module in it and name that, `python "{name}.MODULE:FUNCTION"`, or create `__init__.py` there'
+    )
 
 
 #: what each module that could not be imported in this binding says, by module name: a module is imported
