@@ -139,3 +139,131 @@ def test_earl_fmt_rewrites_a_spec_naming_main_without_a_warning(tmp_path: Path) 
     )
     assert done.returncode == 0, done.stderr
     assert "Warning" not in done.stderr and "    period 10 ms" in target.read_text(encoding="utf-8")
+
+
+# ---------------------------------------------------------------- values read from a run
+
+RECORDS = """\
+system records
+struct Reading {
+    values: double[2]
+    items: int
+    keys: int
+    get: int
+    copy: int
+    update: boolean
+    replace: int
+    count: int
+}
+a/a {
+    cs {
+        period 10 ms
+        reading/m: Reading
+        total/m: double = 0.0
+        never/pp = false
+        produce/pf( -> reading/mo) = python "recordcode_for_test:produce"
+        consume/pf(reading/mi -> total/mo) = python "recordcode_for_test:consume"
+        go/bb {
+            tf = {produce/pf, consume/pf}
+            tc = never/pp
+        }
+        fsm {
+            initial go
+            state go: go/bb
+        }
+    }
+}
+r/r {
+    a/a
+}
+"""
+
+RECORD_CODE = """\
+def produce(inputs, outputs, context):
+    outputs.reading = {"values": [1.0, 2.0], "items": 3, "keys": 4, "get": 5, "copy": 6, "update": True,
+                       "replace": 7, "count": 8}
+
+
+def consume(inputs, outputs, context):
+    r = inputs.reading
+    outputs.total = sum(r.values) + r.items + r.keys + r.get + r.copy + r.replace + r.count + r.update
+"""
+
+
+def test_struct_fields_named_like_dict_methods_are_read_as_the_fields_and_traced(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`msg.values` was dict's method, so `sum(msg.values)` was a fault; the trace (JSON in this process
+    for a BytesIO, msgpack to the writer's process for a file) packs a field named `items` too."""
+    import io
+
+    from earl.runtime import Record
+    from earl.runtime.trace_reader import _messages
+
+    (tmp_path / "recordcode_for_test.py").write_text(RECORD_CODE)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    memory_trace = io.BytesIO()
+    for trace in (tmp_path / "run.mcap", memory_trace):
+        with earl.simulate(earl.loads(RECORDS), trace=trace, record_memory=["all"]) as simulation:
+            simulation.advance_to(0.05)
+            assert simulation.faults == []
+            state = simulation.state_of("a/a.cs")
+        reading = state.memory["reading"]
+        assert state.memory["total"] == 1.0 + 2.0 + 3 + 4 + 5 + 6 + 7 + 8 + 1
+        assert (reading.values, reading.items, reading.update, reading.replace) == ((1.0, 2.0), 3, True, 7)
+        assert dict.items(reading) == {**reading}.items() and "items=3" in repr(reading)
+        assert Record.replace(reading, items=9).items == 9
+    memory_trace.seek(0)
+    path = tmp_path / "from_memory.mcap"
+    path.write_bytes(memory_trace.getvalue())
+    for written in (tmp_path / "run.mcap", path):
+        memories = [value for topic, _, _, value in _messages(written) if topic == "/a/a.cs/memory"]
+        assert memories and memories[-1]["reading"]["items"] == 3
+
+
+def test_a_struct_with_a_field_named_items_crosses_a_link_between_processes() -> None:
+    from earl.model.types import TypeReference
+    from earl.runtime.values import TypeSystem
+    from earl.transport.codec import LinkCodec
+
+    system = earl.loads(RECORDS)
+    types = TypeSystem(system)
+    codec = LinkCodec(types, TypeReference("Reading"), "reading")
+    sent = types.coerce(
+        {"values": [1.0, 2.0], "items": 3, "keys": 4, "get": 5, "copy": 6, "update": True, "replace": 7, "count": 8},
+        TypeReference("Reading"),
+    )
+    received = codec.decode(codec.encode(sent))
+    assert received == sent and received.items == 3
+
+
+def test_values_read_from_a_run_copy_deepcopy_and_pickle_to_equal_values(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import copy
+    import pickle
+
+    (tmp_path / "recordcode_for_test.py").write_text(RECORD_CODE)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    with earl.simulate(earl.loads(RECORDS)) as simulation:
+        simulation.advance_to(0.03)
+        state = simulation.state_of("a/a.cs")
+    reading = state.memory["reading"]
+    assert copy.copy(reading) == reading and copy.deepcopy(reading) == reading
+    assert copy.deepcopy(state) == state and copy.deepcopy(state.memory) == state.memory
+    assert type(copy.deepcopy(reading)) is type(reading)
+    again = pickle.loads(pickle.dumps(state))
+    assert again == state and again.memory["reading"].values == (1.0, 2.0)
+    assert type(again.memory["reading"]).__name__ == "Reading"
+    # unpickled in another process, where no run made the struct's class
+    code = "import pickle, sys; r = pickle.loads(sys.stdin.buffer.read()); print(r.items, r.values, r)"
+    done = subprocess.run(
+        [sys.executable, "-c", code],
+        input=pickle.dumps(reading),
+        env=environment(),
+        capture_output=True,
+        timeout=120,
+        check=False,
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.decode().startswith("3 (1.0, 2.0) Reading(values=(1.0, 2.0), items=3")

@@ -234,7 +234,7 @@ def _json_data(value: Any) -> Any:
     """`value` as plain JSON data: an object without its None fields (absent optional fields), bytes as
     a list of numbers; None in an array stays null (the elements before a memory family's first member)."""
     if isinstance(value, dict):
-        return {key: _json_data(inner) for key, inner in value.items() if inner is not None}
+        return {key: _json_data(inner) for key, inner in dict.items(value) if inner is not None}
     if isinstance(value, (list, tuple)):
         return [_json_data(inner) for inner in value]
     if isinstance(value, (bytes, bytearray)):
@@ -833,7 +833,7 @@ def _packable(value: Any) -> Any:
     if isinstance(value, int):
         return value if -(1 << 63) <= value < (1 << 64) else str(value)
     if isinstance(value, dict):
-        return {_packable(key): _packable(item) for key, item in value.items()}
+        return {_packable(key): _packable(item) for key, item in dict.items(value)}
     if isinstance(value, (list, tuple)):
         return [_packable(item) for item in value]
     if isinstance(value, bytes):

@@ -157,9 +157,30 @@ class Record(dict[str, Any]):
 
     It is a dict underneath so that JSON encoding and equality stay cheap; every
     mutating method is refused, which is what lets one snapshot serve a whole stage.
+    A field named like a method of dict (`values`, `items`, `get`) is read as the field: the
+    method is then reached as `dict.items(msg)` (earl's own code always reaches it so).
+
+    `copy.copy` and `copy.deepcopy` give an equal value, and it pickles: unpickled, it is a
+    Record of a struct of the same name and fields (its class is made again if need be).
     """
 
     __slots__ = ()
+
+    def __copy__(self) -> Record:
+        return self  # immutable: a copy would be the same value
+
+    def __deepcopy__(self, memo: dict[int, Any]) -> Record:
+        import copy
+
+        return type(self)(copy.deepcopy(dict(dict.items(self)), memo))
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        # the classes of structs are made at run time, so pickle could not find one by its name: the
+        # value is made again from its struct's name and fields
+        cls = type(self)
+        if cls is Record:
+            return (Record, (dict(dict.items(self)),))
+        return (_remade_record, (cls.__name__, tuple(dict.keys(self)), dict(dict.items(self))))
 
     def __getattr__(self, name: str) -> Any:
         try:
@@ -181,10 +202,48 @@ class Record(dict[str, Any]):
             raise AttributeError(f"this struct has no field {', '.join(f'`{u}`' for u in sorted(unknown))}")
         merged = dict(self)
         merged.update(changes)
-        return Record(merged)  # unchecked: the runtime checks it when it is written
+        # unchecked, so not of the struct's class, which the runtime takes as checked; of a class under
+        # it, which reads the fields as it does (`.items` is the field): checked when it is written
+        return _unchecked_class(type(self))(merged)
 
     def __repr__(self) -> str:
-        return f"{type(self).__name__}(" + ", ".join(f"{k}={v!r}" for k, v in self.items()) + ")"
+        return f"{type(self).__name__}(" + ", ".join(f"{k}={v!r}" for k, v in dict.items(self)) + ")"
+
+
+def record_class_of(struct: str, fields: Iterable[str]) -> type[Record]:
+    """A Record subclass for a struct: each field a class attribute reading its item (`msg.motorPos` is
+    `msg["motorPos"]`), so that a field read never reaches `Record.__getattr__` (getting there costs
+    Python an AttributeError it builds and drops, ten times the read itself), and so that a field named
+    like a method of dict (`items`, `values`) is read as the field, not as the method."""
+    namespace: dict[str, Any] = {"__slots__": ()}
+    for name in fields:
+        if not (name.startswith("_") and hasattr(Record, name)):  # `__class__`, `_refuse` stay what they are
+            namespace[name] = property(itemgetter(name), doc=f"the field `{name}` of `{struct}`")
+    return type(struct, (Record,), namespace)
+
+
+def _unchecked_class(cls: type[Record]) -> type[Record]:
+    """The class of values `replace` makes from values of `cls`: a subclass, made once."""
+    if cls is Record or cls.__dict__.get("_earl_unchecked", False):
+        return cls
+    found: type[Record] | None = cls.__dict__.get("_earl_unchecked_class")
+    if found is None:
+        found = type(cls.__name__, (cls,), {"__slots__": (), "_earl_unchecked": True})
+        type.__setattr__(cls, "_earl_unchecked_class", found)
+    return found
+
+
+#: the classes `_remade_record` made, by struct name and fields: values unpickled together share one
+_REMADE: dict[tuple[str, tuple[str, ...]], type[Record]] = {}
+
+
+def _remade_record(struct: str, fields: tuple[str, ...], items: dict[str, Any]) -> Record:
+    """A Record unpickled (see `Record.__reduce__`)."""
+    key = (struct, fields)
+    cls = _REMADE.get(key)
+    if cls is None:
+        cls = _REMADE[key] = record_class_of(struct, fields)
+    return cls(items)
 
 
 class ValueTypeError(TypeError):
@@ -305,20 +364,11 @@ class TypeSystem:
         return None
 
     def record_class(self, struct: str, fields: Iterable[str] = ()) -> type[Record]:
-        """The Record subclass of one struct: a value of that class was checked already and passes at once.
-
-        Each field is a class attribute reading its item (`msg.motorPos` is `msg["motorPos"]`),
-        so a field read never reaches `Record.__getattr__`: getting there costs Python an
-        AttributeError it builds and drops, ten times the read itself. A field named like a
-        method of dict (`items`, `keys`) is left to `msg["items"]`, as before.
-        """
+        """The Record subclass of one struct (`record_class_of`): a value of that class was checked already
+        and passes at once."""
         found = self._record_classes.get(struct)
         if found is None:
-            namespace: dict[str, Any] = {"__slots__": ()}
-            for name in fields:
-                if not hasattr(Record, name):
-                    namespace[name] = property(itemgetter(name), doc=f"the field `{name}` of `{struct}`")
-            found = self._record_classes[struct] = type(struct, (Record,), namespace)
+            found = self._record_classes[struct] = record_class_of(struct, fields)
         return found
 
     def _struct_coercer(self, struct: StructType, data_type: DataType, where: str) -> Callable[[Any], Value]:
@@ -507,8 +557,8 @@ def to_json(value: Value) -> Any:
     """A value as JSON data (bytes as a list of numbers), for traces."""
     if isinstance(value, tuple):
         return [to_json(v) for v in value]
-    if isinstance(value, dict):
-        return {k: to_json(v) for k, v in value.items()}
+    if isinstance(value, dict):  # dict's own method: a struct's field may be named `items`
+        return {k: to_json(v) for k, v in dict.items(value)}
     if isinstance(value, bytes):
         return list(value)
     if isinstance(value, float) and not math.isfinite(value):
@@ -575,7 +625,7 @@ def iter_leaves(value: Value, prefix: str = "") -> Iterator[tuple[str, Any]]:
     an infinite real (which JSON cannot write). A string is yielded too, so that a plot of it can
     say it is no number rather than that it was never recorded."""
     if isinstance(value, dict):
-        for key, inner in value.items():
+        for key, inner in dict.items(value):
             yield from iter_leaves(inner, f"{prefix}.{key}" if prefix else key)
     elif isinstance(value, (list, tuple)):
         for index, inner in enumerate(value):

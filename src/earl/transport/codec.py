@@ -99,7 +99,8 @@ def _is_real_array(types: TypeSystem, resolved: PrimitiveType | ArrayType | Stru
 
 def _preparer(types: TypeSystem, data_type: DataType) -> Callable[[Any], Any] | None:
     """What turns a checked value of this type into what msgpack writes: its arrays of reals made
-    packed exts; None when the type holds no array of reals (the value is written as it is)."""
+    packed exts, and structs with a field named `items` plain dicts; None when the type holds neither (the
+    value is written as it is)."""
     resolved = types.resolve(data_type)
     if _is_real_array(types, resolved):
         return pack_reals
@@ -111,6 +112,9 @@ def _preparer(types: TypeSystem, data_type: DataType) -> Callable[[Any], Any] | 
     if isinstance(resolved, StructType):
         fields = [(f.name, p) for f in resolved.fields if (p := _preparer(types, f.data_type)) is not None]
         if not fields:
+            if any(f.name == "items" for f in resolved.fields):
+                # its Record reads `items` as the field, where msgpack calls a dict's `items()`: a plain dict
+                return dict
             return None
 
         def prepare_struct(value: Any) -> dict[str, Any]:
