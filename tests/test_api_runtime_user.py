@@ -267,3 +267,26 @@ def test_values_read_from_a_run_copy_deepcopy_and_pickle_to_equal_values(
     )
     assert done.returncode == 0, done.stderr
     assert done.stdout.decode().startswith("3 (1.0, 2.0) Reading(values=(1.0, 2.0), items=3")
+
+
+# ---------------------------------------------------------------- what errors say
+
+
+def test_an_uncaught_earl_error_and_a_diagnostic_say_their_code_and_hint() -> None:
+    """An overflow policy `'drop'` never said which policies are valid: the hint was left out of str()."""
+    system = earl.loads(spec("nowhere:f"))
+    system.agents[0].subsystems[0].input_buffers.append(
+        earl.InputBuffer("inp", earl.PrimitiveType("int"), queue=earl.Queue(earl.Literal(3), "drop"))
+    )
+    hint = "  = hint: a FIFO's overflow policy is one of dropOldest, dropNewest, fault"
+    [diagnostic] = [d for d in earl.check.check(system) if d.severity is earl.Severity.ERROR]
+    assert str(diagnostic).splitlines() == [
+        "error[EARL-R018]: `inp/ib` has the overflow policy 'drop' (in `c/a.cs`)",
+        hint,
+    ]
+    with pytest.raises(EarlError) as raised:
+        earl.simulate(system)
+    assert str(raised.value).splitlines() == [str(diagnostic).splitlines()[0], hint]
+    with pytest.raises(EarlError) as raised:
+        earl.loads("system s\nx/a {\n}\nx/a {\n}\n", "two.earl")
+    assert str(raised.value).startswith("two.earl:4:1: error[EARL-R002]: ")

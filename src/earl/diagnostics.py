@@ -33,8 +33,15 @@ class Diagnostic:
     hint: str | None = None
 
     def __str__(self) -> str:
+        """`file:3:5: error[EARL-R018]: message`, and the hint on a line of its own, as `earl check` says them:
+        an uncaught `EarlError` (which says its first diagnostic so) must say how to fix what it names."""
+        return self.headline() + (f"\n  = hint: {self.hint}" if self.hint else "")
+
+    def headline(self) -> str:
+        """The diagnostic without its hint: `file:3:5: error[EARL-R018]: message`."""
         where = f"{self.location}: " if self.location else ""
-        return f"{where}{self.severity.value}: {self.message}"
+        code = f"[{self.code}]" if self.code else ""
+        return f"{where}{self.severity.value}{code}: {self.message}"
 
 
 class EarlError(Exception):
@@ -44,10 +51,12 @@ class EarlError(Exception):
         self.diagnostics = list(diagnostics)
         self.sources = sources or SourceMap()
         first = self.diagnostics[0] if self.diagnostics else None
-        said = str(first) if first else "invalid specification"
+        said = first.headline() if first else "invalid specification"
         if len(self.diagnostics) > 1:
             # an uncaught error prints only this: the rest are in `.diagnostics`
             said += f" (and {len(self.diagnostics) - 1} more in .diagnostics)"
+        if first is not None and first.hint:
+            said += f"\n  = hint: {first.hint}"
         super().__init__(said)
 
 
