@@ -8,6 +8,7 @@ import subprocess
 import sys
 import warnings
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -290,3 +291,119 @@ def test_an_uncaught_earl_error_and_a_diagnostic_say_their_code_and_hint() -> No
     with pytest.raises(EarlError) as raised:
         earl.loads("system s\nx/a {\n}\nx/a {\n}\n", "two.earl")
     assert str(raised.value).startswith("two.earl:4:1: error[EARL-R002]: ")
+
+
+# ---------------------------------------------------------------- check=False
+
+
+UNCHECKED = """\
+system c
+c/a {
+    cs {
+        period 10 ms
+        count/m: int = 0
+        done/pp = count/mi >= 3
+        never/pp = false
+        increment/pf(count/mi -> count/mo) = python "unchecked_code_for_test:increment"
+        counting/bb {
+            tf = {increment/pf}
+            tc = done/pp
+        }
+        resting/bb {
+            tf = {}
+            tc = never/pp
+        }
+        fsm {
+            initial counting
+            state counting: counting/bb
+            state finished: resting/bb
+            counting -> finished when done/pp
+        }
+    }
+}
+r/r {
+    c/a
+}
+"""
+
+
+def _cs(system: earl.System) -> earl.ControlSubsystem:
+    subsystem = system.agents[0].subsystems[0]
+    assert isinstance(subsystem, earl.ControlSubsystem)
+    return subsystem
+
+
+def _fsm(system: earl.System) -> earl.FSM:
+    fsm = _cs(system).fsm
+    assert fsm is not None
+    return fsm
+
+
+@pytest.mark.parametrize(
+    ("edit", "message"),
+    [
+        (lambda s: setattr(_fsm(s), "initial", "nowhere"), "its FSM starts in the state `nowhere`"),
+        (
+            lambda s: setattr(_fsm(s).states[1], "behaviour", "nosuch"),
+            "state `finished` runs the behaviour `nosuch/bb`",
+        ),
+        (
+            lambda s: setattr(_fsm(s).transitions[0], "destination", "nosuch"),
+            "a transition of its FSM names the state `nosuch`",
+        ),
+        (
+            lambda s: setattr(
+                _cs(s).partial_transition_functions[0],
+                "reads",
+                [earl.ElementReference("nosuch", earl.Kind.MEMORY_INPUT)],
+            ),
+            "`increment/pf` reads `nosuch/mi`",
+        ),
+        (
+            lambda s: setattr(
+                _cs(s).basic_behaviours[0],
+                "terminal_condition",
+                earl.Predicate(earl.Read(earl.ElementReference("nosuch", earl.Kind.PRIMITIVE_PREDICATE))),
+            ),
+            "the `tc` of `counting/bb` reads `nosuch/pp`",
+        ),
+        (
+            lambda s: (
+                _cs(s)
+                .basic_behaviours[1]
+                .transition_function.stages.append(
+                    [earl.ElementReference("missing", earl.Kind.PARTIAL_TRANSITION_FUNCTION)]
+                )
+            ),
+            "`resting/bb` calls `missing/pf`",
+        ),
+    ],
+)
+def test_a_run_without_the_checker_refuses_an_undeclared_name_before_it_starts(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, edit: Any, message: str
+) -> None:
+    """It was a KeyError from inside the run (engine.py, generated code), a fault at every iteration, or
+    for an initial state that is no state, a run doing nothing without a word."""
+    (tmp_path / "unchecked_code_for_test.py").write_text(
+        "def increment(inputs, outputs, context):\n    outputs.count = inputs.count + 1\n"
+    )
+    monkeypatch.syspath_prepend(str(tmp_path))
+    system = earl.loads(UNCHECKED)
+    with earl.simulate(system, check=False) as simulation:  # as loaded, it runs
+        simulation.advance_to(0.1)
+        assert simulation.state_of("c/a.cs").state == "finished"
+    edit(system)
+    with pytest.raises(EarlError) as raised:
+        earl.simulate(system, check=False)
+    [diagnostic] = raised.value.diagnostics
+    assert diagnostic.code == "EARL-X015"
+    assert diagnostic.message == f"c/a.cs cannot run: {message}, which it does not declare"
+
+
+def test_a_value_of_the_wrong_type_run_without_the_checker_is_named_at_its_path() -> None:
+    from earl.model.validate import ModelTypeError
+
+    system = earl.loads(UNCHECKED)
+    _cs(system).memories[0].data_type = "int"  # type: ignore[assignment]
+    with pytest.raises(ModelTypeError, match=r"^system\.agents\[0\]\.subsystems\[0\]\.memories\[0\]\.data_type: "):
+        earl.simulate(system, check=False)

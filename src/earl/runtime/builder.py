@@ -48,6 +48,7 @@ from earl.runtime.predicates import (
     kept_for_the_decision,
     repeatedly_evaluated,
 )
+from earl.runtime.structure import undeclared
 from earl.runtime.values import TypeSystem, ValueTypeError
 from earl.runtime.views import Context, build_inputs, build_outputs
 
@@ -130,6 +131,10 @@ def build_network(
                             code="EARL-X014",
                         )
                     )
+                    continue
+                names = undeclared(subsystem, subsystem_name(agent, subsystem))
+                if names:  # a model built or edited in Python, run with check=False
+                    problems.extend(names)
                     continue
                 try:
                     engine = _engine(

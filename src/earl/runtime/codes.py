@@ -20,6 +20,8 @@ RUNNING_CODES: dict[str, str] = {
     "EARL-X012": "a subsystem has no `period` and a state that waits for nothing",
     "EARL-X013": "a link ends at an input buffer its subsystem does not have",
     "EARL-X014": "a period or timeout below 1 ns, above 10⁹ s, or in an unknown unit (a model built in Python)",
+    "EARL-X015": "a subsystem names a state, behaviour, function, predicate, buffer or memory it does not declare, "
+    "or starts in no state of its FSM (a model built or edited in Python, run with `check=False`)",
     "EARL-X020": "the environment factory failed (e.g. MuJoCo could not read the model), or the environment's `advance` or `bind` is no method, or its `advance`, `bind` or `close` cannot be called as earl calls it",
     "EARL-X021": "the environment refuses the system (its `bind`): e.g. the MuJoCo model's timestep does not divide a real effector's period, or lacks the actuator a real effector is mapped to",
 }

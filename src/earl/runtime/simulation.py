@@ -28,6 +28,7 @@ from earl.model.elements import Duration, System
 from earl.model.expand import expand
 from earl.model.location import SourceLocation
 from earl.model.types import refuse_wrong_parameters
+from earl.model.validate import explaining
 from earl.runtime.binding import BindingProblem, resolve_callable, user_code_path
 from earl.runtime.builder import NANOSECONDS, Network, RemoteLinks, build_network, to_nanoseconds
 from earl.runtime.engine import exception_text
@@ -141,15 +142,18 @@ class Simulation:
             self._faults = _FaultList()
             own: list[Recorder] = [self.statistics, self._faults, *(recorders or [])]
             self.recorder = Recorders(own)
-            self.network: Network = build_network(
-                self.expanded,
-                recorder=self.recorder,
-                environment=self.environment,
-                seed=seed,
-                code_directories=directories,
-                agents=set(agents) if agents else None,
-                remote=transport,
-            )
+            # a value of the wrong type built in Python (`data_type="int"`), which only the checker looks for
+            # beforehand, fails somewhere inside when run with check=False: said at its path instead
+            with explaining(system):
+                self.network: Network = build_network(
+                    self.expanded,
+                    recorder=self.recorder,
+                    environment=self.environment,
+                    seed=seed,
+                    code_directories=directories,
+                    agents=set(agents) if agents else None,
+                    remote=transport,
+                )
             self.transport = transport
             memory = set(record_memory or [])
             if "all" in memory:
