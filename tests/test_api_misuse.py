@@ -183,6 +183,11 @@ def test_every_kind_of_declared_name_is_checked() -> None:
         ({"realtime": "yes"}, TypeError, "realtime takes True or False, not str 'yes'"),
         ({"trace": "missing/run.mcap"}, FileNotFoundError, "the directory `missing` does not exist"),
         ({"record_outputs": ["zz/a.cs.out"]}, ValueError, "record_outputs: `zz/a.cs.out` is no output buffer"),
+        (  # it was iterated by character: "`a` is no output buffer"
+            {"record_outputs": "a/a.cs.out"},
+            TypeError,
+            "record_outputs takes a list of names, e.g. ['a/a.cs.out'], not a single string",
+        ),
     ],
 )
 def test_simulation_options_of_the_wrong_kind_are_refused_before_the_run(

@@ -101,6 +101,7 @@ class Simulation:
         transport: Transport | None = None,
     ) -> None:
         _refuse_wrong_arguments(system, trace, record_memory=record_memory, record_links=record_links, agents=agents)
+        _refuse_wrong_arguments(system, trace, record_outputs=record_outputs)
         refuse_wrong_parameters(parameters)
         parameters = dict(parameters or {})
         if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
