@@ -407,3 +407,34 @@ def test_a_value_of_the_wrong_type_run_without_the_checker_is_named_at_its_path(
     _cs(system).memories[0].data_type = "int"  # type: ignore[assignment]
     with pytest.raises(ModelTypeError, match=r"^system\.agents\[0\]\.subsystems\[0\]\.memories\[0\]\.data_type: "):
         earl.simulate(system, check=False)
+
+
+# ---------------------------------------------------------------- earl.save
+
+
+def test_save_to_a_directory_writes_its_system_earl_as_load_reads_it(tmp_path: Path) -> None:
+    system = earl.loads(UNCHECKED)
+    earl.save(system, tmp_path)
+    assert (tmp_path / "system.earl").read_text(encoding="utf-8") == system.to_earl()
+    assert earl.load(tmp_path) == earl.load(tmp_path / "system.earl")
+
+
+def test_save_says_which_path_it_cannot_write_not_a_temporary_file(tmp_path: Path) -> None:
+    """A missing directory named the temporary file `.earl-xxxx.tmp`; `""` said `[Errno 22]` without a path."""
+    system = earl.loads(UNCHECKED)
+    missing = tmp_path / "nope" / "system.earl"
+    with pytest.raises(FileNotFoundError) as raised:
+        earl.save(system, missing)
+    assert raised.value.filename == str(missing) and ".tmp" not in str(raised.value)
+    assert f"the directory `{missing.parent}` does not exist" in str(raised.value)
+    with pytest.raises(ValueError, match="save takes a file name, not an empty string"):
+        earl.save(system, "")
+    with pytest.raises(OSError) as device:
+        earl.save(system, "/dev/null")
+    assert device.value.filename == "/dev/null" and "not a regular file" in str(device.value)
+    (tmp_path / "locked").mkdir(mode=0o500)
+    if os.geteuid() != 0:  # root writes anywhere
+        with pytest.raises(PermissionError) as refused:
+            earl.save(system, tmp_path / "locked" / "x.earl")
+        assert refused.value.filename == str(tmp_path / "locked" / "x.earl")
+        assert f"cannot write in the directory `{tmp_path / 'locked'}`" in str(refused.value)

@@ -42,7 +42,8 @@ def load(path: str | Path, parameters: Mapping[str, ParameterValue] | None = Non
 
 
 def save(system: System, path: str | Path) -> None:
-    """Write `system` to `path` as canonical `.earl` text (the file is replaced atomically)."""
+    """Write `system` to `path` as canonical `.earl` text (the file is replaced atomically); a directory
+    stands for the `system.earl` in it, as for `load`."""
     from earl.lang.loader import save as save_file
 
     save_file(system, path)

@@ -308,7 +308,8 @@ def save(system: System, path: str | Path, *, warn_of_main: bool = True) -> None
     The text goes to a temporary file beside the target, which is then renamed over it: a full
     disk or a crash leaves the old file whole.  A symbolic link is followed (the link stays a
     link), the file keeps its permissions, and only a regular file is ever replaced — renaming
-    over `/dev/null` would put a file in the device's place.  An OSError says what went wrong.
+    over `/dev/null` would put a file in the device's place.  An OSError says what went wrong, and its
+    `filename` is the file asked for.  A directory stands for the `system.earl` in it, as for `load`.
     With `warn_of_main`, a text naming functions of `__main__` is written with a warning (`earl fmt`,
     which rewrites a file as it was, does not warn).
     """
@@ -317,11 +318,21 @@ def save(system: System, path: str | Path, *, warn_of_main: bool = True) -> None
             f"save writes a System, as earl.load(path) returns it, not {type(system).__name__} {system!r:.60}"
         )
     _refuse_path(path, "save")
+    if os.fspath(path) in ("", b""):
+        raise ValueError("save takes a file name, not an empty string")
     target = Path(path)
+    if target.is_dir():
+        target = target / "system.earl"  # as `load(directory)` reads it
     if target.is_symlink():
         target = _resolved(target)
     if target.exists() and not target.is_file():
-        raise OSError(errno.EINVAL, "not a regular file (a device, a pipe or a directory); only files are rewritten")
+        raise OSError(
+            errno.EINVAL, "not a regular file (a device, a pipe or a directory); only files are rewritten", str(target)
+        )
+    if not target.parent.is_dir():
+        raise FileNotFoundError(
+            errno.ENOENT, f"cannot save there: the directory `{target.parent}` does not exist", str(target)
+        )
     text = system.to_earl()
     if warn_of_main:
         _warn_of_main(text, target)
@@ -329,13 +340,18 @@ def save(system: System, path: str | Path, *, warn_of_main: bool = True) -> None
         if not os.access(target, os.W_OK) or not target.stat().st_mode & 0o222:
             # renaming over it would succeed, since that needs only the directory (and root may write
             # anything): its mode says no
-            raise OSError(errno.EACCES, "the file is read-only; make it writable first (chmod u+w)")
+            raise OSError(errno.EACCES, "the file is read-only; make it writable first (chmod u+w)", str(target))
         if target.stat().st_nlink > 1:
             # a rename would leave its other names with the old text: written in place instead
             target.write_text(text, encoding="utf-8")
             return
     # a name of our own beside it (never a user's file), short enough whatever the target's name
-    descriptor, name = tempfile.mkstemp(prefix=".earl-", suffix=".tmp", dir=target.parent)
+    try:
+        descriptor, name = tempfile.mkstemp(prefix=".earl-", suffix=".tmp", dir=target.parent)
+    except OSError as error:  # said of the file asked for, not of the temporary name beside it
+        raise type(error)(
+            error.errno, f"cannot write in the directory `{target.parent}`: {error.strerror}", str(target)
+        ) from None
     temporary = Path(name)
     try:
         with os.fdopen(descriptor, "w", encoding="utf-8") as stream:
