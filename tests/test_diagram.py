@@ -172,6 +172,14 @@ def test_png_is_a_png(system: System) -> None:
     assert build_diagram(system, "fsm", "manip/a.cs").render("png").startswith(b"\x89PNG\r\n\x1a\n")
 
 
+def test_render_takes_the_formats_of_earl_diagram_and_names_them_for_another(system: System) -> None:
+    """`render("dot")` said "unknown Graphviz output format 'dot'", though `earl diagram --format dot` exists."""
+    diagram = build_diagram(system, "fsm", "manip/a.cs")
+    assert diagram.render("dot") == diagram.dot.encode("utf-8") and diagram.dot.startswith("digraph")
+    with pytest.raises(ValueError, match=r"^unknown diagram format 'svgz': the formats are svg, png, dot, mermaid$"):
+        diagram.render("svgz")
+
+
 def test_targets_name_what_can_be_drawn(system: System) -> None:
     with pytest.raises(TargetError, match=r"`manip/a\.cs`.*`grip/a\.fingerDrive/re`"):
         build_diagram(system, "fsm", "manip/a.cx")
@@ -179,8 +187,11 @@ def test_targets_name_what_can_be_drawn(system: System) -> None:
         build_diagram(system, "activity", "manip/a.cs.walk/bb")
     with pytest.raises(TargetError, match="the agents are `task/a`, `manip/a`, `grip/a`"):
         build_diagram(system, "agent", "arm/a")
-    with pytest.raises(TargetError, match="needs --target"):
+    # said in the words of build_diagram's caller, its `target`: `--target` is `earl diagram`'s option
+    with pytest.raises(TargetError, match=r"^the agent view needs a target naming one of the agents: task/a"):
         build_diagram(system, "agent")
+    with pytest.raises(TargetError, match=r"^the system view shows the whole system; give no target \(None\)$"):
+        build_diagram(system, "system", "manip/a")
     # a family answers to its name, with or without the index variable; `.tf.execute()` may follow a behaviour
     assert build_diagram(system, "fsm", "manip/a.motorController[K]/ve").header.endswith("motorController[K]/ve.fsm")
     assert build_diagram(system, "activity", "manip/a.cs.idle/bb.tf.execute()").header.startswith("act")

@@ -92,12 +92,25 @@ def build_diagram(
     """The diagram `view` of `target`; raises TargetError when the target names nothing. The system and
     fsm views also have Mermaid text: `diagram.render("mermaid")` or `diagram.mermaid()`."""
     subject = Subject(system, expand, parameters)
-    diagram = diagram_of(subject, view, target)
+    try:
+        diagram = diagram_of(subject, view, target)
+    except TargetError as error:
+        raise TargetError(_in_python_words(str(error))) from None
     if view in MERMAID_VIEWS:
         from earl.render.mermaid import mermaid_of  # it imports this module
 
         diagram = replace(diagram, mermaid_text=lambda: mermaid_of(subject, view, target))
     return diagram
+
+
+def _in_python_words(message: str) -> str:
+    """A TargetError as `build_diagram`'s caller names things: its `target` argument, not `earl diagram`'s
+    `--target` option."""
+    return (
+        message.replace("leave out --target", "give no target (None)")
+        .replace("needs --target naming", "needs a target naming")
+        .replace("--target", "the target")
+    )
 
 
 def diagram_of(subject: Subject, view: str, target: str | None) -> Diagram:

@@ -8,6 +8,9 @@ from functools import cached_property
 
 from earl.render.graphviz import fit_frame, run_dot
 
+#: what `Diagram.render` makes, as `earl diagram --format` names them
+RENDERED_FORMATS = ("svg", "png", "dot", "mermaid")
+
 
 @dataclass(frozen=True)
 class Diagram:
@@ -28,9 +31,14 @@ class Diagram:
         return fit_frame(self.dot)
 
     def render(self, output_format: str = "svg") -> bytes:
-        """The diagram as `svg` or `png` (drawn by Graphviz's `dot`), or as `mermaid` text (UTF-8)."""
+        """The diagram as `svg` or `png` (drawn by Graphviz's `dot`), or as `dot` or `mermaid` text (UTF-8):
+        the formats of `earl diagram --format`."""
         if output_format == "mermaid":
             return self.mermaid().encode("utf-8")
+        if output_format == "dot":
+            return self.dot.encode("utf-8")  # as `earl diagram --format dot` writes it
+        if output_format not in RENDERED_FORMATS:
+            raise ValueError(f"unknown diagram format {output_format!r}: the formats are {', '.join(RENDERED_FORMATS)}")
         return run_dot(self.laid_out, output_format)
 
     def mermaid(self) -> str:
