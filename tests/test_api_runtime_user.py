@@ -6,6 +6,7 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+import textwrap
 import warnings
 from pathlib import Path
 from typing import Any
@@ -438,3 +439,34 @@ def test_save_says_which_path_it_cannot_write_not_a_temporary_file(tmp_path: Pat
             earl.save(system, tmp_path / "locked" / "x.earl")
         assert refused.value.filename == str(tmp_path / "locked" / "x.earl")
         assert f"cannot write in the directory `{tmp_path / 'locked'}`" in str(refused.value)
+
+
+def test_a_traced_run_closes_the_pipes_to_its_writer(tmp_path: Path) -> None:
+    """Under `python -X dev`, every traced run left the writer's standard error open: a ResourceWarning."""
+    code = textwrap.dedent(
+        f"""
+        import gc, earl
+        for _ in range(3):
+            with earl.simulate(earl.loads({UNCHECKED.replace("unchecked_code_for_test:", "code:")!r}),
+                               trace={str(tmp_path / "run.mcap")!r}) as simulation:
+                simulation.advance_to(0.05)
+            gc.collect()
+        del simulation
+        gc.collect()
+        print("done")
+        """
+    )
+    (tmp_path / "code.py").write_text(
+        "def increment(inputs, outputs, context):\n    outputs.count = inputs.count + 1\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-X", "dev", "-c", code],
+        cwd=tmp_path,
+        env={**environment(), "PYTHONPATH": os.pathsep.join([str(ROOT / "src"), str(tmp_path)])},
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
+    assert done.returncode == 0 and done.stdout == "done\n", done.stderr
+    assert "ResourceWarning" not in done.stderr, done.stderr

@@ -759,8 +759,18 @@ class BackgroundSink:
         with contextlib.suppress(OSError):  # a writer that failed has closed its end: said below
             stdin.close()
         said = self._read_until_exit()
-        if self._process.wait() != 0:
+        status = self._process.wait()
+        self._close_stderr()
+        if status != 0:
             self._fail(said)
+
+    def _close_stderr(self) -> None:
+        """The writer's standard error, read to its end: closed, not left to the collector (which says
+        ResourceWarning under `python -X dev`)."""
+        stderr = self._process.stderr
+        if stderr is not None:
+            with contextlib.suppress(OSError):
+                stderr.close()
 
     def _read_until_exit(self) -> bytes:
         """What the writer says on standard error until it exits (its end of the pipe closes then).
@@ -778,6 +788,7 @@ class BackgroundSink:
             if remaining <= 0 or not select.select([descriptor], [], [], remaining)[0]:
                 self._process.kill()
                 self._process.wait()
+                self._close_stderr()
                 raise TraceWriteError(
                     f"cannot write the trace {self.path}: its writer did not finish within {self.FINISH_TIMEOUT:g} s"
                 )
@@ -796,6 +807,7 @@ class BackgroundSink:
         if said is None:
             said = self._read_until_exit()
         process.wait()
+        self._close_stderr()
         text = said.decode("utf-8", "replace").strip()
         why = text.splitlines()[-1] if text else ""  # the last line: the error itself, never a traceback
         raise TraceWriteError(
