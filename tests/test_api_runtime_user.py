@@ -470,3 +470,30 @@ def test_a_traced_run_closes_the_pipes_to_its_writer(tmp_path: Path) -> None:
     )
     assert done.returncode == 0 and done.stdout == "done\n", done.stderr
     assert "ResourceWarning" not in done.stderr, done.stderr
+
+
+def test_a_should_stop_that_raises_leaves_a_run_that_goes_on(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """`should_stop` is asked between instants; its exception marked the run "stopped inside an instant",
+    refusing every later advance."""
+    (tmp_path / "unchecked_code_for_test.py").write_text(
+        "def increment(inputs, outputs, context):\n    outputs.count = inputs.count + 1\n"
+    )
+    monkeypatch.syspath_prepend(str(tmp_path))
+    asked: list[float] = []
+
+    def should_stop() -> bool:
+        asked.append(simulation.time)
+        if len(asked) == 2:
+            raise ZeroDivisionError("division by zero")
+        return False
+
+    with earl.simulate(earl.loads(UNCHECKED), check=False) as simulation:
+        with pytest.raises(ZeroDivisionError) as raised:
+            simulation.advance_to(0.1, should_stop=should_stop)
+        assert raised.value.__traceback__ is not None and "_StopQuestionFailed" not in repr(raised.value)
+        stopped_at = simulation.time
+        assert stopped_at < 0.1
+        simulation.advance_to(0.1)
+        assert simulation.time == pytest.approx(0.1)
+        assert simulation.state_of("c/a.cs").state == "finished"
+        assert simulation.state_of("c/a.cs").memory == {"count": 3}

@@ -363,6 +363,15 @@ class Scheduler:
             self._push(time + state.timeout, engine, _TIMEOUT, token)
         return None
 
+    def _asked(self, should_stop: Callable[[], bool], engine: SubsystemEngine, following: int) -> bool:
+        """`should_stop()`, asked between two iterations of `engine` run alone, off the queue: if it raises,
+        the next iteration is put back on the queue first, so that the run is whole and can go on."""
+        try:
+            return should_stop()
+        except BaseException:
+            self._push(following, engine, _START)
+            raise
+
     def _run_alone(
         self, engine: SubsystemEngine, following: int, until: int, should_stop: Callable[[], bool] | None = None
     ) -> int | None:
@@ -379,13 +388,13 @@ class Scheduler:
         if period is None or period <= 0 or (self.record_memory and engine.name in self.record_memory):
             next_start: int | None = following
             while next_start is not None and next_start <= until and not (queue and queue[0][0] <= next_start):
-                if should_stop is not None and should_stop():
+                if should_stop is not None and self._asked(should_stop, engine, next_start):
                     break
                 self.now = next_start
                 next_start = self._start(engine, next_start)
             return next_start
         while following <= until and not (queue and queue[0][0] <= following):
-            if should_stop is not None and should_stop():
+            if should_stop is not None and self._asked(should_stop, engine, following):
                 break  # the next iteration goes back to the queue, where the stop is made
             self.now = following
             # looked up each time: the engine's `iterate` changes with its state

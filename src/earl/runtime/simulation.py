@@ -247,7 +247,10 @@ class Simulation:
                 "one with earl.simulate"
             )
         try:
-            self.scheduler.advance_to(to_nanoseconds(seconds), should_stop)
+            self.scheduler.advance_to(to_nanoseconds(seconds), None if should_stop is None else _asked(should_stop))
+        except _StopQuestionFailed as failed:
+            # the scheduler asks `should_stop` only between instants: the run can go on from there
+            raise failed.error.with_traceback(failed.error.__traceback__) from None
         except BaseException as error:
             # Ctrl-C, sys.exit() or a failed environment can stop the run between the steps of an iteration
             # (a function run, its writes not yet applied); going on from there would silently skip them
@@ -419,6 +422,26 @@ def _refuse_wrong_arguments(system: object, trace: object, **lists: object) -> N
     for name, value in lists.items():
         if isinstance(value, (str, bytes)):
             raise TypeError(f"{name} takes a list of names, e.g. [{value!r:.60}], not a single string")
+
+
+class _StopQuestionFailed(Exception):
+    """`should_stop` raised `error`: between two instants, so the run is whole and may go on."""
+
+    def __init__(self, error: Exception) -> None:
+        super().__init__(error)
+        self.error = error
+
+
+def _asked(should_stop: Callable[[], bool]) -> Callable[[], bool]:
+    """`should_stop`, whose exception is told apart from one raised inside an instant."""
+
+    def ask() -> bool:
+        try:
+            return should_stop()
+        except Exception as error:  # Ctrl-C and sys.exit() stay what they are
+            raise _StopQuestionFailed(error) from error
+
+    return ask
 
 
 class RecordingWarning(UserWarning):
