@@ -24,7 +24,12 @@ from earl.model import __all__ as _model_names
 from earl.model.elements import System
 
 if TYPE_CHECKING:
+    import os
+    from typing import IO
+
+    from earl.render.document import DocumentResult
     from earl.runtime import Simulation
+    from earl.runtime.traces import Trace
 
 ParameterValue = bool | int | float | str
 
@@ -67,6 +72,29 @@ def simulate(system: System, **options: object) -> Simulation:
     return run(system, **options)
 
 
+def read_trace(source: str | os.PathLike[str] | IO[bytes]) -> Trace:
+    """A trace (`earl run --trace`, `earl.simulate(…, trace=…)`) read back: a path, or a binary file object
+    such as the `io.BytesIO` a run wrote to. `.summary()` is what `earl trace summary` shows, and
+    `.signals(["counter/a.cs.count"])` what `earl plot` draws; `earl.TraceError` says why one cannot be read."""
+    from earl.runtime.traces import read_trace as read
+
+    return read(source)
+
+
+def write_doc(
+    system: System,
+    directory: str | os.PathLike[str],
+    *,
+    expand: bool = False,
+    parameters: Mapping[str, ParameterValue] | None = None,
+) -> DocumentResult:
+    """Write what `earl doc` writes (`index.html`, `index.md`, `diagrams/`) for `system` into `directory`;
+    `expand` and `parameters` are `--expand` and `--param`. Needs Graphviz's `dot`."""
+    from earl.render.document import write_doc as write
+
+    return write(system, directory, expand=expand, parameters=parameters)
+
+
 __version__ = "0.1.0"
 
 #: the packages `earl.NAME` reaches without an import of its own (`earl.check.check(system)`), loaded
@@ -74,11 +102,19 @@ __version__ = "0.1.0"
 _SUBPACKAGES = frozenset({"check", "export", "lang", "render", "runtime", "transport"})
 
 
+#: names `earl.NAME` reaches in a module loaded on first use (not in `__all__`: `from earl import *` stays quick)
+_LAZY_NAMES = {"Trace": "earl.runtime.traces", "TraceError": "earl.runtime.trace_reader"}
+
+
 def __getattr__(name: str) -> object:
     if name in _SUBPACKAGES:
         import importlib
 
         return importlib.import_module(f"earl.{name}")
+    if name in _LAZY_NAMES:
+        import importlib
+
+        return getattr(importlib.import_module(_LAZY_NAMES[name]), name)
     raise AttributeError(f"module 'earl' has no attribute {name!r}")
 
 
@@ -92,4 +128,16 @@ def _display_in_notebooks() -> None:
 
 _display_in_notebooks()
 
-__all__ = ["Diagnostic", "EarlError", "Severity", "__version__", "load", "loads", "save", "simulate", *_model_names]
+__all__ = [
+    "Diagnostic",
+    "EarlError",
+    "Severity",
+    "__version__",
+    "load",
+    "loads",
+    "read_trace",
+    "save",
+    "simulate",
+    "write_doc",
+    *_model_names,
+]

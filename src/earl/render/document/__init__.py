@@ -5,6 +5,6 @@ figures; `html.py` and `markdown.py` print that tree; `site.py` draws the
 diagrams and writes the files.  Both outputs therefore say the same thing.
 """
 
-from earl.render.document.site import DocumentResult, write_site
+from earl.render.document.site import DocumentResult, NotOurs, write_doc, write_site
 
-__all__ = ["DocumentResult", "write_site"]
+__all__ = ["DocumentResult", "NotOurs", "write_doc", "write_site"]

@@ -2,19 +2,22 @@
 
 from __future__ import annotations
 
+import errno
 import os
 import re
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
 from earl.diagnostics import Diagnostic
+from earl.model.elements import System
 from earl.render.build import Subject
 from earl.render.diagram import Diagram
 from earl.render.document.build import DocumentBuilder
 from earl.render.document.html import render_html
 from earl.render.document.markdown import render_markdown
+from earl.render.graphviz import dot_program
 
 
 @dataclass(frozen=True)
@@ -34,10 +37,13 @@ class NotOurs(OSError):
     """A file in the document's place that `earl doc` did not write: it is left alone."""
 
 
-def write_site(subject: Subject, diagnostics: Sequence[Diagnostic], directory: Path) -> DocumentResult:
+def write_site(
+    subject: Subject, diagnostics: Sequence[Diagnostic], directory: str | os.PathLike[str]
+) -> DocumentResult:
     """Build the document and write it to `directory` (created if needed). earl's own files there are
     replaced; a user's `index.html` or `index.md` raises NotOurs before anything is written, and only
     diagrams an earlier run wrote are removed when they are no longer drawn."""
+    directory = Path(directory)
     for name, mark in _OURS.items():
         existing = directory / name
         if existing.is_file() and mark not in _head(existing):
@@ -74,6 +80,34 @@ def write_site(subject: Subject, diagnostics: Sequence[Diagnostic], directory: P
     html.write_text(render_html(document, widths), encoding="utf-8", errors="backslashreplace")
     markdown.write_text(render_markdown(document), encoding="utf-8", errors="backslashreplace")
     return DocumentResult(html, markdown, tuple(paths))
+
+
+def write_doc(
+    system: System,
+    directory: str | os.PathLike[str],
+    *,
+    expand: bool = False,
+    parameters: Mapping[str, bool | int | float | str] | None = None,
+) -> DocumentResult:
+    """What `earl doc SPEC -o DIRECTORY` writes, from Python: `index.html`, `index.md` and `diagrams/`,
+    the checker's findings shown in the document. `expand` and `parameters` are `--expand` and `--param`.
+    Graphviz's `dot` is needed (`GraphvizError` otherwise); a directory holding a user's own `index.html`
+    raises NotOurs (an OSError) before anything is written."""
+    from earl.check import check
+    from earl.model.types import refuse_wrong_parameters
+
+    if not isinstance(system, System):
+        raise TypeError(
+            f"write_doc documents a System, as earl.load(path) returns it, not {type(system).__name__} {system!r:.60}"
+        )
+    if not isinstance(directory, (str, os.PathLike)) or not os.fspath(directory):
+        raise TypeError(f"write_doc writes into a directory named by a str or a Path, not {directory!r:.60}")
+    refuse_wrong_parameters(parameters)
+    target = Path(directory)
+    if target.exists() and not target.is_dir():
+        raise NotADirectoryError(errno.ENOTDIR, "exists and is not a directory", str(target))
+    dot_program()  # before anything is written: without Graphviz there is no document
+    return write_site(Subject(system, expand, dict(parameters or {})), check(system, parameters), target)
 
 
 _SVG_WIDTH = re.compile(rb'<svg\s[^>]*?\bwidth="([\d.]+)(pt|px)?"')
