@@ -126,6 +126,19 @@ def test_a_model_naming_main_saved_warns_and_its_run_by_earl_says_where_the_func
         in (done.stderr)
     )
     assert "earl/__main__.py" not in done.stderr
+    # a name that earl's own `__main__` has (`script`, the command itself) is never bound to it
+    target.write_text(spec("__main__:script"), encoding="utf-8")
+    done = subprocess.run(
+        [sys.executable, "-m", "earl", "run", str(target), "--duration", "0.05"],
+        env=environment(),
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
+    assert "error[EARL-X004]: `increment/pf` of c/a.cs names `__main__:script`, but `__main__` is the program" in (
+        done.stderr
+    )
 
 
 def test_earl_fmt_rewrites_a_spec_naming_main_without_a_warning(tmp_path: Path) -> None:

@@ -144,7 +144,8 @@ def resolve_callable(
             )
         )
     module = _import(module_name, what, location)
-    function = getattr(module, function_name, _ABSENT)
+    # under the `earl` command, `__main__` is earl's own (whose `script` a spec never means)
+    function = _ABSENT if module_name == "__main__" and _program.PROGRAM else getattr(module, function_name, _ABSENT)
     if function is _ABSENT:
         raise BindingProblem(_no_such_function(module, module_name, function_name, what, location, signature))
     kind = None if classes and inspect.isclass(function) else _not_a_plain_function(function)
