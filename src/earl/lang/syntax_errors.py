@@ -9,6 +9,7 @@ without its unit, an element without its kind, a `{` never closed.
 from __future__ import annotations
 
 import dataclasses
+import re
 from functools import lru_cache
 from typing import Any
 
@@ -204,8 +205,9 @@ def said_twice(keyword: str, where: str, first_line: int, location: SourceLocati
 class _Context:
     """What the parser had read when it stopped, and what it would have accepted."""
 
-    def __init__(self, error: UnexpectedToken | UnexpectedEOF, keywords: dict[str, str]) -> None:
+    def __init__(self, error: UnexpectedToken | UnexpectedEOF, keywords: dict[str, str], text: str = "") -> None:
         self.keywords = keywords
+        self.text = text
         parser = getattr(error, "interactive_parser", None)
         state = getattr(parser, "parser_state", None)
         self.values: list[Any] = list(getattr(state, "value_stack", None) or [])
@@ -286,7 +288,7 @@ def _unexpected_token(
     error: UnexpectedToken | UnexpectedEOF, path: str, text: str, keywords: dict[str, str]
 ) -> Diagnostic:
     token: Token = error.token if isinstance(error, UnexpectedToken) else Token("$END", "")
-    context = _Context(error, keywords)
+    context = _Context(error, keywords, text)
     end = context.last_end()
 
     def after_previous() -> SourceLocation:
@@ -336,7 +338,8 @@ def _unexpected_token(
     diagnostic = _expected_message(token, context, location)
     line = token.line
     opens_its_line = token.type in _STRAY_BRACKETS and end is not None and line is not None and line > end[0]
-    if line is not None and opens_its_line and (diagnostic.hint is None or diagnostic.hint.startswith("is a `")):
+    unhinted = diagnostic.hint in (None, _SEE_THE_DOCS) or (diagnostic.hint or "").startswith("is a `")
+    if line is not None and opens_its_line and unhinted:
         # Nothing more specific is known of the line before (`tf` then `{…}` is told that `=` is
         # missing): the bracket that opens its line is the stray thing, pointed at itself, and
         # "is a `}` missing?" misled.
@@ -348,6 +351,9 @@ def _unexpected_token(
         )
     return diagnostic
 
+
+#: the hint of an unexpected token when nothing more is known
+_SEE_THE_DOCS = "see docs/language.md for what may be written here"
 
 #: brackets that cannot begin a declaration: one opening a line where it is unexpected is stray
 _STRAY_BRACKETS = frozenset({"LBRACE", "LSQB", "RSQB", "LPAR", "RPAR"})
@@ -529,7 +535,7 @@ def _misplaced_keyword(token: Token, context: _Context, location: SourceLocation
         if name == "system":
             hint = "`system NAME` is written once, as the first line of the root file"
         elif name in _TOP_LEVEL_ONLY and context.open_brackets():
-            hint = _unclosed_hint(context.open_brackets()) or f"`{name}` is written at the top level of a file"
+            hint = _unclosed_hint(context, context.open_brackets()) or f"`{name}` is written at the top level of a file"
         else:
             hint = None
         return Diagnostic(
@@ -589,14 +595,38 @@ def _missing_arrow(token: Token, context: _Context, location: SourceLocation, pa
     return None
 
 
-def _unclosed_hint(opened: list[Token]) -> str | None:
+def _unclosed_hint(context: _Context, opened: list[Token]) -> str | None:
+    """ "Is a `}` missing?" — only when the file holds more of the innermost open bracket than it closes.
+
+    The parser stops inside a block that is still open however the file goes on, so an open
+    bracket on its stack says nothing by itself: `x/mi = 3` in a `{ … }` that closes further down
+    is no missing `}`.
+    """
     if not opened:
         return None
     innermost = opened[-1]
+    opening = str(innermost)
+    counts = _bracket_counts(context.text)
+    if context.text and counts.get(opening, 0) <= counts.get(_CLOSING[innermost.type], 0):
+        return None
     return (
         f"is a `{_CLOSING[innermost.type]}` missing? "
         f"the `{innermost}` on line {innermost.line}, column {innermost.column} is still open"
     )
+
+
+def _bracket_counts(text: str) -> dict[str, int]:
+    """How many of each bracket the text holds, outside strings and comments."""
+    counts: dict[str, int] = {}
+    for match in _BRACKETS_STRINGS_COMMENTS.finditer(text):
+        bracket = match.group(1)
+        if bracket:
+            counts[bracket] = counts.get(bracket, 0) + 1
+    return counts
+
+
+#: a bracket (group 1), or a string or comment whose brackets do not count
+_BRACKETS_STRINGS_COMMENTS = re.compile(r'([{}()\[\]])|"(?:[^"\\\n]|\\.)*"?|//[^\n]*')
 
 
 def _end_of_file(token: Token, context: _Context, location: SourceLocation, path: str) -> Diagnostic | None:
@@ -642,7 +672,8 @@ def _bad_kind(token: Token, context: _Context, location: SourceLocation, path: s
         hint = f"memory is declared `{named}/m`, read as `{named}/mi` and written as `{named}/mo`; here, {use}"
     if str(token) in (Kind.AGENT.value, Kind.ROBOT.value) and context.open_brackets():
         title = KIND_TITLES[Kind(str(token))]
-        hint = f"an {title} is declared at the top level; " + (_unclosed_hint(context.open_brackets()) or "")
+        unclosed = _unclosed_hint(context, context.open_brackets())
+        hint = f"an {title} is declared at the top level" + (f"; {unclosed}" if unclosed else "")
     return Diagnostic(
         Severity.ERROR,
         f"`{token}` is not a kind of element that can stand here; expected {_join(kinds, 'or')}",
@@ -679,9 +710,9 @@ def _expected_message(token: Token, context: _Context, location: SourceLocation)
     previous = context.previous
     described = context.describe(expected)
     after = f" after `{previous}`" if previous is not None and str(previous).strip() else ""
-    hint: str | None = None
+    hint: str | None = _slip_hint(token, context)
 
-    if token.type == "NAME":
+    if hint is None and token.type == "NAME":
         hint = did_you_mean(str(token), [k for t in expected if (k := context.keyword(t)) and k.isidentifier()])
     if hint is None and previous is not None and previous.type in DECLARATION_FORMS:
         before_slash = context.value(3)
@@ -710,13 +741,13 @@ def _expected_message(token: Token, context: _Context, location: SourceLocation)
     if hint is None and token.type in ("NUMBER", "INT") and "NAME" in expected and "NUMBER" not in expected:
         hint = "names start with a letter or `_`"
     if hint is None and token.type == "NAME" and str(token) in _TOP_LEVEL_ONLY:
-        hint = _unclosed_hint(context.open_brackets())
+        hint = _unclosed_hint(context, context.open_brackets())
     if hint is None and any(t in _OPENING for t in expected) and token.type in _OPENING:
-        hint = _unclosed_hint(context.open_brackets())
+        hint = _unclosed_hint(context, context.open_brackets())
     if hint is None and any(t in _OPENING for t in expected) and context.open_brackets():
         innermost = context.open_brackets()[-1]
         if _OPENING.get(next(t for t in expected if t in _OPENING)) == innermost.type:
-            hint = _unclosed_hint([innermost])
+            hint = _unclosed_hint(context, [innermost])
     if hint is None and previous is not None and previous.type == "CS" and token.type == "SLASH":
         hint = "the Control Subsystem is written `cs { … }`, without a kind"
     top = context.value(1)
@@ -732,7 +763,7 @@ def _expected_message(token: Token, context: _Context, location: SourceLocation)
             f"unexpected {_found(token)}{after}",
             location,
             code="EARL-S006",
-            hint=hint or "see docs/language.md for what may be written here",
+            hint=hint or _SEE_THE_DOCS,
         )
     return Diagnostic(
         Severity.ERROR,
@@ -741,6 +772,45 @@ def _expected_message(token: Token, context: _Context, location: SourceLocation)
         code="EARL-S006",
         hint=hint,
     )
+
+
+def _slip_hint(token: Token, context: _Context) -> str | None:
+    """A hint for a slip recognised by what was read just before the token the parser stopped at."""
+    previous = context.previous
+    if token.type == "EQUAL" and "COMPARISON_OPERATOR" in context.expected:
+        # `tc = x/mi = 3`: an expression may go on with a comparison, and `=` only gives a value
+        return f"to compare, write `==`: `{_line_with(context.text, token, '==')}`"
+    before = context.value(2)
+    if (
+        token.type in ("SLASH", "LSQB")
+        and previous is not None
+        and previous.type == "NAME"
+        and isinstance(before, Token)
+        and before.type == "INITIAL"
+    ):
+        return f"`initial` names a state, not its behaviour: write `initial {previous}`"
+    read = context.value(1)
+    if token.type == "COMMA" and isinstance(read, Tree) and read.data == "element_ref":
+        state, name = context.value(4), context.value(3)
+        if isinstance(state, Token) and state.type == "STATE":
+            parts = read.children
+            behaviour = "/".join(map(str, parts)) if all(isinstance(p, Token) for p in parts) else "b/bb"
+            return (
+                "a state has one behaviour, and its buffers follow it in braces, with no comma: "
+                f"`state {name}: {behaviour} {{ obligatory a/ib  optional b/ib  timeout 20 ms }}`"
+            )
+    return None
+
+
+def _line_with(text: str, token: Token, replacement: str) -> str:
+    """The source line of `token` with the token replaced, trimmed: the line as it was meant."""
+    start, end = token.start_pos, token.end_pos
+    if start is None or end is None or not text:
+        return replacement
+    line_start = text.rfind("\n", 0, start) + 1
+    line_end = text.find("\n", end)
+    line_end = len(text) if line_end < 0 else line_end
+    return (text[line_start:start] + replacement + text[end:line_end]).strip()
 
 
 def _after_keyword_hint(context: _Context) -> str | None:

@@ -1,0 +1,116 @@
+"""Slips a newcomer makes, each told by what it is rather than by a guess at a missing bracket.
+
+The cases come from a hunt through a conveyor-sorter spec changed one line at a time: `=`
+written for `==`, `initial idle/bb`, a comma after a state's behaviour. The parser stops inside
+a block that is still open however the file goes on, so "is a `}` missing?" is only said when
+the file really holds more `{` than `}`.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import earl
+from earl.diagnostics import Diagnostic, EarlError
+
+_HEAD = "system s\n\nr/r {\n    a/a\n}\n\na/a {\n    cs {\n        period 1 ms\n"
+_TAIL = "    }\n}\n"
+_BEHAVIOUR = "        b/bb {\n            tf = {}\n            tc = true\n        }\n"
+
+
+def _spec(body: str) -> str:
+    """A spec whose `a/a.cs` holds `t/m`, `b/bb` and `body` (the body's first line is line 15)."""
+    return _HEAD + "        t/m: int = 0\n" + _BEHAVIOUR + body + _TAIL
+
+
+def _error(text: str) -> Diagnostic:
+    with pytest.raises(EarlError) as caught:
+        earl.loads(text, "spec.earl")
+    diagnostic = caught.value.diagnostics[0]
+    assert diagnostic.location is not None
+    return diagnostic
+
+
+def _where(diagnostic: Diagnostic) -> tuple[int, int]:
+    assert diagnostic.location is not None
+    return diagnostic.location.line, diagnostic.location.column
+
+
+@pytest.mark.parametrize(
+    ("body", "meant"),
+    [
+        ("        x/pp = t/mi > 1 and t/mi = 3\n", "x/pp = t/mi > 1 and t/mi == 3"),
+        (
+            "        fsm {\n            initial idle\n            state idle: b/bb\n"
+            "            idle -> idle when t/mi = 0\n        }\n",
+            "idle -> idle when t/mi == 0",
+        ),
+        (
+            "        c/bb {\n            tf = {}\n            tc = t/mi = 1\n        }\n",
+            "tc = t/mi == 1",
+        ),
+    ],
+    ids=["predicate", "transition", "terminal condition"],
+)
+def test_an_equals_sign_where_a_comparison_is_meant_is_told_to_be_doubled(body: str, meant: str) -> None:
+    diagnostic = _error(_spec(body))
+    assert diagnostic.code == "EARL-S006"
+    assert diagnostic.hint == f"to compare, write `==`: `{meant}`"
+    assert "missing" not in diagnostic.message
+
+
+def test_a_missing_closing_brace_is_still_pointed_at() -> None:
+    """A `{` the file never closes: named with its line, at the end of the file or where it stops."""
+    text = _HEAD + "        b/bb {\n            tf = {}\n            tc = true\n" + _TAIL
+    diagnostic = _error(text + "\n")
+    assert diagnostic.message == "the file ends before the `{` on line 7 is closed"
+    unclosed = _HEAD + "        b/bb {\n            tf = {}\n            tc = true\n        fsm {\n" + _TAIL
+    diagnostic = _error(unclosed)
+    assert diagnostic.hint == "is a `}` missing? the `{` on line 10, column 14 is still open"
+
+
+@pytest.mark.parametrize(
+    "body",
+    ["        x/pp = t/mi > 1 )\n", "        stage s = {b/bb} {b/bb}\n"],
+    ids=["a stray bracket", "a second set"],
+)
+def test_a_brace_hint_is_not_given_when_the_braces_are_balanced(body: str) -> None:
+    """Both said "is a `}` missing? the `{` on line 8 is still open": the `{` of `cs`, closed two lines on."""
+    diagnostic = _error(_spec(body))
+    assert diagnostic.code == "EARL-S006"
+    assert "missing" not in (diagnostic.hint or "")
+
+
+def test_initial_names_a_state_not_its_behaviour() -> None:
+    diagnostic = _error(_spec("        fsm {\n            initial idle/bb\n            state idle: b/bb\n        }\n"))
+    assert _where(diagnostic) == (16, 25)
+    assert diagnostic.hint == "`initial` names a state, not its behaviour: write `initial idle`"
+
+
+def test_a_comma_after_a_states_behaviour_shows_how_a_state_is_written() -> None:
+    body = (
+        "        fsm {\n            initial idle\n            state idle: b/bb, optional { optional x/ib }\n        }\n"
+    )
+    diagnostic = _error(_spec(body))
+    assert _where(diagnostic) == (17, 29)
+    assert diagnostic.hint == (
+        "a state has one behaviour, and its buffers follow it in braces, with no comma: "
+        "`state idle: b/bb { obligatory a/ib  optional b/ib  timeout 20 ms }`"
+    )
+
+
+def test_the_sorter_slips_from_the_command_line(tmp_path: Path) -> None:
+    """The real command on a spec of several blocks: one located sentence and the hint, exit 1."""
+    spec = tmp_path / "slip.earl"
+    spec.write_text(_spec("        x/pp = t/mi = 3\n"))
+    done = subprocess.run(
+        [sys.executable, "-m", "earl", "check", str(spec)], capture_output=True, text=True, timeout=120
+    )
+    assert done.returncode == 1
+    assert "slip.earl:15:21" in done.stderr + done.stdout
+    assert "= hint: to compare, write `==`: `x/pp = t/mi == 3`" in done.stderr + done.stdout
+    assert "missing" not in done.stderr + done.stdout
