@@ -103,6 +103,29 @@ def test_a_comma_after_a_states_behaviour_shows_how_a_state_is_written() -> None
     )
 
 
+@pytest.mark.parametrize(
+    ("group", "meant", "column"),
+    [
+        (
+            "{ obligatory x/ib, optional y/ib, timeout 20 ms }",
+            "{ obligatory x/ib  optional y/ib  timeout 20 ms }",
+            49,
+        ),
+        ("{ optional x/ib, y/ib, timeout 20 ms }", "{ optional x/ib, y/ib  timeout 20 ms }", 53),
+    ],
+    ids=["optional after a comma", "timeout after a comma"],
+)
+def test_commas_between_the_parts_of_a_buffer_group_are_shown_away(group: str, meant: str, column: int) -> None:
+    buffers = "        x/ib: double\n        y/ib: double\n"
+    body = buffers + f"        fsm {{\n            initial idle\n            state idle: b/bb {group}\n        }}\n"
+    diagnostic = _error(_spec(body))
+    assert diagnostic.code == "EARL-S007"
+    assert _where(diagnostic) == (19, column)
+    assert diagnostic.hint == (
+        f"the parts of a buffer group are separated by spaces or new lines, not commas: `{meant}`"
+    )
+
+
 def test_the_sorter_slips_from_the_command_line(tmp_path: Path) -> None:
     """The real command on a spec of several blocks: one located sentence and the hint, exit 1."""
     spec = tmp_path / "slip.earl"

@@ -534,6 +534,8 @@ def _misplaced_keyword(token: Token, context: _Context, location: SourceLocation
     if name in context.keywords.values() and name not in acceptable:
         if name == "system":
             hint = "`system NAME` is written once, as the first line of the root file"
+        elif name in _BUFFER_GROUP_PARTS and _in_buffer_group(context) and _is_token(context.value(2), "COMMA"):
+            hint = _buffer_group_commas_hint(context)
         elif name in _TOP_LEVEL_ONLY and context.open_brackets():
             hint = _unclosed_hint(context, context.open_brackets()) or f"`{name}` is written at the top level of a file"
         else:
@@ -550,6 +552,50 @@ def _misplaced_keyword(token: Token, context: _Context, location: SourceLocation
     return Diagnostic(
         Severity.ERROR, f"unknown keyword `{name}`", _token_location(path, previous), "EARL-S007", suggestion
     )
+
+
+#: The keywords that begin the parts of a state's buffer group.
+_BUFFER_GROUP_PARTS = {"obligatory", "optional", "timeout"}
+
+
+def _is_token(value: Any, terminal: str) -> bool:
+    return isinstance(value, Token) and value.type == terminal
+
+
+def _group_brace(context: _Context) -> Token | None:
+    """The innermost `{` still open."""
+    opened = context.open_brackets()
+    return opened[-1] if opened and opened[-1].type == "LBRACE" else None
+
+
+def _in_buffer_group(context: _Context) -> bool:
+    """Whether the innermost `{` still open is a state's buffer group: `state s: b/bb {`."""
+    brace = _group_brace(context)
+    if brace is None:
+        return False
+    index = next(i for i, value in enumerate(context.values) if value is brace)
+    behaviour = context.values[index - 1] if index >= 1 else None
+    return (
+        isinstance(behaviour, Tree)
+        and behaviour.data == "element_ref"
+        and _is_token(context.values[index - 2] if index >= 2 else None, "COLON")
+    )
+
+
+def _buffer_group_commas_hint(context: _Context) -> str:
+    """`{ obligatory a/ib, optional b/ib }`: the group as it is meant, its parts apart without commas."""
+    hint = "the parts of a buffer group are separated by spaces or new lines, not commas"
+    group = _group_brace(context)
+    start = group.start_pos if group is not None else None
+    end = context.text.find("}", start) if start is not None else -1
+    if start is None or end < 0 or "\n" in context.text[start:end]:
+        return f"{hint}: `{{ obligatory a/ib  optional b/ib  timeout 20 ms }}`"
+    meant = _COMMA_BEFORE_PART.sub(r"  \1", context.text[start : end + 1])
+    return f"{hint}: `{meant}`"
+
+
+#: a comma before a part of a buffer group (the commas inside a part's list of buffers stay)
+_COMMA_BEFORE_PART = re.compile(r"\s*,\s*(obligatory|optional|timeout)\b")
 
 
 def _missing_arrow(token: Token, context: _Context, location: SourceLocation, path: str) -> Diagnostic | None:
