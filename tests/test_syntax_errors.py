@@ -171,8 +171,8 @@ SYNTAX = [
         10,
         21,
         "EARL-S006",
-        "unexpected `/` after `ib`",
-        "there is no division (the slash introduces a kind): write `0.5 * x` for `x / 2`",
+        "there is no division: the `/` after `v/ib` would introduce a kind",
+        "multiply instead: write `v/ib * 0.5` for `v/ib / 2`",
     ),
     Malformed(
         "memory_read_without_its_direction",

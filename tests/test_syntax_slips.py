@@ -137,3 +137,52 @@ def test_the_sorter_slips_from_the_command_line(tmp_path: Path) -> None:
     assert "slip.earl:15:21" in done.stderr + done.stdout
     assert "= hint: to compare, write `==`: `x/pp = t/mi == 3`" in done.stderr + done.stdout
     assert "missing" not in done.stderr + done.stdout
+
+
+@pytest.mark.parametrize(
+    ("declaration", "column", "hint"),
+    [
+        ("param H: double = N/2.0", 20, "multiply instead: write `N * 0.5` for `N / 2.0`"),
+        ("param H: double = 0.3 * N / 4", 27, "multiply instead: write `N * 0.25` for `N / 4`"),
+        ("param H: double = (N + 1) / 2", 27, "multiply instead: write `(N + 1) * 0.5` for `(N + 1) / 2`"),
+        ("param H: double = N / M", 21, "multiply instead, e.g. `N * 0.5` for `N / 2`"),
+        (
+            "param H: int = N / 2",
+            18,
+            "`H` is an `int` and `N * 0.5` is a `double`, even when whole: give `H` its own value and compute "
+            "`N` from it (`param H: int = …`, then `param N: int = 2 * H`), or declare `H` a `double` and "
+            "write `N * 0.5`",
+        ),
+        (
+            "type V = double[N / 2]",
+            19,
+            "an array size is a whole number and `N * 0.5` is a `double`, even when whole: there is no whole "
+            "division, so declare the smaller number as a parameter and compute the larger from it "
+            "(`param HALF: int = 3`, then `param N: int = 2 * HALF`)",
+        ),
+    ],
+    ids=["double", "product", "parenthesised", "by a name", "int", "array size"],
+)
+def test_a_division_is_told_there_is_none_and_how_to_write_it(declaration: str, column: int, hint: str) -> None:
+    """`N / 2` was "`2` is not a kind of element" (the slash read as a kind's), `(N + 1) / 2` a division."""
+    diagnostic = _error(f"system s\nparam N: int = 6\nparam M: int = 3\n{declaration}\n")
+    assert diagnostic.code == "EARL-S006"
+    assert _where(diagnostic) == (4, column)
+    assert diagnostic.message.startswith("there is no division: the `/` after `")
+    assert diagnostic.hint == hint
+
+
+def test_the_advice_for_an_int_parameter_is_one_that_checks(tmp_path: Path) -> None:
+    """`0.5 * N` for an `int` is EARL-R005; what the hint proposes instead is accepted."""
+    spec = tmp_path / "half.earl"
+    spec.write_text("system s\nparam H: int = 3\nparam N: int = 2 * H\n")
+    assert [p.name for p in earl.load(spec).parameters] == ["H", "N"]
+    spec.write_text("system s\nparam N: int = 6\nparam H: int = N * 0.5\n")
+    with pytest.raises(EarlError) as caught:
+        earl.load(spec)
+    diagnostic = caught.value.diagnostics[0]
+    assert diagnostic.code == "EARL-R005"
+    assert diagnostic.hint == (
+        "a `double` stays a `double` even when it is whole (and there is no whole division): give `H` its own "
+        "value (`param H: int = 3`) and compute the others from it by multiplying, or declare `H` a `double`"
+    )

@@ -356,7 +356,7 @@ class Resolver:
                     # the caret is at the spec's own value, which is not the wrong one: say what to change
                     f"give `{parameter.name}` a value of type `{type_name}`, as the spec's own (marked) is"
                     if given
-                    else None,
+                    else _whole_double_hint(parameter.name, type_name, value),
                 )
                 if parameter.name not in overrides:
                     continue
@@ -1447,6 +1447,17 @@ class Resolver:
                         if family is not None
                         else did_you_mean(reference.name, links),
                     )
+
+
+def _whole_double_hint(name: str, type_name: str, value: Value) -> str | None:
+    """For `param H: int = 0.5 * N`: EARL has no whole division, so how a whole half is written."""
+    if type_name not in _INTEGER_TYPES or not isinstance(value, float) or not value.is_integer():
+        return None
+    return (
+        f"a `double` stays a `double` even when it is whole (and there is no whole division): give `{name}` "
+        f"its own value (`param {name}: {type_name} = {int(value)}`) and compute the others from it by "
+        f"multiplying, or declare `{name}` a `double`"
+    )
 
 
 def _without_indices(name: str) -> str:

@@ -19,6 +19,7 @@ from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput
 from earl.diagnostics import Diagnostic, Severity, did_you_mean
 from earl.model.kinds import KIND_TITLES, Kind
 from earl.model.location import SourceLocation
+from earl.model.types import INTEGER_RANGES
 
 #: How each terminal of the grammar is named to a person (keywords and punctuation are quoted).
 TERMINAL_TEXT: dict[str, str] = {
@@ -324,6 +325,7 @@ def _unexpected_token(
 
     for special in (
         _stray_closing,
+        _division,
         _repeated_clause,
         _misplaced_keyword,
         _missing_arrow,
@@ -702,6 +704,163 @@ def _end_of_file(token: Token, context: _Context, location: SourceLocation, path
     )
 
 
+def _division(token: Token, context: _Context, location: SourceLocation, path: str) -> Diagnostic | None:
+    """`N / 2`, `(N + 1) / 2`: EARL has no division, its slash introduces a kind.
+
+    After a value, where an operator may follow, the slash itself is refused (`(N + 1) / 2`,
+    `v/ib / 2`). After a bare name the slash is taken for a kind's (`N/ib`), and the parser stops
+    at what follows it: a number, `(` or `-` is never a kind, nor is a name with capitals or digits.
+    """
+    slash: Token | None = None
+    if token.type == "SLASH" and any(t in context.expected for t in ("STAR", "PLUS", "MINUS")):
+        slash = token
+    elif (
+        _is_token(context.previous, "SLASH")
+        and "MI" in context.expected
+        and _is_token(context.value(2), "NAME")
+        and not _in_header(context)
+        and (
+            token.type in ("NUMBER", "INT", "LPAR", "MINUS")
+            or (token.type == "NAME" and not (str(token).isalpha() and str(token).islower()))
+        )
+    ):
+        slash = context.previous
+    if slash is None or slash.start_pos is None:
+        return None
+    text = context.text
+    dividend = _operand_before(text, slash.start_pos)
+    divisor = _DIVISOR.match(text, slash.end_pos or slash.start_pos + 1)
+    product = f"{dividend} * 0.5"
+    instead = f"multiply instead, e.g. `{product}` for `{dividend} / 2`"
+    if divisor is not None and divisor.group(1) is not None and float(divisor.group(1)) != 0:
+        number = divisor.group(1)
+        product = f"{dividend} * {1 / float(number)!r}"
+        instead = f"multiply instead: write `{product}` for `{dividend} / {number}`"
+    whole = _whole_number_context(context)
+    if whole is None:
+        hint = instead
+    else:
+        what, name = whole
+        times = number if divisor is not None and divisor.group(1) is not None else "2"
+        if name is not None and times.isdigit() and dividend.isidentifier():
+            hint = (
+                f"{what} and `{product}` is a `double`, even when whole: give `{name}` its own value and "
+                f"compute `{dividend}` from it (`param {name}: int = …`, then `param {dividend}: int = {times} * {name}`)"
+                f", or declare `{name}` a `double` and write `{product}`"
+            )
+        elif name is not None:
+            hint = (
+                f"{what} and `{product}` is a `double`, even when whole: give `{name}` its own value "
+                f"(`param {name}: int = …`) and compute the others from it by multiplying, "
+                f"or declare `{name}` a `double`"
+            )
+        else:
+            hint = (
+                f"{what} and `{product}` is a `double`, even when whole: there is no whole division, so declare "
+                "the smaller number as a parameter and compute the larger from it "
+                "(`param HALF: int = 3`, then `param N: int = 2 * HALF`)"
+            )
+    return Diagnostic(
+        Severity.ERROR,
+        f"there is no division: the `/` after `{dividend}` would introduce a kind, as in `x/ib`",
+        _token_location(path, slash),
+        code="EARL-S006",
+        hint=hint,
+    )
+
+
+#: what follows a slash meant for division: a number (group 1), or anything else
+_DIVISOR = re.compile(r"[ \t]*(?:(\d+(?:\.\d+)?(?:[eE][+-]?\d+)?)\b|\S)")
+
+
+def _operand_before(text: str, end: int) -> str:
+    """The name or parenthesised group that ends just before `end`, or `x` when it is neither."""
+    before = text[:end].rstrip()
+    if before.endswith(")"):
+        depth = 0
+        for index in range(len(before) - 1, -1, -1):
+            depth += {")": 1, "(": -1}.get(before[index], 0)
+            if depth == 0:
+                group = before[index:]
+                return group if "\n" not in group else "x"
+        return "x"
+    # a name, a read (`v/ib.pose.x`, `v/mi[1]`) or a number, written without spaces
+    found = re.search(r"[A-Za-z0-9_.\[\]/]+$", before)
+    if found is None or "//" in found.group(0):
+        return "x"
+    operand = found.group(0).rsplit("..", 1)[-1]  # `1..N / 2`: the range's last bound
+    unclosed: list[int] = []
+    for index, character in enumerate(operand):
+        if character == "[":
+            unclosed.append(index)
+        elif character == "]" and unclosed:
+            unclosed.pop()
+    if unclosed:  # `double[N / 2]`: the size, not the type
+        operand = operand[unclosed[-1] + 1 :]
+    return operand or "x"
+
+
+def _in_header(context: _Context) -> bool:
+    """Whether the innermost bracket still open is the `(` of a `/pf` or `/pp` header: its list of reads."""
+    opened = context.open_brackets()
+    if not opened or opened[-1].type != "LPAR":
+        return False
+    index = next(i for i, value in enumerate(context.values) if value is opened[-1])
+    return index >= 1 and (_is_token(context.values[index - 1], "PF") or _is_token(context.values[index - 1], "PP"))
+
+
+#: the rules a data type is read as: a `[` after one opens an array's size
+_DATA_TYPE_RULES = ("named_type", "fixed_array", "variable_array")
+
+
+def _whole_number_context(context: _Context) -> tuple[str, str | None] | None:
+    """What the expression being read must be when it is a whole number, and the name it declares.
+
+    `param H: int = …` gives ("`H` is an `int`", "H"); an array size, a family's range and a FIFO
+    capacity give what they are, and no name.
+    """
+    values = context.values
+    depth = 0
+    for index in range(len(values) - 1, -1, -1):
+        value = values[index]
+        if not isinstance(value, Token):
+            continue
+        if value.type in _OPENING:
+            depth += 1
+            continue
+        if value.type in _CLOSING:
+            if depth:
+                depth -= 1
+                continue
+            typed = values[index - 1] if index >= 1 else None
+            if value.type == "LSQB" and isinstance(typed, Tree) and typed.data in _DATA_TYPE_RULES:
+                return "an array size is a whole number", None
+            if value.type != "LSQB":
+                return None
+            continue
+        if value.type == "FIFO":
+            return "a FIFO capacity is a whole number", None
+        if value.type == "IN" or str(value) == "..":
+            return "a family's range is of whole numbers", None
+        if value.type == "EQUAL":
+            typed = values[index - 1] if index >= 1 else None
+            if not (isinstance(typed, Tree) and typed.data == "named_type"):
+                return None
+            type_name = str(typed.children[0])
+            if type_name not in INTEGER_RANGES:
+                return None
+            declared = values[index - 3] if index >= 3 else None
+            name = declared if _is_token(declared, "NAME") else None
+            if name is None and isinstance(declared, Token) and declared.type == "M":
+                element = values[index - 5] if index >= 5 else None
+                if isinstance(element, Tree) and element.children:
+                    return f"`{element.children[0]}` is an `{type_name}`", None
+            if name is None:
+                return None
+            return f"`{name}` is an `{type_name}`", str(name)
+    return None
+
+
 def _bad_kind(token: Token, context: _Context, location: SourceLocation, path: str) -> Diagnostic | None:
     """`manip/x`: the word after `/` is not a kind that can stand here."""
     previous = context.previous
@@ -781,9 +940,6 @@ def _expected_message(token: Token, context: _Context, location: SourceLocation)
             )
     if hint is None:
         hint = _after_keyword_hint(context)
-    if token.type == "SLASH" and any(t in expected for t in ("STAR", "PLUS", "MINUS")):
-        # `v/ib / 2`: after a value, where an operator may follow, a slash can only mean division
-        hint = "there is no division (the slash introduces a kind): write `0.5 * x` for `x / 2`"
     if hint is None and token.type in ("NUMBER", "INT") and "NAME" in expected and "NUMBER" not in expected:
         hint = "names start with a letter or `_`"
     if hint is None and token.type == "NAME" and str(token) in _TOP_LEVEL_ONLY:
