@@ -261,3 +261,96 @@ def test_a_predicate_that_raises_inside_another_is_named_and_its_traceback_kept(
     finally:
         sim.close()
         sys.modules.pop("limits", None)
+
+
+FAMILY_SPEC = """\
+system tally
+
+param N: int = 3
+
+counter/a {
+    cs {
+        period 1 ms
+
+        x[K in 1..N]/m: int = K
+        step/m: int = 0
+
+        // every member of the family, as a function's reads take it
+        full/pp(x[*]/mi, step/mi) = python "tallies:full"
+
+        increment/pf(step/mi -> step/mo) = python "tallies:increment"
+
+        count/bb {
+            tf = {increment/pf}
+            tc = full/pp
+        }
+
+        fsm {
+            initial count
+            state count: count/bb
+
+            count -> count when full/pp
+        }
+    }
+}
+
+r/r {
+    counter/a
+}
+"""
+
+FAMILY_CODE = """\
+SEEN = []
+
+
+def full(inputs, context):
+    SEEN.append((inputs.x.indices(), list(inputs.x), inputs.x[2]))
+    return sum(inputs.x) + inputs.step >= 8
+
+
+def increment(inputs, outputs, context):
+    outputs.step = inputs.step + 1
+"""
+
+
+def test_a_python_predicate_reads_every_member_of_a_family(tmp_path: Path) -> None:
+    """`full/pp(x[*]/mi, …)` was EARL-R026 ("`[*]` … cannot be a value in an expression"); its reads are a
+    list, as a function's: checked, written back, expanded to every member and given to the code as one."""
+    from earl.model.expand import expand
+    from earl.model.expressions import Read
+    from earl.model.text import reference_text
+
+    spec = tmp_path / "system.earl"
+    spec.write_text(FAMILY_SPEC)
+    (tmp_path / "tallies.py").write_text(FAMILY_CODE)
+    system = earl.load(spec)
+    assert [d for d in check(system) if d.severity is Severity.ERROR] == []
+    assert system.to_earl() == FAMILY_SPEC
+    expanded = expand(system).agent("counter").control_subsystem.primitive_predicate("full")  # type: ignore[union-attr]
+    assert expanded is not None
+    members = ["x[1]/mi", "x[2]/mi", "x[3]/mi", "step/mi"]
+    assert [reference_text(r) for r in expanded.reads] == members
+    arguments = expanded.expression.arguments  # type: ignore[attr-defined]
+    assert [reference_text(a.target) for a in arguments if isinstance(a, Read)] == members
+    sys.modules.pop("tallies", None)
+    sim = earl.simulate(system)
+    try:
+        sim.advance_to(0.0025)
+        import tallies  # type: ignore[import-not-found]
+
+        # the family by its indices, iterated in their order, and one member by its index
+        assert tallies.SEEN[0] == ([1, 2, 3], [1, 2, 3], 2)
+        assert len(tallies.SEEN) == 3  # once per iteration: 0, 1 and 2 ms
+        assert sim.state_of("counter/a.cs").memory["step"] == 3
+        assert sim.faults == []
+    finally:
+        sim.close()
+        sys.modules.pop("tallies", None)
+
+
+def test_a_python_predicates_family_read_without_an_index_is_told_to_write_star() -> None:
+    with pytest.raises(EarlError) as refused:
+        earl.loads(FAMILY_SPEC.replace("full/pp(x[*]/mi", "full/pp(x/mi"), "tally.earl")
+    (problem,) = refused.value.diagnostics
+    assert problem.code == "EARL-R024"
+    assert problem.hint == "write `x[1]/mi`, or `x[*]/mi` for every member"

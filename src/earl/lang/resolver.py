@@ -49,7 +49,7 @@ from earl.model.expressions import (
 from earl.model.graphs import cycles
 from earl.model.kinds import KIND_TITLES, Kind
 from earl.model.location import SourceLocation
-from earl.model.text import reference_text, subsystem_name
+from earl.model.text import expression_text, reference_text, subsystem_name
 from earl.model.types import (
     MAX_ARRAY_DIMENSIONS,
     PARAMETER_TYPES,
@@ -1052,7 +1052,9 @@ class Resolver:
         allowed: Sequence[Kind],
         role: str,
         star: bool = False,
+        read: Read | None = None,
     ) -> _Declared | None:
+        """`read`: the expression's read that names `reference`, whose members `any`/`all` may test."""
         if reference.kind not in allowed:
             text = reference_text(reference)  # made for messages only: a large spec has 100,000 references
             permitted = ", ".join(f"`/{k.value}`" for k in allowed)
@@ -1086,10 +1088,33 @@ class Resolver:
             ]
             self.error(f"`{owner}` has no {title} `{reference.name}`", reference.location, "EARL-R022", hint)
             return None
-        self._indices(reference, declared.family, scope, star)
+        self._indices(reference, declared.family, scope, star, declared.element, read)
         return declared
 
-    def _indices(self, reference: ElementReference, family: IndexRange | None, scope: Scope, star: bool) -> None:
+    def _read_type(self, element: Any, read: Read) -> Any:
+        """The type a read gives, through its fields and elements; None when it cannot be told."""
+        current: Any = self.structural_type(element.data_type) if hasattr(element, "data_type") else None
+        for accessor in read.path:
+            if isinstance(accessor, FieldAccess) and isinstance(current, StructType):
+                member = current.field_named(accessor.name)
+                current = None if member is None else self.structural_type(member.data_type)
+            elif not isinstance(accessor, FieldAccess) and isinstance(current, ArrayType):
+                current = self.structural_type(current.element)
+            else:
+                return None
+        return current
+
+    def _indices(
+        self,
+        reference: ElementReference,
+        family: IndexRange | None,
+        scope: Scope,
+        star: bool,
+        element: Any = None,
+        read: Read | None = None,
+    ) -> None:
+        """The indices of `reference` fit its family; `element`: the one declared, for the hints; `read`:
+        the read in an expression that names it (None in a list of reads, a link's end, a robot)."""
         if family is None:
             if reference.indices:
                 self.error(
@@ -1099,13 +1124,21 @@ class Resolver:
                 )
             return
         if not reference.indices:
+            kind = reference.kind.value
+            around = self._index_in_scope(family, scope) if read is None else None
+            if star:
+                hint = f"write `{reference.name}[1]/{kind}`, or `{reference.name}[*]/{kind}` for every member"
+            elif around is not None:
+                hint = f"write `{reference.name}[{around}]/{kind}`"  # the index of the family around it
+            else:
+                hint = f"write `{reference.name}[1]/{kind}`" + self._every_member(
+                    reference, family, scope, element, read
+                )
             self.error(
-                f"`{reference.name}/{reference.kind.value}` is a family of {len(family.values())}; say which member",
+                f"`{reference.name}/{kind}` is a family of {len(family.values())}; say which member",
                 reference.location,
                 "EARL-R024",
-                f"write `{reference.name}[1]/{reference.kind.value}`, or `{reference.name}[*]/{reference.kind.value}` for every member"
-                if star
-                else f"write `{reference.name}[1]/{reference.kind.value}`, or `any(K in {family.first}..{family.last}: {reference.name}[K]/{reference.kind.value})`",
+                hint,
             )
             return
         if len(reference.indices) > 1:
@@ -1118,11 +1151,12 @@ class Resolver:
         index = reference.indices[0]
         if isinstance(index, Star):
             if not star:
+                every = self._every_member(reference, family, scope, element, read)
                 self.error(
                     f"`{reference_text(reference)}`: `[*]` stands for every member and cannot be a value in an expression",
                     reference.location,
                     "EARL-R026",
-                    f"use `any(K in {family.first}..{family.last}: {reference.name}[K]/{reference.kind.value})` or `all(…)`",
+                    f"name one member, `{reference.name}[1]/{reference.kind.value}`{every}",
                 )
             return
         values = self.index_values(index, scope)
@@ -1136,6 +1170,41 @@ class Resolver:
                 index.location or reference.location,
                 "EARL-R027",
             )
+
+    @staticmethod
+    def _index_in_scope(family: IndexRange, scope: Scope) -> str | None:
+        """An index in scope that runs over the family's members: `K` of the link family around `pusher/a`."""
+        for name, value in scope.items():
+            if type(value) is IndexRange and (value.first, value.last) == (family.first, family.last):
+                return name
+        return None
+
+    def _every_member(
+        self, reference: ElementReference, family: IndexRange, scope: Scope, element: Any, read: Read | None
+    ) -> str:
+        """How every member is taken, as the rest of a hint: by `any`/`all` when the read is a Boolean, by a
+        predicate computed by Python when it is not; nothing outside a condition."""
+        if read is None:
+            return ""
+        written: Family | None = getattr(element, "family", None)
+        # the family's own index letter, unless that means something else here
+        letters = [written.index] if written is not None else []
+        letters += ["K", "J", "I", "L", "M"] + [chr(c) for c in range(ord("A"), ord("Z") + 1)]
+        letter = next((c for c in letters if c not in scope), "K")
+        first, last = (
+            (expression_text(written.first), expression_text(written.last))
+            if written is not None
+            else (str(family.first), str(family.last))
+        )
+        member = replace(read, target=replace(reference, indices=(Name(letter),)))
+        read_type = None if reference.kind is Kind.PRIMITIVE_PREDICATE else self._read_type(element, read)
+        boolean = isinstance(read_type, PrimitiveType) and read_type.name == "boolean"
+        if reference.kind is Kind.PRIMITIVE_PREDICATE or boolean:
+            return f", or every member: `any({letter} in {first}..{last}: {expression_text(member)})` or `all(…)`"
+        return (
+            f"; a predicate computed by Python reads every member: "
+            f'`name/pp({reference.name}[*]/{reference.kind.value}) = python "module:function"`'
+        )
 
     def expression(
         self,
@@ -1192,6 +1261,7 @@ class Resolver:
                     owner,
                     (Kind.INPUT_BUFFER, Kind.MEMORY_INPUT, Kind.PRIMITIVE_PREDICATE),
                     "read by a predicate",
+                    read=node,
                 )
                 if declared is not None:
                     self._path(node, declared, node_scope)
@@ -1206,8 +1276,21 @@ class Resolver:
                 and node is expression
                 and computed_by_python
             ):
-                # a Python primitive predicate: its arguments are the reads it declares
-                stack.extend((child, node_scope) for child in children(node))
+                # a Python primitive predicate: its arguments are the reads it declares, a list of reads as a
+                # Partial Transition Function's, where `x[*]/ib` reads every member of a family
+                for argument in node.arguments:
+                    if isinstance(argument, Read) and not argument.path and table is not None:
+                        self.reference(
+                            argument.target,
+                            table,
+                            node_scope,
+                            owner,
+                            (Kind.INPUT_BUFFER, Kind.MEMORY_INPUT, Kind.PRIMITIVE_PREDICATE),
+                            "read by a predicate",
+                            star=True,
+                        )
+                    else:
+                        stack.append((argument, node_scope))
                 continue
             if isinstance(node, Call) and node.function == PYTHON_PREDICATE:
                 self.error(

@@ -46,6 +46,7 @@ from earl.model.elements import (
     TransitionFunction,
 )
 from earl.model.expressions import (
+    PYTHON_PREDICATE,
     Arithmetic,
     BooleanOperation,
     Call,
@@ -489,6 +490,16 @@ def _expression(expression: Expression, environment: Mapping[str, Value], member
             for a in expression.path
         )
         return Read(target, path, expression.location)
+    if isinstance(expression, Call) and expression.function == PYTHON_PREDICATE:
+        # the reads of a predicate computed by Python: `x[*]/ib` is every member, as in a function's reads
+        expanded: list[Expression] = []
+        for argument in expression.arguments:
+            if isinstance(argument, Read) and not argument.path:
+                targets = _members(argument.target, members.get(_key(argument.target)), environment)
+                expanded.extend(Read(target, (), argument.location) for target in targets)
+            else:
+                expanded.append(_expression(argument, environment, members))
+        return Call(expression.function, tuple(expanded), expression.location)
     if isinstance(expression, Call):
         arguments = tuple(_expression(a, environment, members) for a in expression.arguments)
         return Call(expression.function, arguments, expression.location)
