@@ -371,6 +371,46 @@ def test_a_param_of_the_wrong_type_is_one_error_not_one_per_use(
     assert "given from outside the spec (`--param`" in err and "as the spec's own (marked) is" in err
 
 
+def test_a_family_range_emptied_by_a_param_is_one_error_at_the_param_naming_where_it_came_from(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """`--param N=0` said "the family range 1..0 is empty" ten times, at lines whose text is right, never
+    saying that `N` came from the command line (EARL-R005 says "given from outside the spec")."""
+    status, _, err = run(capsys, "check", str(EXAMPLE), "--param", "N=0")
+    assert status == 1
+    assert err.count("error[") == 1
+    assert (
+        "error[EARL-R016]: `N` = 0, given from outside the spec (`--param`, or `parameters=` in Python), leaves "
+        "the family range 1..0 empty: `1..N` at lines 200, 204, 210, 211, 290, 344, 370, 371, 372 and 373"
+    ) in err
+    assert "system.earl:8:16" in err  # `param N: int = 6`: the value the spec itself gives
+    assert "= hint: give `N` a value of at least 1" in err
+
+
+def test_a_family_range_made_too_large_by_a_param_it_derives_from_is_told_once(tmp_path: Path) -> None:
+    """Through a parameter computed from the one given (`M = 2 * N`), and by the Python API's `parameters=`;
+    a range the spec's own values empty is still told at its own line."""
+    import earl
+
+    text = (
+        "system s\n\nparam N: int = 2\nparam M: int = 2 * N\n\nx/a {\n    cs {\n        period 1 ms\n"
+        "        v[J in 1..M]/m: int = 0\n        w[J in 1..M]/m: int = 0\n        u[J in 3..2]/m: int = 0\n    }\n}\n"
+    )
+    with pytest.raises(earl.EarlError) as refused:
+        earl.loads(text, "s.earl", {"N": 60_000})
+    told = [(d.code, d.message, d.location.line if d.location else None) for d in refused.value.diagnostics]
+    assert refused.value.diagnostics[1].hint == "give `N` a smaller value"
+    assert told == [
+        ("EARL-R016", "the family range 3..2 is empty", 11),
+        (
+            "EARL-R017",
+            "`N` = 60000, given from outside the spec (`--param`, or `parameters=` in Python), gives the family "
+            "range 1..120000 120,000 members; at most 100,000 are allowed: `1..M` at lines 9 and 10",
+            3,
+        ),
+    ]
+
+
 def test_a_problem_is_reported_once_at_the_place_it_was_written(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -209,6 +209,10 @@ class Resolver:
         #: elements the system will have once its families are expanded, counted as they are declared
         self._expanded = 0
         self._expanded_reported = False
+        #: per parameter, the system parameters given from outside (`--param`) that its value comes from
+        self._given: dict[str, frozenset[str]] = {}
+        #: family ranges made wrong by a value given from outside: told once per cause, after the walk
+        self._wrong_from_outside: dict[tuple[str, str, frozenset[str]], list[Family]] = {}
 
     # ------------------------------------------------------------------ reporting
     def error(self, message: str, location: SourceLocation | None, code: str, hint: str | None = None) -> None:
@@ -257,6 +261,7 @@ class Resolver:
         self._links(self.system.links, scope, agent=None)
         self._robots(scope)
         self._place = None
+        self._tell_wrong_from_outside()
         return self.diagnostics
 
     def _names(self) -> None:
@@ -307,6 +312,11 @@ class Resolver:
                 self.duplicate(f"parameter `{parameter.name}`", parameter.location, seen[parameter.name].location)
                 continue
             seen[parameter.name] = parameter
+            self._given[parameter.name] = (
+                frozenset({parameter.name})
+                if parameter.name in overrides
+                else frozenset().union(*(self._given.get(n.name, frozenset()) for n in _names(parameter.value)))
+            )
             type_name = getattr(parameter.data_type, "name", "?")
             if not isinstance(parameter.data_type, PrimitiveType) or type_name not in PARAMETER_TYPES:
                 self.error(
@@ -735,28 +745,69 @@ class Resolver:
         if first is None or last is None:
             return IndexRange(1, 0)
         if first < 0:
-            self.error(
-                f"a family index starts at 0 or more, not {first}",
-                family.first.location or family.location,
-                "EARL-R016",
-            )
+            if not self._from_outside(family, "EARL-R016", f"starts a family at {first}, below 0"):
+                self.error(
+                    f"a family index starts at 0 or more, not {first}",
+                    family.first.location or family.location,
+                    "EARL-R016",
+                )
             return IndexRange(1, 0)
         if last < first:
-            self.error(
-                f"the family range {first}..{last} is empty",
-                family.location,
-                "EARL-R016",
-                "the last index must not be smaller than the first",
-            )
+            if not self._from_outside(family, "EARL-R016", f"leaves the family range {first}..{last} empty"):
+                self.error(
+                    f"the family range {first}..{last} is empty",
+                    family.location,
+                    "EARL-R016",
+                    "the last index must not be smaller than the first",
+                )
             return IndexRange(1, 0)
         if last - first + 1 > MAX_FAMILY_MEMBERS:
-            self.error(
-                f"the family range {first}..{last} has {last - first + 1:,} members; at most {MAX_FAMILY_MEMBERS:,} are allowed",
-                family.location,
-                "EARL-R017",
-            )
+            members = f"{last - first + 1:,} members; at most {MAX_FAMILY_MEMBERS:,} are allowed"
+            if not self._from_outside(family, "EARL-R017", f"gives the family range {first}..{last} {members}"):
+                self.error(f"the family range {first}..{last} has {members}", family.location, "EARL-R017")
             return IndexRange(1, 0)
         return IndexRange(first, last)
+
+    def _from_outside(self, family: Family, code: str, problem: str) -> bool:
+        """Keeps a family range made wrong by a value given from outside the spec, to be told once for
+        all the families it makes wrong (`_tell_wrong_from_outside`); False when the spec's own values
+        make it wrong."""
+        names = _names(family.first) + _names(family.last)
+        causes = frozenset().union(*(self._given.get(n.name, frozenset()) for n in names))
+        if not causes:
+            return False
+        self._wrong_from_outside.setdefault((code, problem, causes), []).append(family)
+        return True
+
+    def _tell_wrong_from_outside(self) -> None:
+        """`--param NBINS=0`: one error at `NBINS`, naming the families it empties, not one per family at
+        lines whose text is right."""
+        declared = {parameter.name: parameter for parameter in self.system.parameters}
+        for (code, problem, causes), families in self._wrong_from_outside.items():
+            names = sorted(causes)
+            values = " and ".join(f"`{name}` = {self.overrides[name]!r}" for name in names)
+            written = sorted({f"{expression_text(f.first)}..{expression_text(f.last)}" for f in families})
+            lines = sorted({f.location.line for f in families if f.location is not None})
+            where = f" at line{'s' if len(lines) > 1 else ''} {_listed([str(line) for line in lines])}" if lines else ""
+            parameter = declared.get(names[0])
+            location = None if parameter is None else parameter.value.location or parameter.location
+            last = families[0].last
+            given = _listed([f"`{name}`" for name in names])
+            if code == "EARL-R017":
+                hint = f"give {given} a smaller value"
+            elif "empty" not in problem:
+                hint = "a family index starts at 0 or more"
+            elif isinstance(last, Name) and last.name in causes:
+                hint = f"give `{last.name}` a value of at least {expression_text(families[0].first)}"
+            else:
+                hint = "the last index must not be smaller than the first"
+            self.error(
+                f"{values}, given from outside the spec (`--param`, or `parameters=` in Python), {problem}: "
+                f"{_listed([f'`{text}`' for text in written])}{where}",
+                location,
+                code,
+                hint,
+            )
 
     def index_values(self, expression: Expression, scope: Scope) -> list[int] | None:
         """Every value an index expression takes over the family indices in scope."""
@@ -1530,6 +1581,11 @@ class Resolver:
                         if family is not None
                         else did_you_mean(reference.name, links),
                     )
+
+
+def _listed(items: list[str]) -> str:
+    """`a`, `a and b`, `a, b and c`."""
+    return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
 
 
 def _whole_double_hint(name: str, type_name: str, value: Value) -> str | None:
