@@ -11,7 +11,17 @@ from earl.check.expression_types import BOOLEAN, ExpressionTyper
 from earl.check.registry import Finding, rule
 from earl.diagnostics import Severity
 from earl.model.elements import BasicBehaviour, Subsystem
-from earl.model.expressions import Call, ElementReference, Expression, Read, children, reads, walk
+from earl.model.expressions import (
+    Call,
+    ElementReference,
+    Expression,
+    ListLiteral,
+    Literal,
+    Read,
+    children,
+    reads,
+    walk,
+)
 from earl.model.graphs import cycles
 from earl.model.kinds import Kind
 from earl.model.location import SourceLocation
@@ -438,13 +448,32 @@ def memory_initial_values(context: CheckContext) -> Iterator[Finding]:
                 value = constant_value(memory.initial_value)
                 structure = context.structural(memory.data_type)
                 integer = isinstance(structure, PrimitiveType) and structure.name in INTEGER_RANGES
-                yield Finding(
-                    str(wrong),
-                    memory.initial_value.location or memory.location,
-                    f"write `{int(value)}`: an integer type holds whole numbers, written without a decimal point"
-                    if integer and isinstance(value, float) and value.is_integer()
-                    else "write a constant of the memory's type, or leave out `= …` for the type's zero value",
-                )
+                hint = "write a constant of the memory's type, or leave out `= …` for the type's zero value"
+                if integer and isinstance(value, float) and value.is_integer():
+                    hint = f"write `{int(value)}`: an integer type holds whole numbers, written without a decimal point"
+                elif isinstance(memory.initial_value, ListLiteral) and memory.initial_value.items:
+                    hint = _filled_hint(context, memory.location, memory.initial_value) or hint
+                yield Finding(str(wrong), memory.initial_value.location or memory.location, hint)
+
+
+def _filled_hint(context: CheckContext, location: SourceLocation | None, written: ListLiteral) -> str | None:
+    """`perBin/m: int[NBINS] = [0, 0, 0]` under `--param NBINS=4`: a list as long as a parameter says is
+    written `[0] * NBINS`, which `earl check` cannot tell of a list written out."""
+    declared = next(
+        (
+            memory
+            for agent in context.declared.agents
+            for subsystem in agent.subsystems
+            for memory in subsystem.memories
+            if location is not None and memory.location == location
+        ),
+        None,
+    )
+    size = getattr(getattr(declared, "data_type", None), "size", None)
+    if size is None or isinstance(size, Literal) or len(set(written.items)) != 1:
+        return None
+    filled = f"[{expression_text(written.items[0])}] * {expression_text(size)}"
+    return f"write `{filled}`: the list repeated as many times as `{expression_text(size)}` says, whatever it is"
 
 
 @rule("EARL-W042", Severity.WARNING, "every partial transition function is used", "§2.2, Table 6")

@@ -473,6 +473,21 @@ def _link_end(end: LinkEnd, environment: Mapping[str, Value]) -> LinkEnd:
 
 
 # ---------------------------------------------------------------------- expressions
+def _filled(operator: str, left: Expression, right: Expression, location: SourceLocation | None) -> Expression | None:
+    """`[0.0] * N` (or `N * [0.0]`), with `N` now a number: the list repeated, an array's initial value
+    sized by a parameter. None when it is no such product, or the count is no whole number of 0 or
+    more (the initial value's check then says what it is)."""
+    if operator != "*":
+        return None
+    items, count = (left, right) if isinstance(left, ListLiteral) else (right, left)
+    if not isinstance(items, ListLiteral) or not isinstance(count, Literal):
+        return None
+    times = count.value
+    if isinstance(times, bool) or not isinstance(times, int) or times < 0:
+        return None
+    return ListLiteral(items.items * times, location)
+
+
 def _expression(expression: Expression, environment: Mapping[str, Value], members: Members) -> Expression:
     """Parameters and indices replaced by values; `any`/`all` unrolled; references made concrete."""
     if isinstance(expression, Literal):
@@ -518,12 +533,12 @@ def _expression(expression: Expression, environment: Mapping[str, Value], member
             expression.location,
         )
     if isinstance(expression, Arithmetic):
-        return Arithmetic(
-            expression.operator,
-            _expression(expression.left, environment, members),
-            _expression(expression.right, environment, members),
-            expression.location,
-        )
+        left = _expression(expression.left, environment, members)
+        right = _expression(expression.right, environment, members)
+        filled = _filled(expression.operator, left, right, expression.location)
+        if filled is not None:
+            return filled
+        return Arithmetic(expression.operator, left, right, expression.location)
     if isinstance(expression, Quantifier):
         first = evaluate_integer(expression.first, environment)
         last = evaluate_integer(expression.last, environment)

@@ -446,6 +446,15 @@ def _constant(expression: Any) -> Any:
         return expression.value
     if isinstance(expression, ListLiteral):
         return [_constant(item) for item in expression.items]
+    if isinstance(expression, Arithmetic) and ListLiteral in (type(expression.left), type(expression.right)):
+        # `[0.0] * N` is filled by the expansion once `N` is known: left here, its count was no whole number
+        count = expression.right if isinstance(expression.left, ListLiteral) else expression.left
+        raise ValueTypeError(
+            f"an initial value must be a constant: `[…] {expression.operator} N` repeats a list, `[0.0] * N`, "
+            f"where N is a whole number of 0 or more, not {shown_value(_constant(count))}"
+            if expression.operator == "*"
+            else f"an initial value must be a constant: `{expression.operator}` takes numbers, not a list"
+        )
     if isinstance(expression, (Negate, Arithmetic)):
         # `2 * QUEUE + 0.5`: the expansion put the parameter's value in.  `-` is the constant evaluator's too,
         # which refuses `-"x"`, `-[1]` and `-true` (Python's -True is -1) as the reader does for a parameter
