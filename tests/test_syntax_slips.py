@@ -186,3 +186,10 @@ def test_the_advice_for_an_int_parameter_is_one_that_checks(tmp_path: Path) -> N
         "a `double` stays a `double` even when it is whole (and there is no whole division): give `H` its own "
         "value (`param H: int = 3`) and compute the others from it by multiplying, or declare `H` a `double`"
     )
+
+
+def test_a_kind_in_capitals_is_no_division() -> None:
+    """`v/IB` after an element's name is its kind in the wrong case; `N / M` after a parameter a division."""
+    diagnostic = _error(_spec("        v/ib: double\n        x/pp = v/IB > 3.0\n"))
+    assert diagnostic.code == "EARL-S005"
+    assert diagnostic.hint == "kinds are written in lowercase: `v/ib`"

@@ -721,7 +721,7 @@ def _division(token: Token, context: _Context, location: SourceLocation, path: s
         and not _in_header(context)
         and (
             token.type in ("NUMBER", "INT", "LPAR", "MINUS")
-            or (token.type == "NAME" and not (str(token).isalpha() and str(token).islower()))
+            or (token.type == "NAME" and not str(token).islower() and _divides(str(context.value(2)), str(token)))
         )
     ):
         slash = context.previous
@@ -767,6 +767,16 @@ def _division(token: Token, context: _Context, location: SourceLocation, path: s
         code="EARL-S006",
         hint=hint,
     )
+
+
+#: the kinds as written after a slash: `cmd/IB` is a kind in the wrong case, not a division by `IB`
+_KIND_WORDS = frozenset(kind.value for kind in Kind) | {"mi", "mo"}
+
+
+def _divides(before: str, after: str) -> bool:
+    """`N/M` is a division by the parameter `M`; `cmd/IB` the kind `ib` in capitals (parameters are
+    named in capitals, elements not)."""
+    return after.lower() not in _KIND_WORDS or before.isupper()
 
 
 #: what follows a slash meant for division: a number (group 1), or anything else
@@ -875,6 +885,8 @@ def _bad_kind(token: Token, context: _Context, location: SourceLocation, path: s
         written = "MO" in context.expected and context.after_arrow()
         use = f"write it: `{named}/mo`" if written else f"read it: `{named}/mi`"
         hint = f"memory is declared `{named}/m`, read as `{named}/mi` and written as `{named}/mo`; here, {use}"
+    if hint is None and str(token).lower() in _KIND_WORDS and not str(token).islower():
+        hint = f"kinds are written in lowercase: `{context.value(2)}/{str(token).lower()}`"  # `cmd/IB`
     if str(token) in (Kind.AGENT.value, Kind.ROBOT.value) and context.open_brackets():
         title = KIND_TITLES[Kind(str(token))]
         unclosed = _unclosed_hint(context, context.open_brackets())
