@@ -122,3 +122,10 @@ def test_a_list_repeated_by_no_whole_number_is_refused(initial: str, message: st
     [(code, said, _hint)] = _errors(SPEC.replace("INITIAL", initial))
     assert code == "EARL-E043"
     assert said == f"an initial value must be a constant: {message}"
+
+
+def test_a_list_of_the_right_length_but_the_wrong_type_is_not_told_to_repeat() -> None:
+    """`[0.0, 0.0, 0.0]` for `int[NBINS]`: the length is right, the items are not (repeating `0.0` would not do)."""
+    [(code, message, hint)] = _errors(SPEC.replace("INITIAL", "[0.0, 0.0, 0.0]"))
+    assert code == "EARL-E043" and "must be a whole number (int), not the real number 0.0" in message
+    assert hint == "write a constant of the memory's type, or leave out `= …` for the type's zero value"

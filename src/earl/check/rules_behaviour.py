@@ -26,7 +26,7 @@ from earl.model.graphs import cycles
 from earl.model.kinds import Kind
 from earl.model.location import SourceLocation
 from earl.model.text import expression_text, instance_name, reference_text, subsystem_name
-from earl.model.types import INTEGER_RANGES, PrimitiveType
+from earl.model.types import INTEGER_RANGES, ArrayType, PrimitiveType
 
 
 def _conditions(
@@ -451,7 +451,14 @@ def memory_initial_values(context: CheckContext) -> Iterator[Finding]:
                 hint = "write a constant of the memory's type, or leave out `= …` for the type's zero value"
                 if integer and isinstance(value, float) and value.is_integer():
                     hint = f"write `{int(value)}`: an integer type holds whole numbers, written without a decimal point"
-                elif isinstance(memory.initial_value, ListLiteral) and memory.initial_value.items:
+                elif (
+                    isinstance(memory.initial_value, ListLiteral)
+                    and memory.initial_value.items
+                    and isinstance(structure, ArrayType)
+                    and isinstance(structure.size, Literal)
+                    and structure.size.value != len(memory.initial_value.items)
+                ):
+                    # a list of the wrong length: the size may be a parameter's, which a repeated list follows
                     hint = _filled_hint(context, memory.location, memory.initial_value) or hint
                 yield Finding(str(wrong), memory.initial_value.location or memory.location, hint)
 
