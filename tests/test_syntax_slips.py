@@ -145,7 +145,19 @@ def test_the_sorter_slips_from_the_command_line(tmp_path: Path) -> None:
         ("param H: double = N/2.0", 20, "multiply instead: write `N * 0.5` for `N / 2.0`"),
         ("param H: double = 0.3 * N / 4", 27, "multiply instead: write `N * 0.25` for `N / 4`"),
         ("param H: double = (N + 1) / 2", 27, "multiply instead: write `(N + 1) * 0.5` for `(N + 1) / 2`"),
-        ("param H: double = N / M", 21, "multiply instead, e.g. `N * 0.5` for `N / 2`"),
+        (
+            "param H: double = N / M",
+            21,
+            "EARL cannot compute `1 / M`: give it as a parameter of its own (`param INV_M: double = …`, then "
+            "`N * INV_M`), or compute it in the Python code that uses it",
+        ),
+        (
+            "param H: double = 1.0 / M",
+            23,
+            "EARL cannot compute `1 / M`: give it as a parameter of its own (`param INV_M: double = …`, then "
+            "`INV_M`), or compute it in the Python code that uses it",
+        ),
+        ("param H: double = N / (M)", 21, "multiply instead, e.g. `N * 0.5` for `N / 2`"),
         (
             "param H: int = N / 2",
             18,
@@ -161,7 +173,7 @@ def test_the_sorter_slips_from_the_command_line(tmp_path: Path) -> None:
             "(`param HALF: int = 3`, then `param N: int = 2 * HALF`)",
         ),
     ],
-    ids=["double", "product", "parenthesised", "by a name", "int", "array size"],
+    ids=["double", "product", "parenthesised", "by a name", "an inverse", "by a group", "int", "array size"],
 )
 def test_a_division_is_told_there_is_none_and_how_to_write_it(declaration: str, column: int, hint: str) -> None:
     """`N / 2` was "`2` is not a kind of element" (the slash read as a kind's), `(N + 1) / 2` a division."""

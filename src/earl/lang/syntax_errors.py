@@ -732,7 +732,15 @@ def _division(token: Token, context: _Context, location: SourceLocation, path: s
     divisor = _DIVISOR.match(text, slash.end_pos or slash.start_pos + 1)
     product = f"{dividend} * 0.5"
     instead = f"multiply instead, e.g. `{product}` for `{dividend} / 2`"
-    if divisor is not None and divisor.group(1) is not None and float(divisor.group(1)) != 0:
+    if divisor is not None and divisor.group(2) is not None:
+        # `1.0 / N`: no expression computes an inverse of a parameter
+        inverse = f"INV_{divisor.group(2).upper()}"
+        use = inverse if dividend in ("1", "1.0") else f"{dividend} * {inverse}"
+        instead = (
+            f"EARL cannot compute `1 / {divisor.group(2)}`: give it as a parameter of its own "
+            f"(`param {inverse}: double = …`, then `{use}`), or compute it in the Python code that uses it"
+        )
+    elif divisor is not None and divisor.group(1) is not None and float(divisor.group(1)) != 0:
         number = divisor.group(1)
         product = f"{dividend} * {1 / float(number)!r}"
         instead = f"multiply instead: write `{product}` for `{dividend} / {number}`"
@@ -779,8 +787,8 @@ def _divides(before: str, after: str) -> bool:
     return after.lower() not in _KIND_WORDS or before.isupper()
 
 
-#: what follows a slash meant for division: a number (group 1), or anything else
-_DIVISOR = re.compile(r"[ \t]*(?:(\d+(?:\.\d+)?(?:[eE][+-]?\d+)?)\b|\S)")
+#: what follows a slash meant for division: a number (group 1), a parameter's name (group 2), or anything else
+_DIVISOR = re.compile(r"[ \t]*(?:(\d+(?:\.\d+)?(?:[eE][+-]?\d+)?)\b|([A-Za-z_][A-Za-z0-9_]*)\b(?!\s*[/\[])|\S)")
 
 
 def _operand_before(text: str, end: int) -> str:
