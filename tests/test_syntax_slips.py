@@ -205,3 +205,15 @@ def test_a_kind_in_capitals_is_no_division() -> None:
     diagnostic = _error(_spec("        v/ib: double\n        x/pp = v/IB > 3.0\n"))
     assert diagnostic.code == "EARL-S005"
     assert diagnostic.hint == "kinds are written in lowercase: `v/ib`"
+
+
+@pytest.mark.parametrize("divisor", ["0", "M", "(2)"])
+def test_an_int_divided_by_no_number_is_told_without_a_product(divisor: str) -> None:
+    """`N / 0` raised inside the message's making (an unbound name); by a name or a group there is no
+    product to show."""
+    diagnostic = _error(f"system s\nparam N: int = 6\nparam M: int = 3\nparam H: int = N / {divisor}\n")
+    assert diagnostic.code == "EARL-S006"
+    assert diagnostic.hint == (
+        "`H` is an `int` and a product with a `double` is a `double`, even when whole: give `H` its own value "
+        "(`param H: int = …`) and compute the others from it by multiplying, or declare `H` a `double`"
+    )

@@ -732,6 +732,9 @@ def _division(token: Token, context: _Context, location: SourceLocation, path: s
     divisor = _DIVISOR.match(text, slash.end_pos or slash.start_pos + 1)
     product = f"{dividend} * 0.5"
     instead = f"multiply instead, e.g. `{product}` for `{dividend} / 2`"
+    number = divisor.group(1) if divisor is not None and divisor.group(1) is not None else None
+    if number is not None and float(number) == 0:
+        number = None  # `N / 0` has no product to show
     if divisor is not None and divisor.group(2) is not None:
         # `1.0 / N`: no expression computes an inverse of a parameter
         inverse = f"INV_{divisor.group(2).upper()}"
@@ -740,8 +743,7 @@ def _division(token: Token, context: _Context, location: SourceLocation, path: s
             f"EARL cannot compute `1 / {divisor.group(2)}`: give it as a parameter of its own "
             f"(`param {inverse}: double = …`, then `{use}`), or compute it in the Python code that uses it"
         )
-    elif divisor is not None and divisor.group(1) is not None and float(divisor.group(1)) != 0:
-        number = divisor.group(1)
+    elif number is not None:
         product = f"{dividend} * {1 / float(number)!r}"
         instead = f"multiply instead: write `{product}` for `{dividend} / {number}`"
     whole = _whole_number_context(context)
@@ -749,22 +751,24 @@ def _division(token: Token, context: _Context, location: SourceLocation, path: s
         hint = instead
     else:
         what, name = whole
-        times = number if divisor is not None and divisor.group(1) is not None else "2"
-        if name is not None and times.isdigit() and dividend.isidentifier():
+        times = number or "2"
+        # divided by a name or a group there is no product to show
+        product = "a product with a `double`" if number is None else f"`{product}`"
+        if name is not None and times.isdigit() and dividend.isidentifier() and number is not None:
             hint = (
-                f"{what} and `{product}` is a `double`, even when whole: give `{name}` its own value and "
+                f"{what} and {product} is a `double`, even when whole: give `{name}` its own value and "
                 f"compute `{dividend}` from it (`param {name}: int = …`, then `param {dividend}: int = {times} * {name}`)"
-                f", or declare `{name}` a `double` and write `{product}`"
+                f", or declare `{name}` a `double` and write {product}"
             )
         elif name is not None:
             hint = (
-                f"{what} and `{product}` is a `double`, even when whole: give `{name}` its own value "
+                f"{what} and {product} is a `double`, even when whole: give `{name}` its own value "
                 f"(`param {name}: int = …`) and compute the others from it by multiplying, "
                 f"or declare `{name}` a `double`"
             )
         else:
             hint = (
-                f"{what} and `{product}` is a `double`, even when whole: there is no whole division, so declare "
+                f"{what} and {product} is a `double`, even when whole: there is no whole division, so declare "
                 "the smaller number as a parameter and compute the larger from it "
                 "(`param HALF: int = 3`, then `param N: int = 2 * HALF`)"
             )
