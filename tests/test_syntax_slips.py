@@ -217,3 +217,37 @@ def test_an_int_divided_by_no_number_is_told_without_a_product(divisor: str) -> 
         "`H` is an `int` and a product with a `double` is a `double`, even when whole: give `H` its own value "
         "(`param H: int = …`) and compute the others from it by multiplying, or declare `H` a `double`"
     )
+
+
+@pytest.mark.parametrize(
+    ("body", "hint"),
+    [
+        (
+            "        fsm {\n            initial idle\n            state idle: b { optional t/mi }\n        }\n",
+            "a state names its behaviour with its kind: `state idle: b/bb`",
+        ),
+        (
+            "        c/bb {\n            tf = {}, {}\n            tc = true\n        }\n",
+            "the stages of a `tf` follow one another with `then`: `tf = {} then {}`; "
+            "the functions of one stage share its braces: `{a/pf, b/pf}`",
+        ),
+        (
+            "        fsm {\n            initial idle\n            state idle: b/bb\n"
+            "            idle -> idle priority 2 when t/mi > 3\n        }\n",
+            "`when CONDITION` comes before `priority`: `idle -> idle when t/mi > 3 priority 2`",
+        ),
+    ],
+    ids=["a state's behaviour without its kind", "stages apart with a comma", "priority before when"],
+)
+def test_more_slips_are_told_how_they_are_written(body: str, hint: str) -> None:
+    """Each had the generic hint, or none (`state s: b {` said only "expected `/` or `[` after `b`")."""
+    assert _error(_spec(body)).hint == hint
+
+
+def test_a_struct_field_with_a_default_value_is_told_there_is_none() -> None:
+    diagnostic = _error("system s\n\nstruct Push {\n    abort: boolean = false\n}\n")
+    assert _where(diagnostic) == (4, 20)
+    assert diagnostic.hint == (
+        "a struct's fields have no default value: a memory of the struct gets its first value in the first stage "
+        "of the initial state's behaviour"
+    )

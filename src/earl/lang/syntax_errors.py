@@ -1015,6 +1015,36 @@ def _slip_hint(token: Token, context: _Context) -> str | None:
         and before.type == "INITIAL"
     ):
         return f"`initial` names a state, not its behaviour: write `initial {previous}`"
+    if (
+        previous is not None
+        and previous.type == "NAME"
+        and "SLASH" in context.expected
+        and _is_token(context.value(2), "COLON")
+        and _is_token(context.value(4), "STATE")
+    ):
+        # `state pushing: pushing { … }`: the behaviour without its kind
+        return f"a state names its behaviour with its kind: `state {context.value(3)}: {previous}/bb`"
+    if token.type == "COMMA" and "THEN" in context.expected:
+        # `tf = {a/pf}, {b/pf}`
+        return (
+            f"the stages of a `tf` follow one another with `then`: `{_line_with(context.text, token, ' then')}`; "
+            "the functions of one stage share its braces: `{a/pf, b/pf}`"
+        )
+    if token.type == "PRIORITY" and context.expected == ["WHEN"]:
+        # `a -> b priority 2 when c/pp`
+        line = _line_with(context.text, token, str(token))
+        meant = _PRIORITY_BEFORE_WHEN.sub(r"when \2 priority \1", line)
+        return (
+            f"`when CONDITION` comes before `priority`: `{meant if meant != line else 'a -> b when c/pp priority 1'}`"
+        )
+    brace = _group_brace(context)
+    if token.type == "EQUAL" and brace is not None:
+        index = next(i for i, value in enumerate(context.values) if value is brace)
+        if index >= 2 and _is_token(context.values[index - 2], "STRUCT"):
+            return (
+                "a struct's fields have no default value: a memory of the struct gets its first value in the "
+                "first stage of the initial state's behaviour"
+            )
     read = context.value(1)
     if token.type == "COMMA" and isinstance(read, Tree) and read.data == "element_ref":
         state, name = context.value(4), context.value(3)
@@ -1026,6 +1056,10 @@ def _slip_hint(token: Token, context: _Context) -> str | None:
                 f"`state {name}: {behaviour} {{ obligatory a/ib  optional b/ib  timeout 20 ms }}`"
             )
     return None
+
+
+#: `priority N when CONDITION` to the end of a line: the two clauses the other way round
+_PRIORITY_BEFORE_WHEN = re.compile(r"priority\s+(\d+)\s+when\s+(.+)$")
 
 
 def _line_with(text: str, token: Token, replacement: str) -> str:
