@@ -100,3 +100,21 @@ def test_a_link_end_inside_a_link_family_is_told_the_links_index() -> None:
     code, message, hint = _refused(text)
     assert (code, message) == ("EARL-R024", "`pusher/a` is a family of 3; say which member")
     assert hint == "write `pusher[K]/a`"
+
+
+@pytest.mark.parametrize(
+    ("condition", "hint"),
+    [
+        ("bad/pp = ready", "an element is read with its kind: write `ready/ib`"),
+        ("bad/pp = remembered", "an element is read with its kind: write `remembered/mi`"),
+        ("bad/pp = NBIN > 2", "did you mean `NBINS`?"),
+    ],
+    ids=["an input buffer", "a memory", "a parameter misspelt"],
+)
+def test_an_element_named_without_its_kind_is_told_its_kind(condition: str, hint: str) -> None:
+    """`tc = extended` where `extended/pp` is declared said "declare it with `param`, or write an element with
+    its kind (`x/pp`)", not which element it is."""
+    text = SPEC.replace("CONDITION", f"ready/ib: boolean\n        remembered/m: int = 0\n        {condition}")
+    text = text.replace("        ready[K in 1..NBINS]/ib: boolean\n", "")
+    code, _message, given = _refused(text)
+    assert (code, given) == ("EARL-R020", hint)

@@ -843,12 +843,19 @@ class Resolver:
             values.append(value)
         return values
 
-    def unknown_name(self, name: Name, scope: Scope) -> None:
+    def unknown_name(self, name: Name, scope: Scope, table: _SubsystemTable | None = None) -> None:
+        """EARL-R020; `table`: the subsystem whose elements a condition may read, told when one has the name."""
+        readable = (
+            []
+            if table is None
+            else [f"`{name.name}/{read.value}`" for kind, read in _READ_AS.items() if name.name in table.lookup(kind)]
+        )
         self.error(
             f"`{name.name}` is not a parameter or family index in scope here",
             name.location,
             "EARL-R020",
-            did_you_mean(name.name, list(scope))
+            (f"an element is read with its kind: write {' or '.join(readable)}" if readable else None)
+            or did_you_mean(name.name, list(scope))
             or "declare it with `param`, or write an element with its kind (`x/pp`)",
         )
 
@@ -1274,7 +1281,7 @@ class Resolver:
             self._operator(node)
             if isinstance(node, Name):
                 if node.name not in node_scope:
-                    self.unknown_name(node, node_scope)
+                    self.unknown_name(node, node_scope, table if reads_allowed else None)
                 continue
             if isinstance(node, Quantifier):
                 if _unreadable_index(node.index):  # built in Python: read from text, it is a name
@@ -1581,6 +1588,14 @@ class Resolver:
                         if family is not None
                         else did_you_mean(reference.name, links),
                     )
+
+
+#: the kinds a condition reads, and how each is written there (memory is read through `mi`)
+_READ_AS = {
+    Kind.PRIMITIVE_PREDICATE: Kind.PRIMITIVE_PREDICATE,
+    Kind.INPUT_BUFFER: Kind.INPUT_BUFFER,
+    Kind.MEMORY: Kind.MEMORY_INPUT,
+}
 
 
 def _listed(items: list[str]) -> str:
