@@ -251,3 +251,11 @@ def test_a_struct_field_with_a_default_value_is_told_there_is_none() -> None:
         "a struct's fields have no default value: a memory of the struct gets its first value in the first stage "
         "of the initial state's behaviour"
     )
+
+
+def test_a_whole_real_written_for_an_int_parameter_is_told_to_drop_the_point() -> None:
+    with pytest.raises(EarlError) as caught:
+        earl.loads("system s\nparam H: int = 3.0\n", "s.earl")
+    diagnostic = caught.value.diagnostics[0]
+    assert diagnostic.code == "EARL-R005"
+    assert diagnostic.hint == "write `3`: an integer type holds whole numbers, written without a decimal point"

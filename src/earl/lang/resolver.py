@@ -37,6 +37,7 @@ from earl.model.expressions import (
     ElementReference,
     Expression,
     FieldAccess,
+    Literal,
     Name,
     Quantifier,
     Read,
@@ -366,7 +367,7 @@ class Resolver:
                     # the caret is at the spec's own value, which is not the wrong one: say what to change
                     f"give `{parameter.name}` a value of type `{type_name}`, as the spec's own (marked) is"
                     if given
-                    else _whole_double_hint(parameter.name, type_name, value),
+                    else _whole_double_hint(parameter, type_name, value),
                 )
                 if parameter.name not in overrides:
                     continue
@@ -1603,10 +1604,13 @@ def _listed(items: list[str]) -> str:
     return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
 
 
-def _whole_double_hint(name: str, type_name: str, value: Value) -> str | None:
+def _whole_double_hint(parameter: Parameter, type_name: str, value: Value) -> str | None:
     """For `param H: int = 0.5 * N`: EARL has no whole division, so how a whole half is written."""
     if type_name not in _INTEGER_TYPES or not isinstance(value, float) or not value.is_integer():
         return None
+    name = parameter.name
+    if isinstance(parameter.value, Literal):
+        return f"write `{int(value)}`: an integer type holds whole numbers, written without a decimal point"
     return (
         f"a `double` stays a `double` even when it is whole (and there is no whole division): give `{name}` "
         f"its own value (`param {name}: {type_name} = {int(value)}`) and compute the others from it by "
