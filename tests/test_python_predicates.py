@@ -354,3 +354,49 @@ def test_a_python_predicates_family_read_without_an_index_is_told_to_write_star(
     (problem,) = refused.value.diagnostics
     assert problem.code == "EARL-R024"
     assert problem.hint == "write `x[1]/mi`, or `x[*]/mi` for every member"
+def _with_big(tmp_path: Path, predicate: earl.PrimitivePredicate) -> earl.System:
+    system = earl.load(write(tmp_path))
+    subsystem = system.agent("counter").control_subsystem  # type: ignore[union-attr]
+    assert subsystem is not None
+    subsystem.primitive_predicates[0] = predicate
+    return system
+
+
+X_READ = earl.ElementReference("x", earl.Kind.MEMORY_INPUT)
+
+
+@pytest.mark.parametrize(
+    "predicate",
+    [
+        # the code is set but the expression is an ordinary one: the check read `false`, the run the code
+        earl.PrimitivePredicate(
+            "big", earl.Literal(False), reads=[X_READ], implementation=earl.PythonImplementation("limits:big")
+        ),
+        # `python()` without the reads it declares: the reload has `python(x/mi)`
+        earl.PrimitivePredicate(
+            "big", earl.Call("python", ()), reads=[X_READ], implementation=earl.PythonImplementation("limits:big")
+        ),
+        # reads said in the expression only: the text writes `big/pp()`
+        earl.PrimitivePredicate(
+            "big", earl.Call("python", (earl.Read(X_READ),)), implementation=earl.PythonImplementation("limits:big")
+        ),
+    ],
+)
+def test_a_predicate_built_in_python_whose_code_expression_and_reads_disagree_is_r048(
+    tmp_path: Path, predicate: earl.PrimitivePredicate
+) -> None:
+    system = _with_big(tmp_path, predicate)
+    errors = [d for d in check(system) if d.severity is Severity.ERROR]
+    assert [d.code for d in errors] == ["EARL-R048"]
+    assert "`big/pp` of `counter/a.cs` is computed by Python" in errors[0].message
+    assert "PrimitivePredicate.python('big', reads, 'limits:big')" in (errors[0].hint or "")
+    with pytest.raises(EarlError):
+        earl.simulate(system)
+
+
+def test_a_predicate_built_with_primitive_predicate_python_is_the_one_read_from_text(tmp_path: Path) -> None:
+    built = earl.PrimitivePredicate.python("big", [X_READ], "limits:big")
+    system = _with_big(tmp_path, built)
+    assert system == earl.load(tmp_path / "system.earl")
+    assert [d for d in check(system) if d.severity is Severity.ERROR] == []
+    assert earl.loads(system.to_earl()) == system

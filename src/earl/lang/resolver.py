@@ -984,6 +984,17 @@ class Resolver:
                 with self._within(f"`{memory.name}/m`", "the initial value"):
                     self.expression(memory.initial_value, table, inner, owner, reads_allowed=False)
         for predicate in subsystem.primitive_predicates:
+            mismatch = predicate.python_problem  # only a model built in Python: the reader builds them alike
+            if mismatch is not None:
+                self.error(
+                    f"`{predicate.name}/pp` of `{owner}` {mismatch}: the text would save the code alone,"
+                    f" so the reload would not be this model",
+                    predicate.location,
+                    "EARL-R048",
+                    f"build it with `PrimitivePredicate.python({predicate.name!r}, reads, "
+                    f"{predicate.implementation.path if predicate.implementation else ''!r})`",
+                )
+                continue
             with self._within(f"`{predicate.name}/pp`"):
                 self.expression(
                     predicate.expression, table, scope, owner, computed_by_python=predicate.implementation is not None
@@ -1356,7 +1367,8 @@ class Resolver:
                     "`python(…)` is no function of a condition",
                     node.location,
                     "EARL-R040",
-                    'a predicate computed by Python is declared `NAME/pp(READS) = python "MODULE:FUNCTION"`, '
+                    'a predicate computed by Python is declared `NAME/pp(READS) = python "MODULE:FUNCTION"` '
+                    '(in Python, `PrimitivePredicate.python(NAME, READS, "MODULE:FUNCTION")`), '
                     "and named in conditions as `NAME/pp`",
                 )
                 continue

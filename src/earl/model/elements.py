@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import ClassVar
 
-from earl.model.expressions import ElementReference, Expression, Star
+from earl.model.expressions import PYTHON_PREDICATE, Call, ElementReference, Expression, Read, Star
 from earl.model.frozen import quick_init
 from earl.model.kinds import Kind
 from earl.model.location import Comments, SourceLocation, comments_field, location_field
@@ -163,6 +163,40 @@ class PrimitivePredicate:
     reads: list[ElementReference] = field(default_factory=list)
     implementation: PythonImplementation | None = None
     kind: ClassVar[Kind] = Kind.PRIMITIVE_PREDICATE
+
+    @classmethod
+    def python(
+        cls, name: str, reads: list[ElementReference], implementation: PythonImplementation | str
+    ) -> PrimitivePredicate:
+        """`graspStable/pp(fingerState/ib, grip/mi) = python "gripping:stable"`, as the reader builds it:
+        `PrimitivePredicate.python("graspStable", [ElementReference("fingerState", "ib"), …], "gripping:stable")`.
+        """
+        if isinstance(implementation, str):
+            implementation = PythonImplementation(implementation)
+        return cls(name, python_expression(reads), reads=list(reads), implementation=implementation)
+
+    @property
+    def python_problem(self) -> str | None:
+        """Why this predicate's `implementation`, `reads` and `expression` do not say one thing, or None.
+
+        A predicate computed by Python is written `NAME/pp(READS) = python "…"`: the text holds the reads
+        and the code, not an expression, so an expression other than `python(READS)` would be lost on
+        save, and the run would call the code where the check read the expression (or the reverse)."""
+        if self.implementation is None:
+            return None
+        expected = python_expression(self.reads)
+        if self.expression == expected:
+            return None
+        return (
+            f"is computed by Python (`implementation={self.implementation.path!r}`) but its expression is not "
+            f"`python(…)` over its `reads`"
+        )
+
+
+def python_expression(reads: list[ElementReference] | tuple[ElementReference, ...]) -> Expression:
+    """The expression of a primitive predicate computed by Python: `python(fingerState/ib, grip/mi)`, a
+    Boolean that depends on what it reads."""
+    return Call(PYTHON_PREDICATE, tuple(Read(reference) for reference in reads))
 
 
 @dataclass
