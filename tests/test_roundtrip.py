@@ -307,3 +307,20 @@ def test_a_library_file_keeps_its_first_comment_above_its_first_declaration() ->
     assert system.name == ""
     assert system.types[0].comments.leading == ["// shared types", ""]
     assert system.to_earl() == text
+
+
+def test_declarations_reordered_in_python_after_reading_are_saved_in_their_new_order() -> None:
+    """The order read from the file keeps how kinds interleave (a link between two agents stays there), but
+    within a list the list's order is the one saved: reversing `system.agents` was undone by `to_earl()`."""
+    text = (
+        "system s\n\nparam N: int = 1\n\nstruct T {}\n\n"
+        + "".join(f"{name}/a {{\n    cs {{\n        period 1 ms\n    }}\n}}\n\n" for name in ("a", "b"))
+        + "link a,b: a/a.cs.x -> b/a.cs.x\n\nc/a {\n    cs {\n        period 1 ms\n    }\n}\n"
+    )
+    system = parse(text)
+    assert system.to_earl() == text
+    system.agents.reverse()
+    written = system.to_earl()
+    assert [agent.name for agent in parse(written).agents] == ["c", "b", "a"]
+    assert written.index("b/a") < written.index("link a,b") < written.index("a/a {")
+    assert parse(written) == system

@@ -9,6 +9,7 @@ order they were written, comments kept where they were.
 from __future__ import annotations
 
 from collections.abc import Iterable
+from typing import Any
 
 from earl.lang.layout import agent_groups, apart, fsm_groups, subsystem_groups
 from earl.model.elements import (
@@ -156,7 +157,7 @@ def format_system(system: System) -> str:
         printer.comment(0, comment)
     if system.name:
         printer.line(0, f"system {system.name}")
-    declared = system.order if _order_is_complete(system) else _default_order(system)
+    declared = _declaration_order(system)
     for import_ in system.imports:
         printer.blank()
         _import(printer, import_)
@@ -193,15 +194,19 @@ def _from_root(system: System, element: object) -> bool:
     return location is None or system.source_file is None or location.file == system.source_file
 
 
-def _order_is_complete(system: System) -> bool:
-    mine = [*system.parameters, *system.types, *system.agents, *system.links, *system.robots]
-    mine = [d for d in mine if _from_root(system, d)]
-    return len(mine) == len(system.order) and all(any(d is o for o in system.order) for d in mine)
-
-
-def _default_order(system: System) -> list[object]:
-    everything = [*system.parameters, *system.types, *system.agents, *system.links, *system.robots]
-    return [d for d in everything if _from_root(system, d)]
+def _declaration_order(system: System) -> list[object]:
+    """The declarations to print: where `system.order` (as read) holds them all, its interleaving of
+    parameters, types, agents, links and robots is kept, but within each list the list's own order wins,
+    so that `system.agents.reverse()` on a loaded system is saved reversed. Otherwise parameters, types,
+    agents, links, robots."""
+    lists: list[list[Any]] = [system.parameters, system.types, system.agents, system.links, system.robots]
+    mine = [[d for d in declarations if _from_root(system, d)] for declarations in lists]
+    owner = {id(d): position for position, declarations in enumerate(mine) for d in declarations}
+    slots = [owner.get(id(o)) for o in system.order]
+    if any(slots.count(position) != len(declarations) for position, declarations in enumerate(mine)) or (None in slots):
+        return [d for declarations in mine for d in declarations]
+    following = [iter(declarations) for declarations in mine]
+    return [next(following[position]) for position in slots]  # type: ignore[index]
 
 
 def _import(printer: _Printer, import_: Import) -> None:
