@@ -955,3 +955,49 @@ def test_spaces_around_a_comment_set_in_python_are_dropped_so_it_reads_back() ->
     said = read.agents[0].comments
     assert (said.leading, said.trailing, said.closing, said.after) == (["// a"], "// t", ["// b", "", "// b2"], "// c")
     assert read.to_earl() == text
+
+
+def _edited_counter(edit: Callable[[Any], None]) -> Any:
+    system = earl.load(Path(__file__).parent / "runtime_specs" / "counter")
+    edit(system)
+    return system
+
+
+def _relay_state(system: Any) -> Any:
+    return next(s for s in system.agents[0].subsystems[1].fsm.states if s.timeout is not None)
+
+
+@pytest.mark.parametrize(
+    ("edit", "path"),
+    [
+        # docs/python-api.md's own example: check returned a diagnostic and simulate raised EarlError
+        (lambda s: setattr(_relay_state(s), "timeout", 0.05), r"fsm\.states\[\d\]\.timeout: expected Duration"),
+        # check said `is '20' ms, not a number`, but to_earl wrote `timeout "20" ms`, which does not load
+        (
+            lambda s: setattr(_relay_state(s), "timeout", earl.Duration("20", "ms")),  # type: ignore[arg-type]
+            r"fsm\.states\[\d\]\.timeout\.value: expected int \| float, got str '20'",
+        ),
+        # check passed it, to_earl wrote `?`, and the reload held True
+        (
+            lambda s: s.types.append(
+                earl.StructType("T", [earl.Field("x", earl.PrimitiveType("int"), optional="yes")])
+            ),  # type: ignore[arg-type]
+            r"system\.types\[\d\]\.fields\[0\]\.optional: expected bool, got str 'yes'",
+        ),
+    ],
+)
+def test_a_value_of_a_wrong_type_is_a_model_type_error_of_check_to_earl_and_simulate_alike(
+    edit: Callable[[Any], None], path: str
+) -> None:
+    for use in (check, lambda system: system.to_earl(), earl.simulate):
+        with pytest.raises(earl.ModelTypeError, match=path):
+            use(_edited_counter(edit))
+
+
+def test_to_earl_refuses_a_priority_check_refuses_rather_than_write_text_that_does_not_load() -> None:
+    def edit(system: Any) -> None:
+        system.agents[0].subsystems[0].fsm.transitions[0].priority = True
+
+    assert [d.code for d in check(_edited_counter(edit)) if d.severity is earl.Severity.ERROR] == ["EARL-R033"]
+    with pytest.raises(earl.ModelTypeError, match=r"transitions\[0\]\.priority: expected int \| None, got bool"):
+        _edited_counter(edit).to_earl()

@@ -22,6 +22,7 @@ from earl.diagnostics import Diagnostic, EarlError, Severity
 from earl.model import *  # noqa: F403  (the model's names are the API)
 from earl.model import __all__ as _model_names
 from earl.model.elements import System
+from earl.model.validate import ModelCommentError, ModelNameError, ModelTypeError
 
 if TYPE_CHECKING:
     import os
@@ -131,6 +132,9 @@ _display_in_notebooks()
 __all__ = [
     "Diagnostic",
     "EarlError",
+    "ModelCommentError",
+    "ModelNameError",
+    "ModelTypeError",
     "Severity",
     "__version__",
     "load",

@@ -33,6 +33,7 @@ from earl.model.elements import (
     Subsystem,
     System,
     Transition,
+    is_duration,
 )
 from earl.model.expressions import ElementReference
 from earl.model.location import Comments
@@ -105,6 +106,8 @@ class _Printer:
 
 
 def duration_text(duration: Duration) -> str:
+    if not is_duration(duration):
+        raise TypeError(f"not a duration: {duration!r}")  # `Duration("20", "ms")` would print `"20" ms`
     return f"{literal_text(duration.value)} {duration.unit}"
 
 
@@ -224,6 +227,8 @@ def _struct(printer: _Printer, struct: StructType) -> None:
         return
     printer.line(0, f"struct {struct.name} {{", struct.comments)
     for field in struct.fields:
+        if not isinstance(field.optional, bool):  # `optional="yes"`: a model built in Python, named at its path
+            raise TypeError(f"not a bool: {field.optional!r}")
         optional = "?" if field.optional else ""
         printer.line(1, f"{field.name}: {data_type_text(field.data_type)}{optional}", field.comments)
     printer.close(0, struct.comments)
@@ -399,5 +404,7 @@ def _transition(printer: _Printer, depth: int, transition: Transition) -> None:
     source = transition.source if transition.source is not None else "*"
     text = f"{source} -> {transition.destination} when {expression_text(transition.condition.expression)}"
     if transition.priority is not None:
+        if isinstance(transition.priority, bool) or not isinstance(transition.priority, int):
+            raise TypeError(f"not a priority: {transition.priority!r}")  # `priority True` would not read back
         text += f" priority {transition.priority}"
     printer.line(depth, text, transition.comments)

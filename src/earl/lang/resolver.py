@@ -26,6 +26,7 @@ from earl.model.elements import (
     Subsystem,
     System,
     duration_problems,
+    is_duration,
 )
 from earl.model.expressions import (
     ARITHMETIC_OPERATORS,
@@ -430,6 +431,8 @@ class Resolver:
             if isinstance(definition, StructType):
                 names: dict[str, Any] = {}
                 for member in definition.fields:
+                    if not isinstance(member.optional, bool):  # `optional="yes"`: named at its path (explaining)
+                        raise TypeError(f"a field's `optional` is a bool, not {member.optional!r}")
                     if member.name in names:
                         self.duplicate(
                             f"field `{member.name}` of `{definition.name}`",
@@ -1051,6 +1054,12 @@ class Resolver:
         if subsystem.fsm is not None:
             self._fsm(subsystem.fsm, table, scope, owner)
         # the reader refuses such a duration; a model built in Python may hold one
+        states = subsystem.fsm.states if subsystem.fsm is not None else []
+        for duration in [subsystem.period, *(state.timeout for state in states)]:
+            if duration is not None and not is_duration(duration):
+                # `timeout=0.05`: a value not of its declared type, which `check`'s `explaining` names at its
+                # path as a ModelTypeError, as it names every other such value
+                raise TypeError(f'not a Duration such as `Duration(2, "ms")`: {duration!r}')
         for what, wrong, location in duration_problems(subsystem):
             self.error(f"{what} of `{owner}` {wrong}", location, "EARL-S012")
 

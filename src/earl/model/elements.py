@@ -64,6 +64,15 @@ def duration_problems(subsystem: Subsystem) -> list[tuple[str, str, SourceLocati
     return found
 
 
+def is_duration(duration: object) -> bool:
+    """Whether `duration` is a Duration of a number (`timeout=0.05` and `Duration("20", "ms")` are not)."""
+    return (
+        isinstance(duration, Duration)
+        and isinstance(duration.value, int | float)
+        and not isinstance(duration.value, bool)
+    )
+
+
 def duration_problem(duration: object) -> str | None:
     """What keeps `duration` from being a period or timeout, in words, or None: a unit other than
     `s`, `ms`, `us`, no number, or a length under 1 ns (time is kept in whole nanoseconds) or over
