@@ -6,6 +6,7 @@ text, not crash the checker or go into the run's generated code."""
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import os
 import re
@@ -1001,3 +1002,114 @@ def test_to_earl_refuses_a_priority_check_refuses_rather_than_write_text_that_do
     assert [d.code for d in check(_edited_counter(edit)) if d.severity is earl.Severity.ERROR] == ["EARL-R033"]
     with pytest.raises(earl.ModelTypeError, match=r"transitions\[0\]\.priority: expected int \| None, got bool"):
         _edited_counter(edit).to_earl()
+
+
+LINKED = """\
+system linked
+
+param W: int = 2
+
+struct Tick {
+    count: int
+}
+
+counter[K in 1..W]/a {
+    cs {
+        period 10 ms
+        tick/ob: Tick
+    }
+}
+
+display/a {
+    cs {
+        period 10 ms
+        tick[K in 1..W]/ib: Tick
+    }
+}
+
+link counter[K in 1..W],display: counter[K]/a.cs.tick -> display/a.cs.tick[K]
+
+fleet/r {
+    counter[*]/a
+    display/a
+    link counter[K in 1..W],display
+}
+"""
+
+
+def _errors_of(system: Any) -> list[tuple[str | None, str]]:
+    return [(d.code, d.message) for d in check(system) if d.severity is earl.Severity.ERROR]
+
+
+@pytest.mark.parametrize(
+    ("edit", "message"),
+    [
+        (
+            lambda s: setattr(s.robots[0], "agents", [ElementReference("display", Kind.ROBOT)]),
+            "an agent of robot `fleet/r` is `display/r`, of kind `/r` (Robot); it must be `/a` (Agent)",
+        ),
+        (
+            lambda s: setattr(s.robots[0], "links", [ElementReference("counter[K in 1..W],display", Kind.AGENT)]),
+            "a link of robot `fleet/r` is `counter[K in 1..W],display/a`, of kind `/a` (Agent); it must be `/aa`",
+        ),
+        (
+            lambda s: setattr(
+                s.links[0], "source", dataclasses.replace(s.links[0].source, agent=ElementReference("counter", "r"))
+            ),
+            "the source agent of link `counter[K in 1..W],display` is `counter/r`, of kind `/r` (Robot)",
+        ),
+        (
+            lambda s: setattr(
+                s.links[0],
+                "destination",
+                dataclasses.replace(s.links[0].destination, buffer=ElementReference("tick", "mi")),
+            ),
+            "the destination buffer of link `counter[K in 1..W],display` is `tick/mi`",
+        ),
+    ],
+)
+def test_a_robot_member_or_link_end_of_the_wrong_kind_is_r021_not_text_that_does_not_load(
+    edit: Callable[[Any], None], message: str
+) -> None:
+    system = earl.loads(LINKED)
+    assert _errors_of(system) == []
+    edit(system)
+    [(code, said)] = _errors_of(system)
+    assert code == "EARL-R021" and said.startswith(message), said
+
+
+def test_a_robot_member_whose_kind_is_no_kind_is_a_model_type_error() -> None:
+    system = earl.loads(LINKED)
+    system.robots[0].agents = [ElementReference("display", "agent")]  # type: ignore[arg-type]
+    with pytest.raises(earl.ModelTypeError, match=r"^system\.robots\[0\]\.agents\[0\]\.kind: expected Kind"):
+        check(system)
+
+
+def test_a_robot_naming_a_link_family_with_an_index_is_r057_as_the_index_would_be_dropped() -> None:
+    system = earl.loads(LINKED)
+    system.robots[0].links = [ElementReference("counter[K in 1..W],display", Kind.INTER_AGENT_LINK, (earl.Star(),))]
+    [(code, said)] = _errors_of(system)
+    assert code == "EARL-R057" and "names the link `counter[K in 1..W],display` with indices" in said
+    # as documented in python-api.md: the family named whole, as it is declared
+    system.robots[0].links = [ElementReference("counter[K in 1..W],display", Kind.INTER_AGENT_LINK)]
+    assert _errors_of(system) == [] and earl.loads(system.to_earl()) == system
+
+
+@pytest.mark.parametrize("parts", [(), ("counter", "display", "x")])
+def test_a_link_name_of_other_than_one_or_two_parts_is_r058(parts: tuple[str, ...]) -> None:
+    system = earl.loads(LINKED)
+    system.links[0].name = tuple(LinkNamePart(part) for part in parts)
+    system.robots[0].links = []  # which named it
+    [(code, said)] = _errors_of(system)
+    assert code == "EARL-R058" and f"has {len(parts)} parts to its name" in said
+
+
+def test_a_system_without_a_name_is_r006() -> None:
+    system = earl.loads(LINKED)
+    system.name = ""
+    assert _errors_of(system) == [
+        (
+            "EARL-R006",
+            "the system has no name: the text would start without its `system` line, which a specification needs",
+        )
+    ]

@@ -84,5 +84,6 @@ READING_CODES: dict[str, str] = {
     "EARL-R054": "a link naming an undeclared buffer, or one of the wrong direction",
     "EARL-R055": "a robot and an agent with the same name",
     "EARL-R056": "a robot naming an undeclared agent",
-    "EARL-R057": "a robot naming an undeclared link",
+    "EARL-R057": "a robot naming an undeclared link, or a link with indices (a model built in Python)",
+    "EARL-R058": "a link whose name has not one or two parts (a model built in Python)",
 }

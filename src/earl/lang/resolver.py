@@ -272,6 +272,13 @@ class Resolver:
         would write text that does not load."""
         for name, what, location, _ in unreadable_names(self.system):
             self._unreadable(name, what, location)
+        if self.system.name == "":  # only `System("")`: the reader refuses a specification without its name
+            self.error(
+                "the system has no name: the text would start without its `system` line, which a specification needs",
+                self.system.location,
+                "EARL-R006",
+                'name it, e.g. `System("demo", …)`',
+            )
 
     def _comments(self) -> None:
         """EARL-R007: a comment `.earl` text cannot hold (`/* x */`, two lines); only a model built in Python
@@ -285,6 +292,23 @@ class Resolver:
                 "EARL-R007",
                 'a comment is one line starting with `//` ("" for a blank line); write one string per line',
             )
+
+    def _of_kind(self, reference: ElementReference, kind: Kind, what: str) -> bool:
+        """Whether `reference` (a robot's member, a link's end: only a model built in Python can hold another
+        kind there, and the text, which writes the kind, would not load or would read back as `kind`) is of
+        `kind`; EARL-R021 if not. A kind that is no Kind (`"agent"`) is a ModelTypeError at its path."""
+        if reference.kind is kind:
+            return True
+        if not isinstance(reference.kind, Kind):
+            raise TypeError(f"not a Kind: {reference.kind!r}")  # `explaining` names it at its path
+        self.error(
+            f"{what} is `{reference_text(reference)}`, of kind `/{reference.kind.value}` ({KIND_TITLES[reference.kind]});"
+            f" it must be `/{kind.value}` ({KIND_TITLES[kind]})",
+            reference.location,
+            "EARL-R021",
+            f'write `ElementReference("{reference.name}", Kind.{kind.name})`',
+        )
+        return False
 
     def _unreadable(self, name: object, what: str, location: SourceLocation | None) -> None:
         """EARL-R006 of one name."""
@@ -1469,6 +1493,15 @@ class Resolver:
         #: each link's name once its family is expanded (`cs,mc[2]`), and the declaration that gives it
         members: dict[str, Link] = {}
         for link in links:
+            if not 1 <= len(link.name) <= 2:  # only a model built in Python: `link :` and `link a,b,c:` do not read
+                self.error(
+                    f"link `{link.name_text}` has {len(link.name)} parts to its name; a link is named by one or two"
+                    " (`source,destination`, §2.5)",
+                    link.location,
+                    "EARL-R058",
+                    "name it after its ends, e.g. `(LinkNamePart(SOURCE), LinkNamePart(DESTINATION))`",
+                )
+                continue
             name = link.name_text
             if name in names:
                 self.duplicate(
@@ -1502,6 +1535,12 @@ class Resolver:
 
     def _link_end(self, link: Link, end: LinkEnd, scope: Scope, agent: _AgentTable | None, kind: Kind) -> None:
         role = "source" if kind is Kind.OUTPUT_BUFFER else "destination"
+        if not self._of_kind(end.buffer, kind, f"the {role} buffer of link `{link.name_text}`"):
+            return
+        if end.agent is not None and not self._of_kind(
+            end.agent, Kind.AGENT, f"the {role} agent of link `{link.name_text}`"
+        ):
+            return
         if agent is None:
             if end.agent is None:
                 self.error(
@@ -1589,6 +1628,8 @@ class Resolver:
             if robot.name in self.agents:
                 self.error(f"`{robot.name}` names both a robot and an agent", robot.location, "EARL-R055")
             for reference in robot.agents:
+                if not self._of_kind(reference, Kind.AGENT, f"an agent of robot `{robot.name}/r`"):
+                    continue
                 table = self.agents.get(reference.name)
                 if table is None:
                     self.error(
@@ -1600,6 +1641,18 @@ class Resolver:
                     continue
                 self._indices(reference, table.family, scope, star=True)
             for reference in robot.links:
+                if not self._of_kind(reference, Kind.INTER_AGENT_LINK, f"a link of robot `{robot.name}/r`"):
+                    continue
+                if reference.indices:  # only a model built in Python: `link NAME` has none, they were dropped
+                    self.error(
+                        f"robot `{robot.name}/r` names the link `{reference.name}` with indices; a robot names a"
+                        " link, or a link family whole, by its name as declared",
+                        reference.location,
+                        "EARL-R057",
+                        f'write `ElementReference("{families.get(_without_indices(reference.name), reference.name)}",'
+                        " Kind.INTER_AGENT_LINK)`",
+                    )
+                    continue
                 if reference.name not in links:
                     family = families.get(_without_indices(reference.name))
                     self.error(
