@@ -1113,3 +1113,19 @@ def test_a_system_without_a_name_is_r006() -> None:
             "the system has no name: the text would start without its `system` line, which a specification needs",
         )
     ]
+
+
+def test_a_control_subsystem_named_otherwise_than_cs_is_r008_and_not_saved_as_cs() -> None:
+    """`ControlSubsystem("main", …)` checked clean, and was saved as `cs`: a link naming `cs` was refused by check
+    (`task/a` has no subsystem `cs`) and one naming `main` did not read back."""
+    system = earl.loads(LINKED)
+    system.agents[1].subsystems[0].name = "main"
+    assert _errors_of(system) == [
+        (
+            "EARL-R008",
+            "the Control Subsystem of `display/a` is named 'main'; an agent's Control Subsystem is called `cs` (§2.2)"
+            " and is saved so",
+        )
+    ]
+    with pytest.raises(earl.ModelNameError, match=r"^system\.agents\[1\]\.subsystems\[0\]\.name: 'main'"):
+        system.to_earl()

@@ -44,6 +44,7 @@ READING_CODES: dict[str, str] = {
     "EARL-R005": "a parameter value of the wrong type",
     "EARL-R006": "a declared name that is not an EARL name, or a keyword where it stands (a model built in Python)",
     "EARL-R007": "a comment that is not one `//` line (a model built in Python)",
+    "EARL-R008": "a Control Subsystem named other than `cs` (a model built in Python)",
     "EARL-R010": "a primitive type redefined",
     "EARL-R011": "a type that contains itself",
     "EARL-R012": "an unknown data type",

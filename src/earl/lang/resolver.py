@@ -903,6 +903,17 @@ class Resolver:
         agents = _size(family)
         for subsystem in agent.subsystems:
             key = (subsystem.name, subsystem.kind)
+            if subsystem.kind is Kind.CONTROL_SUBSYSTEM and subsystem.name != "cs":
+                # `ControlSubsystem("main", …)`: the text writes `cs`, the manual's name for it, and the
+                # reload's is `cs`; links name it `cs` too, so it is known by that name from here on
+                self.error(
+                    f"the Control Subsystem of `{agent.name}/a` is named {subsystem.name!r}; an agent's Control"
+                    " Subsystem is called `cs` (§2.2) and is saved so",
+                    subsystem.location,
+                    "EARL-R008",
+                    "leave the name out: `ControlSubsystem(period=…, …)`",
+                )
+                key = ("cs", subsystem.kind)
             if key in table.subsystems:
                 self._place = f"`{agent.name}/a`"  # not the subsystem declared before it
                 what = (

@@ -648,6 +648,13 @@ class System:
                 else "no EARL name (a letter or `_`, then letters, digits and `_`)"
             )
             raise ModelNameError(f"{path}: {name!r} ({what}) is {why}: the text would not read back; rename it")
+        for i, agent in enumerate(self.agents):
+            for j, subsystem in enumerate(agent.subsystems):
+                if isinstance(subsystem, ControlSubsystem) and subsystem.name != "cs":  # the text writes `cs`
+                    raise ModelNameError(
+                        f"system.agents[{i}].subsystems[{j}].name: {subsystem.name!r} (the Control Subsystem of"
+                        f" `{agent.name}/a`) would be saved as `cs`, its name in the manual (§2.2); leave the name out"
+                    )
         from earl.model.comment_text import unwritable_comments
         from earl.model.validate import ModelCommentError
 
