@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import ClassVar
 
+from earl.model.equality import sequences_compare_equal
 from earl.model.expressions import PYTHON_PREDICATE, Call, ElementReference, Expression, Read, Star
 from earl.model.frozen import quick_init
 from earl.model.kinds import Kind
@@ -675,3 +676,21 @@ class System:
             if where is None:
                 raise
             raise ValueError(f"{where}: {error}") from error
+
+
+# the classes holding lists: a list and a tuple of the same items are equal in them (earl/model/equality.py)
+for _class in (
+    PrimitivePredicate,
+    PartialTransitionFunction,
+    StageSet,
+    TransitionFunction,
+    State,
+    FSM,
+    Subsystem,
+    *SUBSYSTEM_CLASSES.values(),
+    Link,
+    Agent,
+    Robot,
+    System,
+):
+    sequences_compare_equal(_class)

@@ -47,6 +47,8 @@ class ElementReference:
             kind = Kind._value2member_map_.get(self.kind)
             if kind is not None:
                 object.__setattr__(self, "kind", kind)
+        if isinstance(self.indices, list):  # given in Python: a tuple as the reader makes it, equal to it and hashable
+            object.__setattr__(self, "indices", tuple(self.indices))
 
     @property
     def is_family_wide(self) -> bool:
@@ -69,6 +71,10 @@ class ListLiteral:
 
     items: tuple[Expression, ...]
     location: SourceLocation | None = location_field()
+
+    def __post_init__(self) -> None:
+        if isinstance(self.items, list):  # given in Python: a tuple as the reader makes it, equal to it and hashable
+            object.__setattr__(self, "items", tuple(self.items))
 
 
 @quick_init
@@ -111,6 +117,10 @@ class Read:
     path: tuple[Accessor, ...] = ()
     location: SourceLocation | None = location_field()
 
+    def __post_init__(self) -> None:
+        if isinstance(self.path, list):  # given in Python: a tuple as the reader makes it, equal to it and hashable
+            object.__setattr__(self, "path", tuple(self.path))
+
 
 @quick_init
 @dataclass(frozen=True, slots=True)
@@ -120,6 +130,11 @@ class Call:
     function: str
     arguments: tuple[Expression, ...]
     location: SourceLocation | None = location_field()
+
+    def __post_init__(self) -> None:
+        # given in Python: a tuple as the reader makes it, equal to it and hashable
+        if isinstance(self.arguments, list):
+            object.__setattr__(self, "arguments", tuple(self.arguments))
 
 
 @quick_init
@@ -147,6 +162,10 @@ class BooleanOperation:
     #: in an expanded system, the `any`/`all` this operation unrolls (one operand per index value), so
     #: that a message can speak of what was written; no part of the operation's meaning
     unrolled: Quantifier | None = field(default=None, compare=False, repr=False)
+
+    def __post_init__(self) -> None:
+        if isinstance(self.operands, list):  # given in Python: a tuple as the reader makes it, equal to it and hashable
+            object.__setattr__(self, "operands", tuple(self.operands))
 
 
 @quick_init

@@ -7,6 +7,7 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
+from earl.model.equality import sequences_compare_equal
 from earl.model.expressions import Expression
 from earl.model.frozen import quick_init
 from earl.model.location import Comments, SourceLocation, comments_field, location_field
@@ -221,3 +222,7 @@ def refuse_wrong_parameters(parameters: object) -> None:
         # a value of the wrong type is EARL-R005, said with the parameter's declared type
         if not isinstance(name, str):
             raise TypeError(f"a parameter is named by a str, e.g. {{'N': 3}}, not {type(name).__name__} {name!r:.60}")
+
+
+# a list and a tuple of the same fields are equal (earl/model/equality.py)
+sequences_compare_equal(StructType)
