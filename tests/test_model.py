@@ -448,3 +448,17 @@ def test_a_list_where_a_class_declares_a_tuple_or_the_reverse_is_the_same_model_
     # what differs still differs
     behaviour.transition_function.stages = [*behaviour.transition_function.stages, []]
     assert system != read_back
+
+
+def test_literals_of_different_types_are_different_though_python_takes_true_for_1() -> None:
+    """`Literal(True) == Literal(1)` held (Python's `True == 1`): a Boolean predicate and a number one, which
+    check tells apart, were the same model, and one could stand for the other in a cache."""
+    for left, right in [(True, 1), (0, False), (1, 1.0), (1.0, True)]:
+        assert Literal(left) != Literal(right)
+        assert len({Literal(left), Literal(right)}) == 2
+    assert Literal(2) == Literal(2) and hash(Literal("a")) == hash(Literal("a"))
+    system = earl.load(EXAMPLE)
+    text = system.to_earl()
+    assert "= false\n" in text
+    other = earl.loads(text.replace("= false\n", "= 0\n", 1))
+    assert other != system

@@ -63,6 +63,17 @@ class Literal:
     value: bool | int | float | str
     location: SourceLocation | None = location_field()
 
+    # `true` and `1`, `0` and `false`, `1` and `1.0` are different literals, of different types, but Python
+    # takes `True == 1` and `1 == 1.0`: two models differing only there compared equal (and hashed alike)
+    def __eq__(self, other: object) -> bool:
+        if other.__class__ is not Literal:
+            return NotImplemented
+        value = other.value  # type: ignore[attr-defined]
+        return self.value.__class__ is value.__class__ and (self.value is value or self.value == value)
+
+    def __hash__(self) -> int:
+        return hash((self.value.__class__, self.value))
+
 
 @quick_init
 @dataclass(frozen=True, slots=True)
