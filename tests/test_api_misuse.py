@@ -1129,3 +1129,23 @@ def test_a_control_subsystem_named_otherwise_than_cs_is_r008_and_not_saved_as_cs
     ]
     with pytest.raises(earl.ModelNameError, match=r"^system\.agents\[1\]\.subsystems\[0\]\.name: 'main'"):
         system.to_earl()
+
+
+def test_an_import_added_in_python_is_said_not_to_be_read(tmp_path: Path) -> None:
+    """`System(imports=[Import("types.earl")])`: check and the run said only `unknown data type `Tick``, whatever
+    the working directory, while the saved text loaded (and read back with the file's declarations)."""
+    (tmp_path / "types.earl").write_text("struct Tick {\n    count: int\n}\n")
+    system = earl.loads(LINKED)
+    system.types.clear()
+    system.imports.append(earl.Import("types.earl"))
+    errors = _errors_of(system)
+    assert errors[0] == (
+        "EARL-R009",
+        'system.imports[0]: `import "types.earl"` in a model built in Python is not read: what that file declares'
+        " is not in this model, which check and the run see as it is",
+    )
+    [said] = [d for d in check(system) if d.code == "EARL-R009"]
+    assert "earl.load" in (said.hint or "")
+    # as the hint says: saved and loaded, the import is read next to the file
+    earl.save(system, tmp_path / "system.earl")
+    assert _errors_of(earl.load(tmp_path / "system.earl")) == []

@@ -45,6 +45,7 @@ READING_CODES: dict[str, str] = {
     "EARL-R006": "a declared name that is not an EARL name, or a keyword where it stands (a model built in Python)",
     "EARL-R007": "a comment that is not one `//` line (a model built in Python)",
     "EARL-R008": "a Control Subsystem named other than `cs` (a model built in Python)",
+    "EARL-R009": "an import in a model built in Python, which is not read (save the model and load it)",
     "EARL-R010": "a primitive type redefined",
     "EARL-R011": "a type that contains itself",
     "EARL-R012": "an unknown data type",

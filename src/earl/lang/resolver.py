@@ -252,6 +252,7 @@ class Resolver:
                     did_you_mean(name, known) or f"system parameters: {', '.join(known) or 'none'}",
                 )
         self._names()
+        self._imports()
         if not self.comments_from_text:
             self._comments()
         self._types(scope)
@@ -279,6 +280,22 @@ class Resolver:
                 "EARL-R006",
                 'name it, e.g. `System("demo", …)`',
             )
+
+    def _imports(self) -> None:
+        """EARL-R009: an import added in Python (it has no location: the reader's have theirs). What an imported
+        file declares is merged into the model as the file is read; a System built in Python holds its
+        `Import` alone, so check and the run would not know the file's declarations, and the saved text, read
+        back, would hold them."""
+        for position, declaration in enumerate(self.system.imports):
+            if declaration.location is None:
+                self.error(
+                    f'system.imports[{position}]: `import "{declaration.path}"` in a model built in Python is not'
+                    " read: what that file declares is not in this model, which check and the run see as it is",
+                    None,
+                    "EARL-R009",
+                    'save the model and load it, `earl.save(system, "system.earl")` then `earl.load("system.earl")`:'
+                    " the import is read next to the saved file; or put the declarations in the System itself",
+                )
 
     def _comments(self) -> None:
         """EARL-R007: a comment `.earl` text cannot hold (`/* x */`, two lines); only a model built in Python
