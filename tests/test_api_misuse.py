@@ -83,6 +83,9 @@ NEVER = Read(ElementReference("never", Kind.PRIMITIVE_PREDICATE))
             "EARL has `+`, `-`, `*`",
         ),
         (Quantifier("some", "K", Literal(1), Literal(2), NEVER), "`some` is no quantifier of EARL", None),
+        # to_earl wrote the operand alone, which read back as no operation
+        (BooleanOperation("and", (NEVER,)), "`and` over 1 operand; it takes two or more", None),
+        (BooleanOperation("or", ()), "`or` over 0 operands; it takes two or more", None),
     ],
 )
 def test_an_operator_the_language_does_not_have_is_r047(condition: Any, message: str, hint: str | None) -> None:

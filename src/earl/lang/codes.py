@@ -76,7 +76,8 @@ READING_CODES: dict[str, str] = {
     "EARL-R044": "a field read from something that is not a struct",
     "EARL-R045": "a field the struct does not have",
     "EARL-R046": "an index into something that is not an array",
-    "EARL-R047": "an operator or quantifier EARL does not have (a model built in Python)",
+    "EARL-R047": "an operator or quantifier EARL does not have, or `and`/`or` over fewer than two operands"
+    " (a model built in Python)",
     "EARL-R048": "a primitive predicate with an `implementation` whose expression is not `python(…)` over its"
     " `reads` (a model built in Python)",
     "EARL-R050": "an inter-agent link end without its agent",

@@ -33,6 +33,7 @@ from earl.model.expressions import (
     BUILTIN_FUNCTIONS,
     COMPARISON_OPERATORS,
     PYTHON_PREDICATE,
+    BooleanOperation,
     Call,
     ConstantError,
     ElementReference,
@@ -1474,6 +1475,15 @@ class Resolver:
                 node.location,
                 "EARL-R047",
                 did_you_mean(str(operator), known) or f"EARL has {', '.join(f'`{k}`' for k in known)}",
+            )
+        elif isinstance(node, BooleanOperation) and len(node.operands) < 2:
+            # `BooleanOperation("and", (a,))`: the text writes `a` alone, which reads back as no operation
+            self.error(
+                f"`{operator}` over {len(node.operands)} operand{'' if len(node.operands) == 1 else 's'}; it takes"
+                " two or more",
+                node.location,
+                "EARL-R047",
+                "write the operand itself for one" if node.operands else "write `Literal(True)` or `Literal(False)`",
             )
 
     def _path(self, read: Read, declared: _Declared, scope: Scope) -> None:
