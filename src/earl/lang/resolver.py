@@ -1429,9 +1429,14 @@ class Resolver:
                     "`python(…)` is no function of a condition",
                     node.location,
                     "EARL-R040",
-                    'a predicate computed by Python is declared `NAME/pp(READS) = python "MODULE:FUNCTION"` '
-                    '(in Python, `PrimitivePredicate.python(NAME, READS, "MODULE:FUNCTION")`), '
-                    "and named in conditions as `NAME/pp`",
+                    'a predicate computed by Python is declared `NAME/pp(READS) = python "MODULE:FUNCTION"`, '
+                    "and named in conditions as `NAME/pp`"
+                    # built in Python (no location): how to build one there
+                    + (
+                        '; in Python, `PrimitivePredicate.python(NAME, READS, "MODULE:FUNCTION")`'
+                        if node.location is None
+                        else ""
+                    ),
                 )
                 continue
             if isinstance(node, Call):
