@@ -35,6 +35,7 @@ def _encode(root: object, write: Any) -> None:
             write(value.text)
         elif isinstance(value, (int, float)) and not isinstance(value, bool):
             # a number by its value, as `==` compares it: `period 10 ms` and `period 10.0 ms` are one system
+            # (a Literal compares its type too, `1` and `1.0`: unequal models, but one value where they run)
             whole = isinstance(value, int) or value.is_integer()
             write(f"number:{int(value) if whole else repr(value)};".encode())
         elif value is None or isinstance(value, (bool, str, bytes)):
