@@ -354,6 +354,8 @@ def test_a_python_predicates_family_read_without_an_index_is_told_to_write_star(
     (problem,) = refused.value.diagnostics
     assert problem.code == "EARL-R024"
     assert problem.hint == "write `x[1]/mi`, or `x[*]/mi` for every member"
+
+
 def _with_big(tmp_path: Path, predicate: earl.PrimitivePredicate) -> earl.System:
     system = earl.load(write(tmp_path))
     subsystem = system.agent("counter").control_subsystem  # type: ignore[union-attr]
