@@ -141,6 +141,34 @@ class Case:
     passing: str
 
 
+def ping_pong(a2_period: bool) -> str:
+    """BASE with a link back from a2 to a1, each waiting for the other's message, a1 without a period and a2
+    with one or without: each message wakes the other at once (EARL-W018) when neither has one."""
+    return edit(
+        ("    cs { period 1 ms\n        out/ob: double", "    cs {\n        back/ib: double\n        out/ob: double"),
+        (
+            "            state run: run/bb\n            run -> run when go/pp",
+            "            state run: run/bb { obligatory back/ib }\n            run -> run when go/pp",
+        ),
+        (
+            "    cs { period 1 ms\n        inp/ib: double\n",
+            ("    cs { period 1 ms\n" if a2_period else "    cs {\n")
+            + "        inp/ib: double\n        ret/ob: double\n",
+        ),
+        ("        take/pf(inp/ib -> y/mo)\n", "        take/pf(inp/ib -> y/mo)\n        give/pf(y/mi -> ret/ob)\n"),
+        ("            tf = {take/pf}\n", "            tf = {take/pf} then {give/pf}\n"),
+        (
+            "            state run: run/bb\n            run -> run when got/pp",
+            "            state run: run/bb { obligatory inp/ib }\n            run -> run when got/pp",
+        ),
+        (
+            "link a1,a2: a1/a.cs.out -> a2/a.cs.inp\n",
+            "link a1,a2: a1/a.cs.out -> a2/a.cs.inp\nlink a2,a1: a2/a.cs.ret -> a1/a.cs.back\n",
+        ),
+        ("    link a1,a2\n}", "    link a1,a2\n    link a2,a1\n}"),
+    )
+
+
 def optional_speed(terminal_condition: str) -> str:
     """BASE with the link's messages a struct of one optional field, and a2's `tc` reading it."""
     return add(
@@ -688,6 +716,15 @@ CASES: list[Case] = [
                 "            state run: run/bb { obligatory inp/ib }\n            run -> run when got/pp",
             ),
         ),
+    ),
+    Case(
+        "EARL-W018",
+        ping_pong(a2_period=False),
+        17,
+        13,
+        "subsystems without a `period` wait for each other in a cycle, each message starting the next iteration "
+        "at once: a1/a.cs in state `run` → a2/a.cs in state `run` → a1/a.cs in state `run`",
+        ping_pong(a2_period=True),
     ),
     Case(
         "EARL-W022",

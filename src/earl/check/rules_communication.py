@@ -9,7 +9,7 @@ from operator import attrgetter
 from earl.check.context import CheckContext, ResolvedLink
 from earl.check.registry import Finding, rule
 from earl.diagnostics import Severity
-from earl.model.elements import Link, LinkNamePart, default_link_name
+from earl.model.elements import Agent, Link, LinkNamePart, State, Subsystem, default_link_name
 from earl.model.kinds import KIND_TITLES, Kind
 from earl.model.tables import PERMITTED_LINKS, permitted_link
 from earl.model.text import expression_text, instance_name, subsystem_name
@@ -300,6 +300,177 @@ def every_state_is_paced(context: CheckContext) -> Iterator[Finding]:
                     "give the subsystem a `period` (`period 10 ms`), or list the buffers the state waits for: "
                     f"`state {state.name}: {state.behaviour}/bb {{ obligatory {example}/ib }}`",
                 )
+
+
+#: a state of an expanded subsystem: (id of the subsystem, the state's name)
+_StateNode = tuple[int, str]
+
+
+@rule(
+    "EARL-W018",
+    Severity.WARNING,
+    "subsystems without a period do not wake each other at once, for ever",
+    "§2.2, Figure 5b",
+)
+def zero_time_cycles(context: CheckContext) -> Iterator[Finding]:
+    """A subsystem without a `period` is paced by its obligatory Input Buffers alone (EARL-E017): each
+    iteration waits for their messages. When such subsystems wait for each other in a cycle of links,
+    each state's obligatory buffers fed only by states of the cycle that send to them, every message
+    starts the next iteration in the same instant, and run time never passes: `earl run` ends such a
+    run with a `zero-time-loop` fault once a subsystem has iterated 10,000 times in one instant
+    (docs/semantics.md). A state's `timeout` does not break the cycle, since a message that comes ends
+    the wait at once; a `period` on one of the subsystems does. What the check cannot know: whether a
+    function declared to write an Output Buffer writes it in every iteration (a buffer not written is not
+    sent), nor whether the subsystems are ever in the states of the cycle at the same time; it warns of
+    every cycle of states that could loop so, once per cycle, at the state the cycle is told from."""
+    periodless = [
+        (agent, subsystem)
+        for agent, subsystem in context.subsystems()
+        if subsystem.period is None and subsystem.fsm is not None
+    ]
+    if not periodless:
+        return
+    states: dict[_StateNode, tuple[Agent, Subsystem, State]] = {}
+    for agent, subsystem in periodless:
+        assert subsystem.fsm is not None
+        for state in subsystem.fsm.states:
+            states[(id(subsystem), state.name)] = (agent, subsystem, state)
+    # per state, per obligatory buffer: the states of period-less subsystems that may send into it
+    senders: dict[_StateNode, list[set[_StateNode]]] = {}
+    for node, (_, subsystem, state) in states.items():
+        if not state.obligatory:
+            continue  # EARL-E017's
+        buffers = []
+        for reference in state.obligatory:
+            buffer = context.input_buffer(subsystem, reference)
+            if buffer is None:
+                continue
+            buffers.append(
+                {
+                    sender
+                    for link in context.links_into.get(id(buffer), ())
+                    if link.source_subsystem.period is None and link.source_subsystem.fsm is not None
+                    for sender in _states_sending(link)
+                }
+            )
+        if buffers:
+            senders[node] = buffers
+    # Only states whose every obligatory buffer some state of the set sends to can be woken at once by
+    # the set alone: drop the others until none is left to drop (one fed by a subsystem with a period,
+    # or by no link, waits for it).
+    alive = set(senders)
+    changed = True
+    while changed:
+        changed = False
+        for node in list(alive):
+            if any(not (fed & alive) for fed in senders[node]):
+                alive.discard(node)
+                changed = True
+    wakes: dict[_StateNode, list[_StateNode]] = defaultdict(list)
+    for node in alive:
+        for sender in set().union(*senders[node]) & alive:
+            wakes[sender].append(node)
+    order = {node: position for position, node in enumerate(states)}
+    for component in _cycles(sorted(alive, key=order.__getitem__), wakes):
+        cycle = _cycle_through(component[0], set(component), wakes, order)
+        names = [f"{subsystem_name(states[node][0], states[node][1])} in state `{node[1]}`" for node in cycle]
+        first = states[cycle[0]][2]
+        yield Finding(
+            "subsystems without a `period` wait for each other in a cycle, each message starting the next "
+            f"iteration at once: {' → '.join(names + names[:1])}; run time would never pass (`earl run` "
+            "ends such a run, a `zero-time-loop` fault)",
+            first.location,
+            "give one of them a `period` (`period 10 ms`)",
+        )
+
+
+def _states_sending(link: ResolvedLink) -> Iterator[_StateNode]:
+    """The states of the link's source whose behaviour declares a function writing the link's Output Buffer."""
+    subsystem = link.source_subsystem
+    assert subsystem.fsm is not None
+    name = link.source_buffer.name
+    writers = {
+        function.name
+        for function in subsystem.partial_transition_functions
+        if any(write.kind is Kind.OUTPUT_BUFFER and write.name == name for write in function.writes)
+    }
+    for state in subsystem.fsm.states:
+        behaviour = subsystem.basic_behaviour(state.behaviour)
+        if behaviour is not None and any(
+            function.name in writers for function in behaviour.transition_function.partial_transition_functions
+        ):
+            yield (id(subsystem), state.name)
+
+
+def _cycles(nodes: list[_StateNode], edges: dict[_StateNode, list[_StateNode]]) -> list[list[_StateNode]]:
+    """The strongly connected components of `nodes` that hold a cycle (Tarjan's, without recursion), each in
+    the order of `nodes`, in the order of their first node."""
+    position = {node: index for index, node in enumerate(nodes)}
+    index: dict[_StateNode, int] = {}
+    low: dict[_StateNode, int] = {}
+    stack: list[_StateNode] = []
+    on_stack: set[_StateNode] = set()
+    found: list[list[_StateNode]] = []
+    for root in nodes:
+        if root in index:
+            continue
+        work = [(root, iter(edges.get(root, ())))]
+        index[root] = low[root] = len(index)
+        stack.append(root)
+        on_stack.add(root)
+        while work:
+            node, successors = work[-1]
+            for successor in successors:
+                if successor not in index:
+                    index[successor] = low[successor] = len(index)
+                    stack.append(successor)
+                    on_stack.add(successor)
+                    work.append((successor, iter(edges.get(successor, ()))))
+                    break
+                if successor in on_stack:
+                    low[node] = min(low[node], index[successor])
+            else:
+                work.pop()
+                if work:
+                    low[work[-1][0]] = min(low[work[-1][0]], low[node])
+                if low[node] == index[node]:
+                    component = []
+                    while True:
+                        member = stack.pop()
+                        on_stack.discard(member)
+                        component.append(member)
+                        if member == node:
+                            break
+                    if len(component) > 1 or node in edges.get(node, ()):
+                        found.append(sorted(component, key=position.__getitem__))
+    return sorted(found, key=lambda component: position[component[0]])
+
+
+def _cycle_through(
+    start: _StateNode,
+    component: set[_StateNode],
+    edges: dict[_StateNode, list[_StateNode]],
+    order: dict[_StateNode, int],
+) -> list[_StateNode]:
+    """A shortest cycle from `start` back to it within `component` (breadth first, successors in order)."""
+    came_from: dict[_StateNode, _StateNode] = {}
+    frontier = [start]
+    while frontier:
+        following = []
+        for node in frontier:
+            for successor in sorted(edges.get(node, ()), key=order.__getitem__):
+                if successor not in component:
+                    continue
+                if successor == start:
+                    path = [node]
+                    while path[-1] != start:
+                        path.append(came_from[path[-1]])
+                    return path[::-1]
+                if successor not in came_from:
+                    came_from[successor] = node
+                    following.append(successor)
+        frontier = following
+    return [start]
 
 
 @rule("EARL-W011", Severity.WARNING, "every Input Buffer is fed by a link", "§2.2, §2.3")

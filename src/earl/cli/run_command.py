@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import _thread
 import argparse
 import contextlib
 import gc
@@ -10,6 +11,7 @@ import re
 import signal
 import statistics
 import sys
+import threading
 import time
 import warnings
 from collections.abc import Callable, Iterator
@@ -65,12 +67,14 @@ code a spec names (docs/runtime.md).
 
 exit codes: 0 the run completed (or the spec's code called sys.exit(0)), 1 invalid spec,
             the run could not start, its trace could not be written (a full disk), the
-            environment failed, the spec's code called sys.exit with a failure, or the --plot
+            environment failed, subsystems without a period woke each other for ever in one
+            instant (a zero-time-loop), the spec's code called sys.exit with a failure, or the --plot
             or run.toml's report asked for failed at the end (the run and its trace are
             whole); with --transport zenoh also when a link's messages were refused for
             another data type (the run goes on, and names the links at its end),
             2 usage error (an option, or a run.toml that cannot be used), 130
-            interrupted (the trace is closed and readable)
+            interrupted (the trace is closed and readable): Ctrl-C, SIGTERM or SIGHUP stop
+            after the instant running, or inside it when it has not ended 2 s later
 """
 
 
@@ -483,6 +487,8 @@ class _StopRequest:
     requested = False
     #: whether a Ctrl-C (SIGINT) asked: a second one stops at once
     by_ctrl_c = False
+    #: whether the instant running outlasted STOP_INSIDE_AFTER: the run is stopped inside it
+    forced = False
 
 
 @contextlib.contextmanager
@@ -513,16 +519,43 @@ def _stopped_like_ctrl_c() -> Iterator[_StopRequest]:
         yield request
 
 
+#: seconds the instant running may go on after a stop signal before the run is stopped inside it (an
+#: instant that never ends: a function that never returns); less than `earl launch`'s STOP_GRACE, after
+#: which it kills the process, so that the trace is closed first
+STOP_INSIDE_AFTER = 2.0
+
+
 @contextlib.contextmanager
 def _stopped_between_instants() -> Iterator[_StopRequest]:
     """Ctrl-C, SIGTERM and SIGHUP ask the run to stop once the instant running has run to its end, so
     that every subsystem has run the same instants; a second Ctrl-C stops it at once, inside the instant
-    (a function that never returns). A repeated SIGTERM or SIGHUP is the same request: `timeout` sends
+    (a function that never returns), and so does the first signal once the instant has gone on for
+    STOP_INSIDE_AFTER seconds after it. A repeated SIGTERM or SIGHUP is the same request: `timeout` sends
     its SIGTERM to the run and again to the run's process group."""
     request = _StopRequest()
+    main = threading.get_ident()
+    #: held while the watcher signals the main thread, and taken to end: no signal after the handlers go
+    lock = threading.Lock()
+    ended = threading.Event()
+
+    def watch(number: int) -> None:
+        """Stop the run inside its instant if it has not stopped STOP_INSIDE_AFTER seconds after the request:
+        the same signal again, whose handler then raises (and again, should the spec's code swallow it)."""
+        while not ended.wait(STOP_INSIDE_AFTER):
+            with lock:
+                if ended.is_set():
+                    return
+                if not request.forced:
+                    request.forced = True
+                    with contextlib.suppress(OSError):
+                        os.write(2, b"earl run: the instant running has not ended; stopping inside it\n")
+                if hasattr(signal, "pthread_kill"):
+                    signal.pthread_kill(main, number)  # wakes a sleep too, as the signal itself did
+                else:  # Windows
+                    _thread.interrupt_main(signal.Signals(number))
 
     def stop(number: int, *_: object) -> None:
-        if request.requested and number == signal.SIGINT and request.by_ctrl_c:
+        if request.forced or (request.requested and number == signal.SIGINT and request.by_ctrl_c):
             raise KeyboardInterrupt
         request.by_ctrl_c = request.by_ctrl_c or number == signal.SIGINT
         if not request.requested:
@@ -531,9 +564,14 @@ def _stopped_between_instants() -> Iterator[_StopRequest]:
                 # `earl launch` stops its processes with SIGTERM: "Ctrl-C again" is advice for a terminal
                 said = b" (Ctrl-C again to stop at once)" if number == signal.SIGINT else b""
                 os.write(2, b"earl run: stopping after this instant" + said + b"\n")
+            threading.Thread(target=watch, args=(number,), name="earl-stop-watch", daemon=True).start()
 
     with handling_stop_signals(stop):
-        yield request
+        try:
+            yield request
+        finally:
+            with lock:
+                ended.set()
 
 
 def _close(transport: Any) -> None:
@@ -560,6 +598,7 @@ def _execute(
     report_name: str,
     path: Path,
 ) -> int:
+    from earl.runtime.scheduler import ZeroTimeLoop
     from earl.runtime.simulation import EnvironmentFailed
     from earl.runtime.trace import TraceWriteError
 
@@ -569,6 +608,7 @@ def _execute(
     failed: TraceWriteError | None = None
     exited: SystemExit | None = None
     broken: EnvironmentFailed | None = None
+    looped: ZeroTimeLoop | None = None
     from earl.cli import main as program
 
     if program.AS_PROGRAM:
@@ -588,6 +628,8 @@ def _execute(
         exited = request
     except EnvironmentFailed as error:  # the plant failed (a diverging simulation): the run ends there
         broken = error
+    except ZeroTimeLoop as error:  # subsystems without a period woke each other for ever: time cannot pass
+        looped = error
     finally:
         wall = time.perf_counter() - started
         try:
@@ -613,6 +655,9 @@ def _execute(
     delivered = plotted and reported
     if broken is not None:
         console.print(f"earl run: {brief(str(broken))} at {simulation.time:.3f} s; the run stopped there")
+        return EXIT_FAILED
+    if looped is not None:  # it says its run time
+        console.print(f"earl run: {looped}; the run stopped there")
         return EXIT_FAILED
     if interrupted:
         closed = "; the trace is closed" if arguments.trace else ""

@@ -15,10 +15,20 @@ from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from earl.runtime.events import Fault
+    from earl.runtime.scheduler import ZeroTimeLoop
     from earl.runtime.simulation import RecordingWarning, Simulation, SubsystemState, UnknownSubsystem, simulate
     from earl.runtime.values import Record
 
-__all__ = ["Fault", "Record", "RecordingWarning", "Simulation", "SubsystemState", "UnknownSubsystem", "simulate"]
+__all__ = [
+    "Fault",
+    "Record",
+    "RecordingWarning",
+    "Simulation",
+    "SubsystemState",
+    "UnknownSubsystem",
+    "ZeroTimeLoop",
+    "simulate",
+]
 
 _HOMES = {
     "Fault": "earl.runtime.events",
@@ -28,6 +38,7 @@ _HOMES = {
     "UnknownSubsystem": "earl.runtime.simulation",
     "SubsystemState": "earl.runtime.simulation",
     "simulate": "earl.runtime.simulation",
+    "ZeroTimeLoop": "earl.runtime.scheduler",
 }
 
 

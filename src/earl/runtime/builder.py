@@ -443,6 +443,7 @@ def _behaviour(
                 )
                 for _, transition in leaving
             ],
+            location=state.location,
         )
 
 

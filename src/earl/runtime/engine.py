@@ -84,6 +84,8 @@ class StateRuntime:
     complete: Completion | None = None
     #: the queues of the obligatory input buffers' channels, found at the first wait
     obligatory_queues: tuple[Any, ...] | None = None
+    #: where the spec declares the state, named when its waits never let run time pass
+    location: SourceLocation | None = None
 
 
 class Sink(Protocol):

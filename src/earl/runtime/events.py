@@ -21,7 +21,7 @@ class Fault:
     time: int
     subsystem: str
     #: "exception" | "undeclared-write" | "type" | "return-value" | "predicate" | "no-transition" | "overflow" |
-    #: "deadline"
+    #: "deadline" | "zero-time-loop" (which ends the run)
     kind: str
     message: str
     state: str = ""

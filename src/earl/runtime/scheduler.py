@@ -24,6 +24,7 @@ import threading
 import time as wall
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any, Protocol
 
 from earl.runtime.builder import Network
@@ -31,6 +32,15 @@ from earl.runtime.engine import SubsystemEngine
 from earl.runtime.events import Recorder
 
 _START, _RESUME, _TIMEOUT = 0, 1, 2
+
+#: iterations a subsystem without a `period` may start in one instant (no run time passing), beyond one
+#: for each message its FIFOs hold, before the run ends as a zero-time loop (docs/semantics.md, "When
+#: subsystems run"): subsystems that wake each other at once would otherwise never let run time pass
+ZERO_TIME_ITERATIONS = 10_000
+
+
+class ZeroTimeLoop(RuntimeError):
+    """Subsystems without a `period` woke each other at once, for ever, in one instant: run time cannot pass."""
 
 
 @dataclass
@@ -107,6 +117,8 @@ class Scheduler:
         self._owning = False
         #: what went wrong while serving a message on the receiving thread, raised in the scheduler's
         self._failure: BaseException | None = None
+        #: per subsystem without a period: the instant of its last iteration and how many it started then
+        self._instant_starts: dict[str, list[int]] = {}
 
     # ------------------------------------------------------------------ start
     def start(self) -> None:
@@ -164,6 +176,8 @@ class Scheduler:
             if realtime and kind == _START:
                 self._record_lateness(time, engine)
             if kind == _START:
+                if engine.period is None:
+                    self._count_iteration_in_instant(engine, time)
                 # `_start` and `_push` written out: this is the path of nearly every event
                 if not engine.iterate(time):
                     self._wait(engine, time)
@@ -342,6 +356,8 @@ class Scheduler:
 
     def _start(self, engine: SubsystemEngine, time: int) -> int | None:
         """One iteration from START; the time of the next START, or None while the engine waits."""
+        if engine.period is None:
+            self._count_iteration_in_instant(engine, time)
         if engine.iterate(time):
             if self.record_memory and engine.name in self.record_memory:
                 self.recorder.memory_snapshot(time, engine.name, engine.memory)
@@ -403,6 +419,37 @@ class Scheduler:
                 return None
             following += period
         return following
+
+    def _count_iteration_in_instant(self, engine: SubsystemEngine, time: int) -> None:
+        """An iteration of a subsystem without a period starts at `time`. Only such a subsystem can start
+        two in one instant (a FIFO's messages, taken one per iteration, or a message that came at once);
+        one that starts more than ZERO_TIME_ITERATIONS ends the run (ZeroTimeLoop)."""
+        seen = self._instant_starts.get(engine.name)
+        if seen is None or seen[0] != time:
+            self._instant_starts[engine.name] = [time, 1]
+            return
+        seen[1] += 1
+        if seen[1] > ZERO_TIME_ITERATIONS and seen[1] > ZERO_TIME_ITERATIONS + _fifo_capacity(engine):
+            self._end_zero_time_loop(engine, time)
+
+    def _end_zero_time_loop(self, engine: SubsystemEngine, time: int) -> None:
+        """Record the loop as a fault of `engine` and end the run: every subsystem that started more than one
+        iteration in this instant is part of it (each wakes the next at once)."""
+        looping = [
+            other
+            for other in self.network.engines
+            if (seen := self._instant_starts.get(other.name)) is not None and seen[0] == time and seen[1] > 1
+        ]
+        self._instant_starts[engine.name][1] -= 1  # the iteration refused does not run
+        named = [_where_it_waits(other, self._instant_starts[other.name][1]) for other in looping]
+        subsystems = named[0] if len(named) == 1 else ", ".join(named[:-1]) + " and " + named[-1]
+        message = (
+            f"{subsystems} at {time / 1e9:.6f} s, with no run time passing: "
+            f"{'it has' if len(looping) == 1 else 'they have'} no `period`, and each message sent started "
+            "the next iteration at once, for ever; give one of them a `period` (earl check: EARL-W018)"
+        )
+        engine.report_fault(time, "zero-time-loop", message)
+        raise ZeroTimeLoop(message)
 
     def _delivered(self, engine: SubsystemEngine) -> None:
         """A message reached a waiting engine: wake it now if its obligatory buffers are all filled."""
@@ -474,3 +521,19 @@ class Scheduler:
     @property
     def next_event_time(self) -> int | None:
         return self._queue[0][0] if self._queue else None
+
+
+def _fifo_capacity(engine: SubsystemEngine) -> int:
+    """The messages the FIFOs of `engine`'s input buffers hold at most: one iteration each, in zero time."""
+    return sum(channel.capacity or 0 for channel in engine.channels.values())
+
+
+def _where_it_waits(engine: SubsystemEngine, iterations: int) -> str:
+    """`a/a.cs` (10,000 iterations in state `s0`, system.earl:27): the subsystem, and the state it loops in
+    where the spec says it."""
+    state = engine.state
+    if state is None:
+        return f"`{engine.name}` ({iterations:,} iterations)"
+    location = state.location
+    where = f", {Path(location.file).name}:{location.line}" if location is not None else ""
+    return f"`{engine.name}` ({iterations:,} iterations in state `{state.name}`{where})"
