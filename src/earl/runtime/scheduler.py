@@ -119,6 +119,9 @@ class Scheduler:
         self._failure: BaseException | None = None
         #: per subsystem without a period: the instant of its last iteration and how many it started then
         self._instant_starts: dict[str, list[int]] = {}
+        #: real time: the run time an iteration was due by its period, for one whose start the wait of the
+        #: iteration before it put off (its lateness counts from then, and it is an overrun)
+        self._put_off: dict[str, int] = {}
 
     # ------------------------------------------------------------------ start
     def start(self) -> None:
@@ -475,7 +478,11 @@ class Scheduler:
         if period is None:
             return time
         following = engine.iteration_start + period
-        return following if following > time else time
+        if following >= time:
+            return following
+        if self.realtime:
+            self._put_off[engine.name] = following  # the wait overran the period: the next starts late
+        return time
 
     def _sleep_until_due(self, time: int, should_stop: Callable[[], bool] | None) -> bool:
         """Wait until run time `time` on the wall clock: sleep most of the way, in steps of at most 50 ms
@@ -501,21 +508,32 @@ class Scheduler:
         self._clock_running = True
 
     def _record_lateness(self, time: int, engine: SubsystemEngine) -> None:
+        """How late the iteration due at `time` starts on the wall clock, counted from when its period said it
+        was due: an overrun when more than a period late, or when the wait of the iteration before it for its
+        obligatory buffers went past that instant (docs/semantics.md, "When subsystems run")."""
+        put_off = self._put_off.pop(engine.name, None) if self._put_off else None
         if not self._clock_running:
             return  # the first instant, run before the clock starts
-        late = self.clock() - (self._wall_start + time)
+        due = time if put_off is None else put_off
+        late = self.clock() - (self._wall_start + due)
         record = self.lateness.get(engine.name)
         if record is None:
             record = self.lateness[engine.name] = Lateness()
         record.samples.append(late)
-        if engine.period is not None and late > engine.period:
+        period = engine.period
+        if period is not None and (late > period or put_off is not None):
             record.overruns += 1
             if record.overruns == 1:
+                why = (
+                    f"more than its period ({period / 1e6:g} ms)"
+                    if put_off is None
+                    else f"due at {put_off / 1e9:.6f} s by its period ({period / 1e6:g} ms): the iteration before it "
+                    f"waited for its obligatory buffers until {(time - put_off) / 1e6:g} ms after that"
+                )
                 engine.report_fault(
                     time,
                     "deadline",
-                    f"an iteration started {late / 1e6:.3f} ms late, more than its period "
-                    f"({engine.period / 1e6:g} ms); further overruns are only counted",
+                    f"an iteration started {late / 1e6:.3f} ms late, {why}; further overruns are only counted",
                 )
 
     @property
