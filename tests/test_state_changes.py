@@ -1,15 +1,55 @@
-"""What a state change records: when (the instant the decision was made, after any wait of its
-iteration); docs/semantics.md, "The trace"."""
+"""What a state change records: which declared transition was taken (a `* -> S` line is told from `R -> S`),
+and when (the instant the decision was made, after any wait of its iteration); docs/semantics.md, "The trace"."""
 
 from __future__ import annotations
 
+import json
+import subprocess
+import sys
 from pathlib import Path
 from typing import Any
+
+import jsonschema
+from mcap.reader import make_reader
 
 import earl
 from earl.runtime.events import Recorder
 
 MS = 1_000_000
+EARL = [sys.executable, "-m", "earl.cli.main"]
+
+# n counts the iterations: at n == 1 `s0 -> s1` holds, at n == 3 only `* -> s1` (from s0 too)
+STAR = """\
+system star
+
+r/r {
+    a/a
+}
+
+a/a {
+    cs {
+        period 10 ms
+        n/m: int = 0
+        true/pp = true
+        odd/pp = n/mi == 1
+        even/pp = n/mi == 3
+        inc/pf(n/mi -> n/mo) = python "counting:inc"
+        go/bb {
+            tf = {inc/pf}
+            tc = true/pp
+        }
+        fsm {
+            initial s0
+            state s0: go/bb
+            state s1: go/bb
+
+            s0 -> s1 when odd/pp
+            * -> s1 when even/pp
+            s1 -> s0 when true/pp
+        }
+    }
+}
+"""
 
 COUNTING = """\
 def inc(inputs, outputs, context):
@@ -25,6 +65,53 @@ class Changes(Recorder):
         self, time: int, subsystem: str, source: str | None, destination: str, transition: str | None
     ) -> None:
         self.changes.append((time, source, destination, transition))
+
+
+def star_spec(tmp_path: Path) -> Path:
+    (tmp_path / "system.earl").write_text(STAR)
+    (tmp_path / "counting.py").write_text(COUNTING)
+    return tmp_path
+
+
+def test_the_trace_says_which_declared_transition_was_taken_and_stays_valid_against_its_schema(
+    tmp_path: Path,
+) -> None:
+    trace = tmp_path / "run.mcap"
+    result = subprocess.run(
+        [*EARL, "run", str(star_spec(tmp_path)), "--duration", "40ms", "--trace", str(trace)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
+    assert result.returncode == 0, result.stderr
+    changes = []
+    with trace.open("rb") as stream:
+        for schema, _channel, message in make_reader(stream).iter_messages(topics=["/a/a.cs/fsm"]):
+            data = json.loads(message.data)
+            assert schema is not None
+            jsonschema.validate(data, json.loads(schema.data))
+            changes.append((message.log_time, data))
+    assert changes == [
+        (0, {"to": "s0"}),
+        (0, {"from": "s0", "to": "s1", "transition": "s0,s1"}),  # `s0 -> s1`, which names itself
+        (10 * MS, {"from": "s1", "to": "s0", "transition": "s1,s0"}),
+        (20 * MS, {"from": "s0", "to": "s1", "transition": "s0,s1", "declared": "*,s1"}),  # the `*` line
+        (30 * MS, {"from": "s1", "to": "s0", "transition": "s1,s0"}),
+    ]  # at 40 ms n == 5: neither holds, and s0 stays
+
+
+def test_a_recorder_is_given_the_name_it_always_was_which_also_says_the_declared_one(tmp_path: Path) -> None:
+    changes = Changes()
+    simulation = earl.simulate(earl.load(star_spec(tmp_path)), recorders=[changes])
+    try:
+        simulation.advance_to(0.025)
+    finally:
+        simulation.close()
+    names = [transition for _, _, _, transition in changes.changes]
+    assert names == [None, "s0,s1", "s1,s0", "s0,s1"]
+    assert [getattr(name, "declared", None) for name in names] == [None, "s0,s1", "s1,s0", "*,s1"]
+    assert all(type(str(name)) is str for name in names[1:])
 
 
 # a state of `period 10 ms` whose buffer group waits 3 ms for a message that never comes

@@ -38,7 +38,7 @@ from earl.runtime.engine import (
     TransitionRuntime,
     shown,
 )
-from earl.runtime.events import Recorder
+from earl.runtime.events import Recorder, TransitionName
 from earl.runtime.names import agent_name, indexed, reference_key
 from earl.runtime.parameters import agent_parameters, subsystem_parameters
 from earl.runtime.predicates import (
@@ -433,7 +433,10 @@ def _behaviour(
             timeout,
             [
                 TransitionRuntime(
-                    f"{transition.source},{transition.destination}",
+                    TransitionName(
+                        f"{transition.source},{transition.destination}",
+                        f"*,{transition.destination}" if transition.from_any_state else None,
+                    ),
                     transition.destination,
                     compile_predicate(
                         transition.condition.expression,

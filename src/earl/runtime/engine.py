@@ -30,7 +30,7 @@ from earl.model.location import SourceLocation
 from earl.runtime.binding import UserFunction
 from earl.runtime.channels import Channel
 from earl.runtime.compiled_iteration import Completion, Iterate, compile_completion, compile_iteration
-from earl.runtime.events import Fault, Recorder
+from earl.runtime.events import Fault, Recorder, TransitionName
 from earl.runtime.iteration import Call, Execute
 from earl.runtime.predicates import CompiledPredicate
 from earl.runtime.values import ValueTypeError
@@ -65,7 +65,8 @@ class BehaviourRuntime:
 
 @dataclass
 class TransitionRuntime:
-    name: str  # `idle,jointMove`
+    #: `idle,jointMove`; its `declared` is `*,jointMove` for a transition a `*` line stands for
+    name: TransitionName
     destination: str
     condition: CompiledPredicate
 

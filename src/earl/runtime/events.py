@@ -14,6 +14,19 @@ from typing import Any
 MessageWriter = Callable[[int, Any], None]
 
 
+class TransitionName(str):
+    """A transition's name, `idle,stop`, as recorders are given it, that also says how the spec declares
+    it: `declared` is `*,stop` for one of the transitions a `* -> stop` line stands for, and the name itself
+    otherwise. A str, so that a recorder written before it sees the name it always did."""
+
+    declared: str
+
+    def __new__(cls, name: str, declared: str | None = None) -> TransitionName:
+        made = super().__new__(cls, name)
+        made.declared = name if declared is None else declared
+        return made
+
+
 @dataclass
 class Fault:
     """Something went wrong in a subsystem; the run goes on (docs/semantics.md, "Faults")."""
@@ -45,8 +58,9 @@ class SubsystemStatistics:
 class Recorder:
     """Receives the events of a run; this base class ignores them all.
 
-    `state_changed` gives the transition's name (`idle,move`); the entry into the initial state, when
-    the FSM starts, has neither a source state nor a transition (None, None)."""
+    `state_changed` gives the transition's name (`idle,move`), a `TransitionName` whose `declared` is
+    `*,move` when a `* -> move` line was taken; the entry into the initial state, when the FSM starts,
+    has neither a source state nor a transition (None, None)."""
 
     def state_changed(
         self, time: int, subsystem: str, source: str | None, destination: str, transition: str | None

@@ -2,7 +2,7 @@
 
 Topics (one channel each; log time = run time in ns; names in `trace_topics.py`):
 
-    /SUBSYSTEM/fsm        a state change   {"from", "to", "transition"}
+    /SUBSYSTEM/fsm        a state change   {"from", "to", "transition", "declared" (a `*` line)}
     /SUBSYSTEM/behaviour  a behaviour starts or stops {"event", "state", "behaviour", "iterations", "reason"}
     /SUBSYSTEM/memory     a memory snapshot after an iteration (only for subsystems asked for); a
                           memory family is one array, member K at index K (`windingCurrent[1]`)
@@ -60,6 +60,11 @@ _STATE_SCHEMA = {
         "from": {"type": "string", "description": "left out at the first state"},
         "to": {"type": "string"},
         "transition": {"type": "string", "description": "left out at the first state"},
+        "declared": {
+            "type": "string",
+            "description": "the transition as the spec declares it, `*,to` for a `* -> to` line; left out when "
+            "it is `transition`",
+        },
     },
     "required": ["to"],
 }
@@ -427,7 +432,11 @@ class TraceWriter(Recorder):
         channel = self._channel(
             trace_topics.fsm(subsystem), "earl.StateChange", _STATE_SCHEMA, {"subsystem": subsystem}
         )
-        self._write(channel, time, {"from": source, "to": destination, "transition": transition})
+        change = {"from": source, "to": destination, "transition": None if transition is None else str(transition)}
+        declared = getattr(transition, "declared", transition)
+        if declared != transition:  # `*,to`: which line was taken, when two name the same move
+            change["declared"] = str(declared)
+        self._write(channel, time, change)
 
     def behaviour_started(self, time: int, subsystem: str, state: str, behaviour: str) -> None:
         channel = self._channel(
