@@ -642,7 +642,7 @@ def test_a_condition_that_fails_names_the_primitive_predicate_at_fault(tmp_path:
     try:
         sim.advance_to(0.005)
         assert sim.faults[0].message == (
-            "evaluating the terminal condition of `counting/bb` raised IndexError: tuple index out of range in `done/pp`"
+            "evaluating the terminal condition of `counting/bb` in `done/pp`: `v/mi` has no element 5 (it has 3 elements)"
         )
     finally:
         sim.close()

@@ -187,7 +187,7 @@ class _Reader:
                 field = current.field_named(accessor.name)
                 if field is None:
                     break
-                if field.optional and (position < last or use != "equality"):
+                if field.optional and use != "equality":  # `==` and `!=` read an absent field as absent
                     needed = path[: position + 2]
                     # read into, compared for order or computed with: raises; taken as a Boolean: false
                     faults = faults or position < last or use == "value"
@@ -220,8 +220,8 @@ def optional_fields_read_only_when_present(context: CheckContext) -> Iterator[Fi
     """An optional field may be absent; a condition that compares it (`<`, `>`), computes with it or reads
     into it then faults and counts as false, and an optional Boolean taken as a condition reads as false
     (`not` of it as true). Guard the read with `newData(x/ib.field) and …`, as Table 4 does; `==` and `!=`
-    need no guard (an absent field equals no value). Assumptions are not evaluated at run time and are
-    not checked."""
+    need no guard: an absent field equals no value, and so does a field inside it (`cmd/ib.target.x == 1.0`
+    is false while `target` is absent). Assumptions are not evaluated at run time and are not checked."""
 
     reported: set[object] = set()  # each read once, named with the first condition that reaches it
     for _agent, subsystem in context.distinct_subsystems():

@@ -32,7 +32,7 @@ from earl.runtime.channels import Channel
 from earl.runtime.compiled_iteration import Completion, Iterate, compile_completion, compile_iteration
 from earl.runtime.events import Fault, Recorder, TransitionName
 from earl.runtime.iteration import Call, Execute
-from earl.runtime.predicates import CompiledPredicate
+from earl.runtime.predicates import CompiledPredicate, absent_read
 from earl.runtime.values import ValueTypeError
 from earl.runtime.views import Context, Inputs, Outputs, UndeclaredAccess, explain
 
@@ -336,7 +336,11 @@ class SubsystemEngine:
         else:
             inside = _predicate_raising(raised)
             where = f" in `{inside}`" if inside and inside not in what else ""
-            said = f"evaluating {what} raised {exception_text(explain(raised))}{where}"
+            absent = absent_read(raised)  # in EARL's words rather than Python's, when it can be said
+            if absent is not None:
+                said = f"evaluating {what}{where}: {absent}"
+            else:
+                said = f"evaluating {what} raised {exception_text(explain(raised))}{where}"
         self.report_fault(time, "predicate", said, trace=trace)
         self._failure_recorded(raised)
 

@@ -36,6 +36,7 @@ from earl.model.expressions import (
     Not,
     Quantifier,
     Read,
+    children,
     walk,
 )
 from earl.model.kinds import Kind
@@ -62,10 +63,15 @@ def compile_predicate(
     """
     source = f"lambda {_ARGUMENTS}: {_source(expression)}"
     code = compile(source, f"<earl predicate {description}>", "eval")
-    function: CompiledPredicate = eval(
-        code, {"__builtins__": {}, "stale": stale, "_element": _element, "_carries": _carries}
-    )
+    names = {"__builtins__": {}, "stale": stale, "_element": _element, "_carries": _carries, "_carried": _carried}
+    # read back from a failing frame's globals, to say in EARL's words what was absent (`absent_read`)
+    names[_EXPRESSION] = expression
+    function: CompiledPredicate = eval(code, names)
     return function
+
+
+#: the name under which a compiled predicate's globals hold its expression
+_EXPRESSION = "__earl_expression__"
 
 
 #: a named predicate that one condition, evaluated in full, would evaluate more often than this is
@@ -160,6 +166,119 @@ def _carries(value: Any, *steps: str | int) -> bool:
     return value is not None
 
 
+def _carried(value: Any, *steps: str | int) -> Any:
+    """What `steps` lead to in a message, or None (absent) when an optional field on the way is absent: an
+    operand of `==` or `!=`, where an absent field equals no value, a field inside it no more than it."""
+    for step in steps:
+        if value is None:
+            return None
+        value = value[step]
+    return value
+
+
+def absent_read(error: BaseException) -> str | None:
+    """`` `cmd/ib.inner` was absent ``: what a compiled predicate's `error` (a TypeError or IndexError, Python's
+    words for it) comes from, read from the innermost compiled predicate it passed through and the values that
+    predicate was given; None when it is not a read of something absent."""
+    if not isinstance(error, (TypeError, IndexError)):
+        return None
+    frame = None
+    trace = error.__traceback__
+    while trace is not None:
+        if _EXPRESSION in trace.tb_frame.f_globals:
+            frame = trace.tb_frame
+        trace = trace.tb_next
+    if frame is None:
+        return None
+    expression = frame.f_globals[_EXPRESSION]
+    values = {"ib": frame.f_locals.get("ib"), "mem": frame.f_locals.get("mem")}
+    try:
+        for read, use in _reads(expression, "boolean"):
+            said = _absent_on_the_way(read, use, values, error)
+            if said is not None:
+                return said
+    except Exception:  # only an explanation: Python's own words are said instead
+        return None
+    return None
+
+
+def _reads(expression: Expression, use: str) -> Iterable[tuple[Read, str]]:
+    """The reads of buffers and memory in `expression`, in the order they are written, with how each value is
+    used: `equality` (an operand of `==`, `!=`), `value` (ordered, computed with), `boolean`."""
+    if isinstance(expression, Read):
+        if expression.target.kind != Kind.PRIMITIVE_PREDICATE:
+            for accessor in expression.path:
+                if isinstance(accessor, IndexAccess):
+                    yield from _reads(accessor.index, "value")
+            yield expression, use
+        return
+    if isinstance(expression, Call):
+        for argument in expression.arguments:  # newData(x/ib.a.b) reads nothing that can fault but its indices
+            for accessor in argument.path if isinstance(argument, Read) else ():
+                if isinstance(accessor, IndexAccess):
+                    yield from _reads(accessor.index, "value")
+        return
+    if isinstance(expression, Comparison):
+        side = "equality" if expression.operator in ("==", "!=") else "value"
+        yield from _reads(expression.left, side)
+        yield from _reads(expression.right, side)
+        return
+    if isinstance(expression, (BooleanOperation, Not)):
+        for child in children(expression):
+            yield from _reads(child, "boolean")
+        return
+    for child in children(expression):
+        yield from _reads(child, "value")
+
+
+def _absent_on_the_way(read: Read, use: str, values: Mapping[str, Any], error: BaseException) -> str | None:
+    """What of `read` was absent (or beyond an array's end), given the values its predicate was given."""
+    target = read.target
+    source = values.get("ib" if target.kind == Kind.INPUT_BUFFER else "mem")
+    if not isinstance(source, Mapping):
+        return None
+    value = source.get(reference_key(target))
+    said = f"{reference_key(target)}/{'ib' if target.kind == Kind.INPUT_BUFFER else 'mi'}"
+    for accessor in read.path:
+        if isinstance(accessor, FieldAccess):
+            if value is None:
+                # a field read into an absent one: raised unless compared for equality (`_carried`)
+                return None if use == "equality" or not isinstance(error, TypeError) else _absent(said)
+            if not isinstance(value, Mapping):
+                return None
+            value = value.get(accessor.name)
+            said += f".{accessor.name}"
+            continue
+        if value is None:
+            return None if use == "equality" or not isinstance(error, TypeError) else _absent(said)
+        index = _literal_index(accessor)
+        if index is not None and isinstance(value, (list, tuple)) and index >= len(value):
+            if isinstance(error, IndexError):
+                count = len(value)
+                return f"`{said}` has no element {index} (it has {count} element{'' if count == 1 else 's'})"
+            return None
+        if index is None or not isinstance(value, (list, tuple)):
+            return None
+        value = value[index]
+        said += f"[{index}]"
+    if value is None and use == "value" and isinstance(error, TypeError):
+        return _absent(said)
+    return None
+
+
+def _absent(said: str) -> str:
+    """`` `cmd/ib.inner` was absent ``, with the guard that reads an input buffer's field only when it came."""
+    guard = f" (guard the read: `newData({said}) and …`, EARL-W046)" if "/ib." in said else ""
+    return f"`{said}` was absent{guard}"
+
+
+def _literal_index(accessor: IndexAccess) -> int | None:
+    index = accessor.index
+    if isinstance(index, Literal) and type(index.value) is int and index.value >= 0:
+        return index.value
+    return None
+
+
 def predicate_source(expression: Expression) -> str:
     """The generated Python for `expression` (shown by tests and in fault reports)."""
     return _source(expression)
@@ -194,12 +313,26 @@ def _source(expression: Expression) -> str:
         if expression.operator not in known:
             # a model built in Python and run unchecked: the operator would go into the generated code as it is
             raise PredicateCompileError(f"`{expression.operator}` is no operator of EARL ({', '.join(known)})")
+        if isinstance(expression, Comparison) and expression.operator in ("==", "!="):
+            # an absent field equals no value, and so does a field inside an absent one
+            left, right = _equality_operand(expression.left), _equality_operand(expression.right)
+            return f"({left} {expression.operator} {right})"
         return f"({_source(expression.left)} {expression.operator} {_source(expression.right)})"
     if isinstance(expression, Name):
         raise PredicateCompileError(f"`{expression.name}` is not a parameter or index with a known value")
     if isinstance(expression, Quantifier):
         raise PredicateCompileError("a quantifier must be expanded before it runs")
     raise PredicateCompileError(f"cannot run the expression {expression!r}")
+
+
+def _equality_operand(expression: Expression) -> str:
+    """An operand of `==` or `!=`: a read that goes on past a field, which may be an absent optional one, is
+    absent itself then (`_carried`); any other operand as everywhere."""
+    if not isinstance(expression, Read) or expression.target.kind == Kind.PRIMITIVE_PREDICATE:
+        return _source(expression)
+    if not any(isinstance(accessor, FieldAccess) for accessor in expression.path[:-1]):
+        return _source(expression)  # no field on the way: nothing on it can be absent
+    return f"_carried({_base(expression)}, {_steps(expression)})"
 
 
 def _read(read: Read) -> str:
@@ -209,13 +342,18 @@ def _read(read: Read) -> str:
         if read.path:
             raise PredicateCompileError(f"`{target.name}/pp` is a Boolean: it has no fields or elements")
         return f"pp[{key}]({_ARGUMENTS})"
+    return _base(read) + _path(read)
+
+
+def _base(read: Read) -> str:
+    """The buffer or memory `read` reads, without its fields and elements."""
+    target = read.target
+    key = repr(reference_key(target))
     if target.kind == Kind.INPUT_BUFFER:
-        base = f"ib[{key}]"
-    elif target.kind in (Kind.MEMORY_INPUT, Kind.MEMORY):
-        base = f"mem[{key}]"
-    else:
-        raise PredicateCompileError(f"a predicate cannot read `{target.name}/{target.kind.value}`")
-    return base + _path(read)
+        return f"ib[{key}]"
+    if target.kind in (Kind.MEMORY_INPUT, Kind.MEMORY):
+        return f"mem[{key}]"
+    raise PredicateCompileError(f"a predicate cannot read `{target.name}/{target.kind.value}`")
 
 
 def _path(read: Read) -> str:
