@@ -718,6 +718,15 @@ CASES: list[Case] = [
         ),
     ),
     Case(
+        "EARL-W045",
+        edit(("    cs { period 1 ms\n        out/ob", "    cs { period 1.0000005 ms\n        out/ob")),
+        4,
+        10,
+        "the period of a1/a.cs, `period 1.0000005 ms`, is 1000000.5 ns: earl keeps time in whole nanoseconds, so "
+        "it runs as 1000001 ns",
+        edit(("    cs { period 1 ms\n        out/ob", "    cs { period 1.000001 ms\n        out/ob")),
+    ),
+    Case(
         "EARL-W018",
         ping_pong(a2_period=False),
         17,

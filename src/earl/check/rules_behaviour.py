@@ -4,13 +4,14 @@ from __future__ import annotations
 
 import re
 from collections.abc import Iterable, Iterator
+from fractions import Fraction
 
 from earl.check.constants import constant_value
 from earl.check.context import CheckContext, reference_key
 from earl.check.expression_types import BOOLEAN, ExpressionTyper
 from earl.check.registry import Finding, rule
 from earl.diagnostics import Severity
-from earl.model.elements import BasicBehaviour, Subsystem
+from earl.model.elements import BasicBehaviour, Subsystem, duration_problem
 from earl.model.expressions import (
     Call,
     ElementReference,
@@ -512,6 +513,55 @@ def subsystems_have_an_fsm(context: CheckContext) -> Iterator[Finding]:
                     subsystem.location,
                     f"add one: `fsm {{ initial {behaviour}  state {behaviour}: {behaviour}/bb }}`",
                 )
+
+
+#: nanoseconds in one of each unit a period or timeout is written in
+_NANOSECONDS_PER = {"s": 10**9, "ms": 10**6, "us": 10**3}
+
+
+@rule("EARL-W045", Severity.WARNING, "a period or timeout is a whole number of nanoseconds", "§2.2, Figure 5")
+def whole_nanoseconds(context: CheckContext) -> Iterator[Finding]:
+    """earl keeps run time in whole nanoseconds, so a `period` or `timeout` is rounded to the nearest one:
+    `period 0.0015 us` (1.5 ns) runs as 2 ns, a third longer than written. A duration that is a whole number of
+    nanoseconds runs as written."""
+    for agent in context.declared.agents:
+        for subsystem in agent.subsystems:
+            owner = subsystem_name(agent, subsystem)
+            durations = [("the period", "period", subsystem.period, subsystem.period_location)]
+            if subsystem.fsm is not None:
+                durations += [
+                    (f"the timeout of state `{state.name}`", "timeout", state.timeout, state.timeout_location)
+                    for state in subsystem.fsm.states
+                ]
+            for what, keyword, duration, location in durations:
+                if duration is None or duration_problem(duration) is not None:
+                    continue  # none, or one the reader refuses (EARL-S012)
+                exact = Fraction(str(duration.value)) * _NANOSECONDS_PER[duration.unit]
+                if exact.denominator == 1:
+                    continue
+                runs = round(duration.seconds * 1e9)  # as the runtime turns it into nanoseconds
+                yield Finding(
+                    f"{what} of {owner}, `{keyword} {duration.value} {duration.unit}`, is {_decimal(exact)} ns: earl "
+                    f"keeps time in whole nanoseconds, so it runs as {runs} ns",
+                    location or subsystem.location,
+                    f"write a whole number of nanoseconds: `{keyword} {_in_unit(runs, duration.unit)} {duration.unit}` "
+                    f"({runs} ns)",
+                )
+
+
+def _in_unit(nanoseconds: int, unit: str) -> str:
+    """`0.002` for 2 ns in `us`: a whole number of nanoseconds written in `unit`, exactly."""
+    return _decimal(Fraction(nanoseconds, _NANOSECONDS_PER[unit]))
+
+
+def _decimal(value: Fraction) -> str:
+    """`1000000.5`: a fraction whose denominator divides a power of ten, written out in full."""
+    whole, rest = divmod(value.numerator, value.denominator)
+    digits = ""
+    while rest and len(digits) < 30:
+        whole_digit, rest = divmod(rest * 10, value.denominator)
+        digits += str(whole_digit)
+    return f"{whole}.{digits}" if digits else str(whole)
 
 
 @rule("EARL-W044", Severity.WARNING, "a `timeout` can come true", "§2.2, Figure 5b")
