@@ -167,3 +167,22 @@ def test_a_state_change_after_a_wait_is_stamped_when_the_wait_ended(tmp_path: Pa
         (3 * MS, "wait", "gone"),
     ]
     assert iterations == 2  # at 0 and at 10 ms
+
+
+def test_a_fault_in_the_condition_of_a_star_transition_names_it_as_declared(tmp_path: Path) -> None:
+    spec = star_spec(tmp_path)
+    text = (spec / "system.earl").read_text()
+    text = text.replace("        n/m: int = 0\n", "        n/m: int = 0\n        v/m: double[3] = [0.0, 0.0, 0.0]\n")
+    text = text.replace("even/pp = n/mi == 3", "even/pp = v/mi[5] > 1.0")
+    (spec / "system.earl").write_text(text)
+    simulation = earl.simulate(earl.load(spec), check=False)  # `earl check` refuses the index (EARL-E030)
+    try:
+        simulation.advance_to(0.02)  # at 20 ms, n == 3 in s0: `s0 -> s1` does not hold, the `*` line is tried
+        faults = [(fault.time, fault.kind, fault.message) for fault in simulation.faults]
+    finally:
+        simulation.close()
+    assert faults[0] == (
+        20 * MS,
+        "predicate",
+        "evaluating the condition of `*,s1/t` (from `s0`) in `even/pp`: `v/mi` has no element 5 (it has 3 elements)",
+    )

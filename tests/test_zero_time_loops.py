@@ -138,7 +138,7 @@ def test_from_python_a_zero_time_loop_raises_and_the_simulation_cannot_go_on() -
         with pytest.raises(ZeroTimeLoop, match="with no run time passing"):
             simulation.advance_to(0.001)
         (fault,) = simulation.faults
-        assert (fault.kind, fault.subsystem, fault.time) == ("zero-time-loop", "a/a.cs", 0.0)
+        assert (fault.kind, fault.subsystem, fault.time) == ("zero-time-loop", "a/a.cs", 0)
         assert simulation.state_of("b/a.cs").iteration == ZERO_TIME_ITERATIONS
         with pytest.raises(RuntimeError, match="stopped inside an instant"):
             simulation.advance_to(0.002)

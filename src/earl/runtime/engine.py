@@ -70,6 +70,15 @@ class TransitionRuntime:
     destination: str
     condition: CompiledPredicate
 
+    @property
+    def condition_named(self) -> str:
+        """`the condition of `idle,stop/t``, or of `*,stop/t` (from `idle`) as the checker says a `*` line's."""
+        name = self.name
+        declared = getattr(name, "declared", name)
+        if declared != name:
+            return f"the condition of `{declared}/t` (from `{name.split(',', 1)[0]}`)"
+        return f"the condition of `{name}/t`"
+
 
 @dataclass
 class StateRuntime:
@@ -316,7 +325,9 @@ class SubsystemEngine:
             self._timeouts_set = True
 
     # ------------------------------------------------------------------ Figure 5b, step 5 and Figure 5a
-    def _evaluate(self, time: int, predicate: CompiledPredicate, what: str) -> bool:
+    def _evaluate(self, time: int, predicate: CompiledPredicate, what: str | TransitionRuntime) -> bool:
+        """`predicate`'s value, false when it fails (a fault naming `what`: a transition's condition is named
+        only then)."""
         try:
             return bool(predicate(self.inputs, self.new_data, self.timed_out, self.memory, self.predicates))
         except (KeyboardInterrupt, SystemExit):
@@ -324,7 +335,8 @@ class SubsystemEngine:
         except PredicateFailedBefore:
             return False
         except BaseException as raised:  # a Python predicate's own exception class may derive from BaseException
-            self._condition_failed(time, what, raised)
+            said = what.condition_named if isinstance(what, TransitionRuntime) else what
+            self._condition_failed(time, said, raised)
             return False
 
     def _condition_failed(self, time: int, what: str, raised: BaseException) -> None:
@@ -381,7 +393,7 @@ class SubsystemEngine:
                 return
             reason = "terminal"
         for transition in state.transitions:
-            if self._evaluate(time, transition.condition, f"the condition of `{transition.name}/t`"):
+            if self._evaluate(time, transition.condition, transition):
                 self._enter(time, transition, reason)
                 return
         if not self._stuck:
