@@ -96,18 +96,63 @@ def test_a_cycle_one_of_whose_states_also_waits_for_a_paced_sender_is_not_warned
         simulation.close()
 
 
-def test_a_subsystem_that_sends_to_itself_is_a_cycle_of_one(tmp_path: Path) -> None:
-    spec = ping_copy(
-        tmp_path,
-        ("    b/a\n", ""),
-        ("    link a,b\n    link b,a\n", "    link a,a\n"),
-        (
-            "link a,b: a/a.cs.out -> b/a.cs.in\nlink b,a: b/a.cs.out -> a/a.cs.in\n",
-            "link a,a: a/a.cs.out -> a/a.cs.in\n",
-        ),
-    )
-    (found,) = w018(spec)
-    assert "a/a.cs in state `s0` → a/a.cs in state `s0`" in found
+AGENT_CYCLE = """\
+system inside
+
+r/r {
+    a/a
+}
+
+a/a {
+    cs {
+        in/ib: int
+        out/ob: int
+        n/m: int = 0
+        false/pp = false
+        inc/pf(in/ib -> n/mo) = python "pinging:inc"
+        send/pf(n/mi -> out/ob) = python "pinging:send"
+        go/bb {
+            tf = {inc/pf} then {send/pf}
+            tc = false/pp
+        }
+        fsm {
+            initial s0
+            state s0: go/bb { obligatory in/ib }
+        }
+    }
+    m/ve {
+        in/ib: int
+        out/ob: int
+        drive/ob: int
+        n/m: int = 0
+        false/pp = false
+        inc/pf(in/ib -> n/mo) = python "pinging:inc"
+        send/pf(n/mi -> out/ob, drive/ob) = python "pinging:send"
+        go/bb {
+            tf = {inc/pf} then {send/pf}
+            tc = false/pp
+        }
+        fsm {
+            initial s0
+            state s0: go/bb { obligatory in/ib }
+        }
+    }
+    d/re {
+        drive/ib: int
+    }
+    link cs,m: cs.out -> m/ve.in
+    link m,cs: m/ve.out -> cs.in
+    link m,d: m/ve.drive -> d/re.drive
+}
+"""
+
+
+def test_a_control_subsystem_and_its_virtual_effector_can_be_such_a_cycle(tmp_path: Path) -> None:
+    (tmp_path / "system.earl").write_text(AGENT_CYCLE)
+    diagnostics = check(earl.load(tmp_path))
+    assert [d for d in diagnostics if d.severity.name == "ERROR"] == []
+    (found,) = [d.message for d in diagnostics if d.code == "EARL-W018"]
+    assert "a/a.cs in state `s0` → a/a.m/ve in state `s0` → a/a.cs in state `s0`" in found
 
 
 # ---------------------------------------------------------------------------------------------- the run
