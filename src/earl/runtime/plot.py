@@ -139,7 +139,12 @@ def _path_problem(expanded: System, subsystem: Subsystem, element: str, path: st
         for index, field in steps:
             if field is not None:
                 if not isinstance(current, StructType) or current.field_named(field) is None:
-                    return f"`{named}` has no field `{field}` where the signal names it"
+                    hint = (
+                        did_you_mean(field, [f.name for f in current.fields])
+                        if isinstance(current, StructType)
+                        else None
+                    )
+                    return f"`{named}` has no field `{field}` where the signal names it" + (f"; {hint}" if hint else "")
                 current = types.resolve(current.field_named(field).data_type)  # type: ignore[union-attr]
                 named += f".{field}"
             else:

@@ -397,6 +397,14 @@ class TraceWriter(Recorder):
         self.memory_types = memory_types
         self.link_patterns = links
         self.link_sources = link_sources or {}
+        #: subsystem -> the output buffers links leave (`push[1]`, `beltSpeed`), for its FSM channel's
+        #: metadata: a link's channel is made at its first message, so the trace alone could not tell
+        #: a member of a family that never sent from one the family does not have (earl plot)
+        self._buffers: dict[str, list[str]] = {}
+        for source in self.link_sources.values():
+            subsystem, _, buffer = source.rpartition(".")
+            if subsystem and buffer not in self._buffers.setdefault(subsystem, []):
+                self._buffers[subsystem].append(buffer)
         #: links recorded whatever the patterns say: those leaving an output buffer a plot draws
         self.links_also_recorded: set[str] = set()
         #: topic -> channel number; None for a link that is not recorded
@@ -429,9 +437,10 @@ class TraceWriter(Recorder):
     def state_changed(
         self, time: int, subsystem: str, source: str | None, destination: str, transition: str | None
     ) -> None:
-        channel = self._channel(
-            trace_topics.fsm(subsystem), "earl.StateChange", _STATE_SCHEMA, {"subsystem": subsystem}
-        )
+        metadata = {"subsystem": subsystem}
+        if self._buffers.get(subsystem):
+            metadata["buffers"] = json.dumps(sorted(self._buffers[subsystem]), separators=(",", ":"))
+        channel = self._channel(trace_topics.fsm(subsystem), "earl.StateChange", _STATE_SCHEMA, metadata)
         change = {"from": source, "to": destination, "transition": None if transition is None else str(transition)}
         declared = getattr(transition, "declared", transition)
         if declared != transition:  # `*,to`: which line was taken, when two name the same move

@@ -23,7 +23,7 @@ from mcap.records import Channel, Message, Schema
 from mcap.stream_reader import CRCValidationError, StreamReader
 
 from earl.diagnostics import did_you_mean, escape_controls
-from earl.runtime import trace_topics
+from earl.runtime import trace_paths, trace_topics
 from earl.runtime.signal_syntax import signal_syntax_error
 from earl.runtime.values import iter_leaves
 
@@ -384,12 +384,19 @@ def _families(metadata: dict[str, str]) -> dict[str, int] | None:
 def _unschemed(metadata: dict[str, str]) -> list[str]:
     """The memories a memory channel's metadata names as in its messages but not in its schema (an array
     of arrays: `grid/m: double[2][2]`); none when it names none (a trace written before it did)."""
+    return _listed(metadata, "unschemed") or []
+
+
+def _listed(metadata: dict[str, str], key: str) -> list[str] | None:
+    """The names a channel's metadata lists under `key` (a JSON list): a memory channel's `unschemed`,
+    an FSM channel's `buffers` (the output buffers links leave); None when it has none (a trace written
+    before it did, or a damaged entry)."""
     try:
-        found = json.loads(metadata["unschemed"])
+        found = json.loads(metadata[key])
     except (KeyError, ValueError):
-        return []
+        return None
     if not isinstance(found, list):
-        return []
+        return None
     return [name for name in found if isinstance(name, str)]
 
 
@@ -688,6 +695,9 @@ def read_signals(path: Path, names: list[str]) -> Signals:
             if parts:
                 listed = ", ".join(f"`{subsystem}.{leaf}`" for leaf in parts[:4]) + (" …" if len(parts) > 4 else "")
                 raise TraceError(f"`{name}` is not a number but has parts that are: name one, {listed}")
+            problem = _trace_path_problem(subsystem, inner, by_kind, channels, links, leaves)
+            if problem is not None:
+                raise TraceError(f"`{name}`: {problem}")
             element = signal_element(inner)
             same = sorted({leaf for (owner, leaf) in leaves if owner == subsystem and signal_element(leaf) == element})
             if same:
@@ -720,6 +730,35 @@ def read_signals(path: Path, names: list[str]) -> Signals:
     if not series:
         raise TraceError(f"no signal has a value in this trace: {'; '.join(leaf_hints)}")
     return Signals(series, bands, end, empty, bool(cut))
+
+
+def _trace_path_problem(
+    subsystem: str,
+    inner: str,
+    by_kind: dict[tuple[str, str], str],
+    channels: dict[str, tuple[dict[str, str], Any]],
+    links: list[tuple[str, dict[str, str]]],
+    leaves: dict[tuple[str, str], Any],
+) -> str | None:
+    """What the trace's schemas say is wrong with `inner`, a signal of `subsystem` that had no value
+    (`trace_paths.path_problem`), or None."""
+    memory_topic = by_kind.get(("memory", subsystem))
+    memory = None
+    if memory_topic is not None:
+        metadata, schema = channels[memory_topic]
+        memory = (schema, _families(metadata) or {})
+    declared = _listed(channels[by_kind[("fsm", subsystem)]][0], "buffers")
+    buffers: dict[str, Any] = {}
+    for topic, metadata in links:
+        source = metadata.get("source", "")
+        if source.startswith(subsystem + "."):
+            buffers.setdefault(source[len(subsystem) + 1 :], channels[topic][1])
+
+    def has_leaves(prefix: str) -> bool:
+        pattern = re.compile(re.escape(prefix).replace(r"\[\*\]", r"\[\d+\]") + r"(?:[.\[]|\Z)")
+        return any(owner == subsystem and pattern.match(leaf) for owner, leaf in leaves)
+
+    return trace_paths.path_problem(inner, memory, buffers, declared, has_leaves)
 
 
 def _elements_in(

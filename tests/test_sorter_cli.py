@@ -1,0 +1,97 @@
+"""`earl run`, `earl plot` and `earl trace` on a conveyor sorter (tests/runtime_specs/sorter): a family of
+agents (`pusher[K in 1..NBINS]/a`), a family of links to them and a family of output buffers, as a new
+user wrote it. Real processes, real files."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+SORTER = Path(__file__).parent / "runtime_specs" / "sorter"
+EARL = [sys.executable, "-m", "earl.cli.main"]
+
+
+def earl_cli(*arguments: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([*EARL, *arguments], capture_output=True, text=True, timeout=120, cwd=cwd, check=False)
+
+
+@pytest.fixture(scope="module")
+def sorter_trace(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A trace of 4 s of the sorter (its run.toml records `sorter/a.cs`'s memory): parts have been
+    dispatched to the pushers by then, so `push[1..3]` sent messages."""
+    trace = tmp_path_factory.mktemp("sorter") / "run.mcap"
+    ran = earl_cli("run", str(SORTER), "--trace", str(trace))
+    assert ran.returncode == 0, ran.stderr
+    return trace
+
+
+@pytest.mark.parametrize(
+    ("signal", "said"),
+    [
+        # a misspelt field of a member of a family of output buffers: the trace's schema has its fields
+        (
+            "sorter/a.cs.push[2].abortt",
+            "`sorter/a.cs.push[2].abortt`: `push[2]` has no field `abortt` where the signal names it; "
+            "did you mean `abort`?",
+        ),
+        # a member that never sent in 4 s (no part for bin 1 yet): its field is checked by its siblings' schema
+        (
+            "sorter/a.cs.push[1].abortt",
+            "`sorter/a.cs.push[1].abortt`: `push[1]` has no field `abortt` where the signal names it; "
+            "did you mean `abort`?",
+        ),
+        # past the end of an `int[NBINS]` memory: its schema says it has 3 elements
+        (
+            "sorter/a.cs.perBin[5]",
+            "`sorter/a.cs.perBin[5]`: `perBin` has elements 0 to 2 where the signal indexes it, not 5",
+        ),
+        # a member the family of output buffers does not have
+        ("sorter/a.cs.push[7]", "`sorter/a.cs.push[7]`: `push` has members 1..3, not 7"),
+        ("sorter/a.cs.push[7].abort", "`sorter/a.cs.push[7].abort`: `push` has members 1..3, not 7"),
+        # a field of something that is not a struct
+        (
+            "sorter/a.cs.sorted.count",
+            "`sorter/a.cs.sorted.count`: `sorted` has no field `count` where the signal names it: it is a whole number",
+        ),
+    ],
+)
+def test_a_path_the_trace_s_schemas_do_not_have_is_refused_not_drawn_without(
+    sorter_trace: Path, tmp_path: Path, signal: str, said: str
+) -> None:
+    """A misspelt field, an index past a fixed array's end or a member a family lacks is refused with
+    what the trace has (exit 1, as a misspelt memory name is), not left out as "no value in this run"
+    while the other signals are drawn (exit 0)."""
+    picture = tmp_path / "x.png"
+    plot = earl_cli("plot", str(sorter_trace), "--signal", "sorter/a.cs.sorted", "--signal", signal, "-o", str(picture))
+    assert plot.returncode == 1, plot.stderr
+    assert plot.stderr == f"earl plot: {said}\n"
+    assert not picture.exists()
+
+
+def test_the_paths_the_trace_has_are_drawn(sorter_trace: Path, tmp_path: Path) -> None:
+    """The same elements named rightly are drawn: the check refuses only what the schemas lack."""
+    picture = tmp_path / "x.png"
+    signals = ["sorter/a.cs.perBin[2]", "sorter/a.cs.push[*].partId", "sorter/a.cs.push[2].abort"]
+    plot = earl_cli("plot", str(sorter_trace), *(f"--signal={s}" for s in signals), "-o", str(picture))
+    assert plot.returncode == 0, plot.stderr
+    assert plot.stderr == "" and picture.stat().st_size > 0
+
+
+def test_a_member_that_never_sent_is_drawn_without_as_having_no_value(sorter_trace: Path, tmp_path: Path) -> None:
+    """`push[1]` is a member of the family (the trace's metadata lists the buffers links leave) that sent
+    nothing in 4 s: no slip, so the others are drawn and it is said to have had no value."""
+    picture = tmp_path / "x.png"
+    signals = ["--signal=sorter/a.cs.sorted", "--signal=sorter/a.cs.push[1].abort"]
+    plot = earl_cli("plot", str(sorter_trace), *signals, "-o", str(picture))
+    assert plot.returncode == 0, plot.stderr
+    assert "`sorter/a.cs.push[1].abort` had no value in this run" in plot.stderr
+
+
+def test_earl_run_plot_suggests_the_field_a_signal_misspells(tmp_path: Path) -> None:
+    """Before the run, from the spec: the same did-you-mean as `earl plot` gives from a trace."""
+    ran = earl_cli("run", str(SORTER), "--plot", str(tmp_path / "x.png"), "--signal", "sorter/a.cs.push[2].abortt")
+    assert ran.returncode == 2
+    assert "`push[2]` has no field `abortt` where the signal names it; did you mean `abort`?" in ran.stderr
