@@ -4,6 +4,7 @@ user wrote it. Real processes, real files."""
 
 from __future__ import annotations
 
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -95,3 +96,102 @@ def test_earl_run_plot_suggests_the_field_a_signal_misspells(tmp_path: Path) -> 
     ran = earl_cli("run", str(SORTER), "--plot", str(tmp_path / "x.png"), "--signal", "sorter/a.cs.push[2].abortt")
     assert ran.returncode == 2
     assert "`push[2]` has no field `abortt` where the signal names it; did you mean `abort`?" in ran.stderr
+
+
+def recorded_links(trace: Path) -> list[str]:
+    from earl.runtime.trace_reader import topics
+
+    return sorted(topic.removeprefix("/link/") for topic in topics(trace) if topic.startswith("/link/"))
+
+
+@pytest.mark.parametrize(
+    ("pattern", "links"),
+    [
+        # brackets with a number: that member (they were a glob's character class, `1`, and matched nothing)
+        ("pusher[2],sorter", ["pusher[2],sorter"]),
+        # `[*]` and the index variable: every member, as `[*]` and `[K]` name a family elsewhere
+        ("pusher[*],sorter", ["pusher[1],sorter", "pusher[2],sorter", "pusher[3],sorter"]),
+        ("pusher[K],sorter", ["pusher[1],sorter", "pusher[2],sorter", "pusher[3],sorter"]),
+        (
+            "pusher[3]/a:*",
+            ["pusher[3]/a:arm,armMotor", "pusher[3]/a:arm,cs", "pusher[3]/a:armMotor,arm", "pusher[3]/a:cs,arm"],
+        ),
+    ],
+)
+def test_record_links_names_a_member_of_a_link_family_by_its_index(
+    tmp_path: Path, pattern: str, links: list[str]
+) -> None:
+    trace = tmp_path / "run.mcap"
+    ran = earl_cli("run", str(SORTER), "--duration", "0.2s", "--trace", str(trace), "--record-links", pattern)
+    assert ran.returncode == 0, ran.stderr
+    assert "matches no link" not in ran.stderr
+    assert recorded_links(trace) == links
+
+
+def test_a_link_pattern_matching_nothing_lists_the_names_one_can_write_families_once(tmp_path: Path) -> None:
+    """The list was the first 8 links in order, all of them members of `pusher[1]` and `pusher[2]`:
+    the sorter's own links and `sorter,pusher[…]` never appeared."""
+    ran = earl_cli(
+        "run",
+        str(SORTER),
+        "--duration",
+        "0.1s",
+        "--trace",
+        str(tmp_path / "r.mcap"),
+        "--record-links",
+        "sortr,pusher[1]",
+    )
+    assert ran.returncode == 0, ran.stderr
+    assert (
+        "earl run: --record-links `sortr,pusher[1]` matches no link; did you mean `sorter,pusher[1]`? (the links: "
+        "pusher[*],sorter, pusher[*]/a:arm,armMotor, pusher[*]/a:arm,cs, pusher[*]/a:armMotor,arm, pusher[*]/a:cs,arm, "
+        "sorter,pusher[*], sorter/a:beltDrive,beltMotor, sorter/a:camera,detector, sorter/a:cs,beltDrive, "
+        "sorter/a:detector,cs)\n"
+    ) in ran.stderr
+
+
+@pytest.mark.parametrize(
+    ("pattern", "said"),
+    [
+        ("pusher[1-2],sorter", "`[1-2]` is no index; brackets name a member by its number"),
+        ("pusher[1,sorter", "the `[` at character 7 is not closed"),
+    ],
+)
+def test_brackets_that_name_no_member_are_refused_before_the_run(tmp_path: Path, pattern: str, said: str) -> None:
+    trace = tmp_path / "run.mcap"
+    ran = earl_cli("run", str(SORTER), "--trace", str(trace), "--record-links", pattern)
+    assert ran.returncode == 2 and ran.stdout == ""
+    assert ran.stderr.startswith(f"earl: error: --record-links `{pattern}`: ") and said in ran.stderr
+    assert not trace.exists()
+
+
+def test_run_toml_record_links_names_members_alike(tmp_path: Path) -> None:
+    spec = tmp_path / "sorter"
+    shutil.copytree(SORTER, spec, ignore=shutil.ignore_patterns("__pycache__"))
+    settings = spec / "run.toml"
+    text = settings.read_text()
+    settings.write_text(text + 'record_links = ["sorter/a:*", "pusher[2],sorter"]\n')
+    trace = tmp_path / "run.mcap"
+    ran = earl_cli("run", str(spec), "--duration", "0.2s", "--trace", str(trace))
+    assert ran.returncode == 0, ran.stderr
+    assert "matches no link" not in ran.stderr
+    assert recorded_links(trace) == [
+        "pusher[2],sorter",
+        "sorter/a:beltDrive,beltMotor",
+        "sorter/a:camera,detector",
+        "sorter/a:cs,beltDrive",
+        "sorter/a:detector,cs",
+    ]
+    settings.write_text(text + 'record_links = ["pusher[a-c],sorter"]\n')
+    refused = earl_cli("run", str(spec), "--duration", "0.2s", "--trace", str(trace))
+    line = len(text.splitlines()) + 1
+    assert refused.returncode == 2
+    assert f"run.toml:{line}: `record_links`: `pusher[a-c],sorter`: `[a-c]` is no index" in refused.stderr
+
+
+def test_the_python_api_takes_the_same_link_patterns() -> None:
+    import earl
+
+    system = earl.load(SORTER / "system.earl")
+    with pytest.raises(ValueError, match=r"record_links: `pusher\[1-3\],sorter`: `\[1-3\]` is no index"):
+        earl.simulate(system, record_links=["pusher[1-3],sorter"])

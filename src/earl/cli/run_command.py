@@ -117,7 +117,8 @@ def register(commands: Any) -> None:
         action="append",
         default=None,
         metavar="PATTERN",
-        help="with --trace (or --plot): record only messages on links matching a glob, e.g. 'task,*' "
+        help="with --trace (or --plot): record only messages on links matching a glob, e.g. 'task,*'; "
+        "brackets name a member of a link family, 'sorter,pusher[2]', or every one, 'sorter,pusher[*]' "
         "(repeatable; default: all; to record none, write record_links = [] in run.toml)",
     )
     parser.add_argument(
@@ -361,6 +362,7 @@ def check_options(arguments: argparse.Namespace) -> CheckedOptions:
     anything runs, by `earl run` and by `earl launch` for each process's `args`. Fills in what follows from
     them: --signal from run.toml's `plot`, --trace from --plot, --realtime with --transport zenoh."""
     from earl.runtime.durations import parse_duration
+    from earl.runtime.link_patterns import link_pattern_problem
     from earl.runtime.run_settings import read_run_settings
 
     path = spec_path(arguments.spec)
@@ -384,6 +386,10 @@ def check_options(arguments: argparse.Namespace) -> CheckedOptions:
     ):
         for text in given or []:
             named(text, option, example, what)
+    for pattern in arguments.record_links or []:
+        problem = link_pattern_problem(pattern)
+        if problem is not None:
+            raise UsageError(f"--record-links {problem}")
     try:
         settings = read_run_settings(path)
     except ValueError as error:
@@ -463,7 +469,7 @@ def _say_what_is_not_recorded(
     """A line for each link pattern (of --record-links, or else of run.toml's `record_links`) that
     matches no link of the system: a misspelt glob would otherwise leave the trace quietly empty.
     (--record-links without a trace to record into is refused by `check_options`.)"""
-    from fnmatch import fnmatchcase
+    from earl.runtime.link_patterns import matches, no_link_matched
 
     links = sorted(simulation.network.link_types)
     if arguments.record_links is not None:
@@ -471,9 +477,8 @@ def _say_what_is_not_recorded(
     else:  # the command line wins over run.toml: only the patterns the run uses are checked
         patterns, said = record_links_of_run_toml or [], "record_links `{}` in run.toml"
     for pattern in patterns:
-        if not any(fnmatchcase(link, pattern) for link in links):
-            known = ", ".join(links[:8]) + (" …" if len(links) > 8 else "")
-            print(f"earl run: {said.format(pattern)} matches no link (the links: {known or 'none'})", file=sys.stderr)
+        if not any(matches(pattern, link) for link in links):
+            print(f"earl run: {said.format(pattern)} {no_link_matched(pattern, links)}", file=sys.stderr)
 
 
 #: signals that end a run as Ctrl-C does: `kill`, `timeout`, a service manager, a closed terminal

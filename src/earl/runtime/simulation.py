@@ -102,6 +102,7 @@ class Simulation:
     ) -> None:
         _refuse_wrong_arguments(system, trace, record_memory=record_memory, record_links=record_links, agents=agents)
         _refuse_wrong_arguments(system, trace, record_outputs=record_outputs)
+        _refuse_wrong_link_patterns(record_links)
         refuse_wrong_parameters(parameters)
         parameters = dict(parameters or {})
         if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
@@ -399,16 +400,25 @@ def _refuse_unknown_outputs(outputs: list[str] | None, expanded: System) -> None
 def _warn_of_patterns_matching_nothing(patterns: list[str] | None, links: Mapping[str, object]) -> None:
     """A misspelt glob would leave the trace quietly without the links meant (`earl run` says the same)."""
     import warnings
-    from fnmatch import fnmatchcase
+
+    from earl.runtime.link_patterns import matches, no_link_matched
 
     for pattern in patterns or []:
-        if not any(fnmatchcase(link, pattern) for link in links):
-            shown = ", ".join(sorted(links)[:8]) + (" …" if len(links) > 8 else "")
+        if not any(matches(pattern, link) for link in links):
             warnings.warn(
-                f"record_links: `{pattern}` matches no link (the links: {shown or 'none'})",
-                RecordingWarning,
-                stacklevel=3,
+                f"record_links: `{pattern}` {no_link_matched(pattern, links)}", RecordingWarning, stacklevel=3
             )
+
+
+def _refuse_wrong_link_patterns(patterns: list[str] | None) -> None:
+    """A pattern whose brackets hold no index (`pusher[1-3]`): said before anything runs, not warned
+    of as matching no link (brackets name a member, not a character class)."""
+    from earl.runtime.link_patterns import link_pattern_problem
+
+    for pattern in patterns or []:
+        problem = link_pattern_problem(pattern)
+        if problem is not None:
+            raise ValueError(f"record_links: {problem}")
 
 
 def _refuse_wrong_arguments(system: object, trace: object, **lists: object) -> None:

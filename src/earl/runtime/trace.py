@@ -38,7 +38,6 @@ import subprocess
 import sys
 import time
 from collections.abc import Callable
-from fnmatch import fnmatchcase
 from pathlib import Path
 from typing import IO, Any, NoReturn
 
@@ -46,7 +45,7 @@ import msgpack  # type: ignore[import-untyped]
 
 from earl import __version__
 from earl.model.types import DataType
-from earl.runtime import trace_topics
+from earl.runtime import link_patterns, trace_topics
 from earl.runtime.events import Fault, MessageWriter, Recorder
 from earl.runtime.values import TypeSystem, json_schema, to_json
 
@@ -493,7 +492,7 @@ class TraceWriter(Recorder):
         return (
             self.link_patterns is None
             or link in self.links_also_recorded
-            or any(fnmatchcase(link, p) for p in self.link_patterns)
+            or any(link_patterns.matches(p, link) for p in self.link_patterns)
         )
 
     def _link(self, link: str) -> int | None:
