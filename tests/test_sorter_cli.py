@@ -195,3 +195,80 @@ def test_the_python_api_takes_the_same_link_patterns() -> None:
     system = earl.load(SORTER / "system.earl")
     with pytest.raises(ValueError, match=r"record_links: `pusher\[1-3\],sorter`: `\[1-3\]` is no index"):
         earl.simulate(system, record_links=["pusher[1-3],sorter"])
+
+
+def recorded_memories(trace: Path) -> list[str]:
+    from earl.runtime.trace_reader import topics
+
+    return sorted(topic.strip("/").removesuffix("/memory") for topic in topics(trace) if topic.endswith("/memory"))
+
+
+@pytest.mark.parametrize("family", ["pusher[*]/a.cs", "pusher[K]/a.cs", "pusher/a.cs"])
+def test_record_memory_names_a_family_of_agents_whole_as_a_robot_does(tmp_path: Path, family: str) -> None:
+    """It was refused: "names no subsystem of this run … (subsystems are named like sorter/a.cs)"."""
+    trace = tmp_path / "run.mcap"
+    ran = earl_cli("run", str(SORTER), "--duration", "0.1s", "--trace", str(trace), "--record-memory", family)
+    assert ran.returncode == 0, ran.stderr
+    assert recorded_memories(trace) == ["pusher[1]/a.cs", "pusher[2]/a.cs", "pusher[3]/a.cs"]
+
+
+def test_record_memory_of_no_subsystem_shows_how_a_member_and_a_family_are_named(tmp_path: Path) -> None:
+    ran = earl_cli("run", str(SORTER), "--trace", str(tmp_path / "r.mcap"), "--record-memory", "pusher[4]/a.cs")
+    assert ran.returncode == 2
+    assert "names no subsystem of this run: pusher[4]/a.cs" in ran.stderr
+    assert "a family's member `pusher[1]/a.cs`, or every member, `pusher[*]/a.cs`" in ran.stderr
+
+
+def test_agents_names_a_family_whole(tmp_path: Path) -> None:
+    """`--agents 'pusher[*]'` is every member (`earl launch` passes a process's agents as it got them)."""
+    trace = tmp_path / "run.mcap"
+    ran = earl_cli(
+        "run",
+        str(SORTER),
+        "--agents",
+        "pusher[*]",
+        "--environment",
+        "none",
+        "--duration",
+        "0.05s",
+        "--trace",
+        str(trace),
+        "--record-memory",
+        "pusher/a.arm/ve",
+    )
+    assert ran.returncode == 0, ran.stderr
+    from earl.runtime.trace_reader import summarise
+
+    assert sorted(summarise(trace).subsystems) == [
+        f"pusher[{k}]/a.{s}" for k in (1, 2, 3) for s in ("arm/ve", "armMotor/re", "cs")
+    ]
+    assert recorded_memories(trace) == ["pusher[1]/a.arm/ve", "pusher[2]/a.arm/ve", "pusher[3]/a.arm/ve"]
+    twice = earl_cli(
+        "run", str(SORTER), "--agents", "pusher[*],pusher[2]", "--environment", "none", "--duration", "0.05s"
+    )
+    assert twice.returncode == 2 and "--agents: `pusher[2]/a` is named twice" in twice.stderr
+
+
+def test_launch_runs_a_family_of_agents_a_deploy_toml_names_whole(tmp_path: Path) -> None:
+    """`agents = ["pusher[*]/a"]` is the process of every member (it was "not an agent of this system");
+    the two processes exchange messages over Zenoh on 127.0.0.1."""
+    import socket
+
+    spec = tmp_path / "sorter"
+    shutil.copytree(SORTER, spec, ignore=shutil.ignore_patterns("__pycache__"))
+    sockets = [socket.socket() for _ in range(2)]
+    for s in sockets:
+        s.bind(("127.0.0.1", 0))
+    ports = [s.getsockname()[1] for s in sockets]
+    for s in sockets:
+        s.close()
+    (spec / "deploy.toml").write_text(
+        f'[[process]]\nagents = ["sorter/a"]\nlisten = "tcp/127.0.0.1:{ports[0]}"\nenvironment = true\n\n'
+        f'[[process]]\nagents = ["pusher[*]/a"]\nlisten = "tcp/127.0.0.1:{ports[1]}"\nenvironment = false\n'
+        'args = ["--environment", "none"]\n'
+    )
+    launched = earl_cli("launch", str(spec), "--duration", "1s")
+    assert "[pusher[1]/a,pusher[2]/a,pusher[3]/a] system conveyorSorter: 1.000 s" in launched.stdout, launched.stdout
+    received = [line for line in launched.stdout.splitlines() if line.startswith("[sorter/a") and "received" in line]
+    assert len(received) == 3 and all(" 0 received" not in line for line in received), launched.stdout
+    assert "Traceback" not in launched.stdout + launched.stderr

@@ -963,3 +963,30 @@ def test_the_run_options_sharing_a_prefix_with_the_launch_options_are_known_to_t
         other for other in options - set(LAUNCH_SETS) - {"--help"} for launch in LAUNCH_SETS if other[:3] == launch[:3]
     }
     assert sharing == set(SHARING_A_PREFIX)
+
+
+def test_a_deployment_names_a_family_of_agents_whole_or_member_by_member(tmp_path: Path) -> None:
+    """`worker[*]`, `worker[K]` or `worker` is every member, as in a robot; a member in two processes is
+    said at its line, whichever way it is named."""
+    path = tmp_path / "deploy.toml"
+    agents = ["boss/a", "worker[1]/a", "worker[2]/a", "worker[3]/a"]
+    for family in ("worker[*]", "worker[K]/a", "worker"):
+        path.write_text(
+            "[[process]]\nagents = ['boss']\nlisten = 'tcp/127.0.0.1:1'\n"
+            f"[[process]]\nagents = ['{family}']\nlisten = 'tcp/127.0.0.1:2'\n"
+        )
+        deployment = read_deployment(path).check_agents(agents)
+        assert [process.agents for process in deployment.processes] == [
+            ("boss/a",),
+            ("worker[1]/a", "worker[2]/a", "worker[3]/a"),
+        ]
+        assert deployment.group_of(["worker[3]", "worker[1]", "worker[2]"]) is deployment.processes[1]
+    path.write_text(
+        "[[process]]\nagents = ['boss', 'worker[2]']\nlisten = 'tcp/127.0.0.1:1'\n"
+        "[[process]]\nagents = [\n  'worker[*]',\n]\nlisten = 'tcp/127.0.0.1:2'\n"
+    )
+    with pytest.raises(
+        DeploymentError,
+        match=r"deploy\.toml:6: process 2: `worker\[2\]/a` \(a member of `worker\[\*\]/a`\) already runs in process 1",
+    ):
+        read_deployment(path).check_agents(agents)

@@ -110,7 +110,7 @@ def run(arguments: argparse.Namespace) -> int:
     try:
         deployment = read_deployment(deployment_path)
         known, acting = _agents(path, arguments.param)
-        deployment.check_agents(known)
+        deployment = deployment.check_agents(known)
         environment = read_run_settings(path).environment
         if environment not in (None, "none"):
             # each `earl run` places it by the same rule; said here, before anything starts

@@ -53,7 +53,8 @@ examples:
   earl run spec.earl --duration 30s --seed 7              another seed, another random stream
   earl run spec.earl --realtime --duration 5s             paced by the wall clock, jitter reported
 
-Subsystems are named like manip/a.cs or manip/a.motorController[3]/ve. A `run.toml` next
+Subsystems are named like manip/a.cs or manip/a.motorController[3]/ve; a family whole
+(every member) like manip/a.motorController[*]/ve. A `run.toml` next
 to the spec may set defaults: environment, duration, seed, record_memory, record_links,
 plot, report.
 `--environment none` runs without it (a process whose agents have no physics).
@@ -110,7 +111,7 @@ def register(commands: Any) -> None:
         default=None,
         metavar="SUBSYSTEM",
         help="with --trace (or --plot): record memory snapshots of a subsystem after each iteration "
-        "(repeatable; `all` for every one)",
+        "(repeatable; `all` for every one; a family whole, pusher[*]/a.cs, for every member)",
     )
     parser.add_argument(
         "--record-links",
@@ -137,7 +138,8 @@ def register(commands: Any) -> None:
     parser.add_argument(
         "--agents",
         metavar="A,B",
-        help="run only these agents, e.g. manip/a,grip/a (with --transport zenoh the others run in other processes)",
+        help="run only these agents, e.g. manip/a,grip/a, or a family's every member, pusher[*]/a "
+        "(with --transport zenoh the others run in other processes)",
     )
     parser.add_argument(
         "--transport",
@@ -185,6 +187,7 @@ def _run(arguments: argparse.Namespace) -> int:
 
     watch_supervisor()
     launch_status = take_launch_status()
+    from earl.runtime.names import named_members
     from earl.runtime.simulation import RecordingWarning, Simulation, bind_report
 
     try:
@@ -203,10 +206,6 @@ def _run(arguments: argparse.Namespace) -> int:
     if environment == "none":
         environment = None
     record_memory = arguments.record_memory if arguments.record_memory is not None else settings.record_memory
-    if agents and arguments.record_memory is None and record_memory:
-        # run.toml names the subsystems of the whole system; this process records those it runs
-        wanted = {a if a.endswith("/a") else f"{a}/a" for a in agents}
-        record_memory = [m for m in record_memory if m.split(".", 1)[0] in wanted]
     transport: Any = None
     plotted_outputs: list[str] = []
     try:
@@ -226,6 +225,10 @@ def _run(arguments: argparse.Namespace) -> int:
             from earl.transport.process import agents_of
 
             agents = agents_of(system, parameters, agents)
+        if agents and arguments.record_memory is None and record_memory:
+            # run.toml names the subsystems of the whole system; this process records those it runs
+            # (a family's, `pusher[*]/a.cs`, if it runs a member)
+            record_memory = [m for m in record_memory if named_members(m.split(".", 1)[0], agents)]
         # bound now, as the spec's functions are: not found to be misspelt after the whole run
         report = bind_report(settings.report, path, settings) if settings.report and environment is not None else None
         if arguments.plot:

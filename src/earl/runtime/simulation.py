@@ -16,13 +16,14 @@ import contextlib
 import inspect
 import math
 import numbers
+import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
 from earl import _program
-from earl.diagnostics import Diagnostic, EarlError, Severity, SourceMap
+from earl.diagnostics import Diagnostic, EarlError, Severity, SourceMap, did_you_mean
 from earl.model.digest import model_digest
 from earl.model.elements import Duration, System
 from earl.model.expand import expand
@@ -33,6 +34,7 @@ from earl.runtime.binding import BindingProblem, resolve_callable, user_code_pat
 from earl.runtime.builder import NANOSECONDS, Network, RemoteLinks, build_network, to_nanoseconds
 from earl.runtime.engine import exception_text
 from earl.runtime.events import Fault, Recorder, Recorders, StatisticsRecorder
+from earl.runtime.names import family_example, named_members
 from earl.runtime.run_settings import RunSettings, read_run_settings
 from earl.runtime.scheduler import Inbox, Scheduler
 from earl.runtime.trace import TraceWriter
@@ -157,15 +159,7 @@ class Simulation:
                     remote=transport,
                 )
             self.transport = transport
-            memory = set(record_memory or [])
-            if "all" in memory:
-                memory = set(self.network.by_name)
-            unknown = sorted(memory - set(self.network.by_name))
-            if unknown:
-                raise ValueError(
-                    f"record_memory (--record-memory, run.toml's record_memory) names no subsystem of this run: {', '.join(unknown)} "
-                    f"(subsystems are named like {next(iter(self.network.by_name), 'manip/a.cs')})"
-                )
+            memory = _memory_recorded(record_memory or [], list(self.network.by_name))
             _refuse_unknown_outputs(record_outputs, self.expanded)
             _warn_of_patterns_matching_nothing(record_links, self.network.link_types)
             if transport is not None:
@@ -408,6 +402,31 @@ def _warn_of_patterns_matching_nothing(patterns: list[str] | None, links: Mappin
             warnings.warn(
                 f"record_links: `{pattern}` {no_link_matched(pattern, links)}", RecordingWarning, stacklevel=3
             )
+
+
+def _memory_recorded(named: list[str], subsystems: list[str]) -> set[str]:
+    """The subsystems whose memory `record_memory` names: `all`, a subsystem, or every member of a
+    family (`pusher[*]/a.cs`, `pusher[K]/a.cs`, `pusher/a.cs`, as a robot names one); a ValueError
+    for a name of none."""
+    if "all" in named:
+        return set(subsystems)
+    memory: set[str] = set()
+    unknown: list[str] = []
+    for name in named:
+        members = named_members(name, subsystems)
+        memory.update(members)
+        if not members:
+            unknown.append(name)
+    if unknown:
+        families = [re.sub(r"\[[0-9]+\]", "[*]", name) for name in subsystems]
+        hint = did_you_mean(unknown[0], [*dict.fromkeys(families), *subsystems]) if len(unknown) == 1 else None
+        family = family_example(subsystems)
+        example = f"`{next(iter(subsystems), 'manip/a.cs')}`" + (f", a family's member {family}" if family else "")
+        raise ValueError(
+            "record_memory (--record-memory, run.toml's record_memory) names no subsystem of this run: "
+            f"{', '.join(sorted(unknown))} ({f'{hint} ' if hint else ''}subsystems are named like {example})"
+        )
+    return memory
 
 
 def _refuse_wrong_link_patterns(patterns: list[str] | None) -> None:

@@ -32,6 +32,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from earl.diagnostics import did_you_mean
+from earl.runtime.names import named_members
 from earl.toml_lines import TomlTable, as_written, invalid_toml, key_lines, toml_tables, value_line
 from earl.transport.listeners import clash, listener
 
@@ -153,23 +154,40 @@ class Deployment:
         """The endpoints `process` connects to: every other process's."""
         return [other.listen for other in self.processes if other is not process]
 
-    def check_agents(self, system_agents: list[str]) -> None:
-        """Every agent of the system runs in one process, and the file names no other."""
-        deployed = [agent for process in self.processes for agent in process.agents]
-        known = set(system_agents)
+    def check_agents(self, system_agents: list[str]) -> Deployment:
+        """Every agent of the system runs in one process, and the file names no other. Returned: this
+        deployment with a family named whole (`pusher[*]/a`, `pusher[K]/a` or `pusher/a`, as a robot
+        names one) replaced by its members, in the system's order: a process runs whole agents, and a
+        family's members are agents."""
+        processes: list[ProcessGroup] = []
+        runs: dict[str, int] = {}
         for number, process in enumerate(self.processes, start=1):
+            agents: list[str] = []
             for agent in process.agents:
-                if agent not in known:
+                where = self.at(number, "agents", self._written_agent(number, agent))
+                members = named_members(agent, system_agents)
+                if not members:
                     raise DeploymentError(
-                        f"{self.at(number, 'agents', self._written_agent(number, agent))}: process {number}: "
-                        f"`{agent}` is not an agent of this system "
+                        f"{where}: process {number}: `{agent}` is not an agent of this system "
                         f"(its agents: {', '.join(system_agents)})"
                     )
-        missing = [agent for agent in system_agents if agent not in deployed]
+                for member in members:
+                    of = "" if member == agent else f" (a member of `{agent}`)"
+                    if member in agents:
+                        raise DeploymentError(f"{where}: process {number}: `{member}`{of} is listed twice")
+                    if member in runs:
+                        raise DeploymentError(
+                            f"{where}: process {number}: `{member}`{of} already runs in process {runs[member]}"
+                        )
+                    runs[member] = number
+                    agents.append(member)
+            processes.append(replace(process, agents=tuple(agents)))
+        missing = [agent for agent in system_agents if agent not in runs]
         if missing:
             raise DeploymentError(
                 f"{self.first_line()}: the agent `{missing[0]}` runs in no process; add it to a process's `agents`"
             )
+        return replace(self, processes=tuple(processes))
 
     def place_environment(self, acting: Collection[str]) -> Deployment:
         """This deployment with every process's `environment` decided, for a system whose agents

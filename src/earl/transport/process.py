@@ -17,7 +17,7 @@ from earl.diagnostics import escape_controls
 from earl.model.elements import System
 from earl.model.expand import expand
 from earl.model.kinds import Kind
-from earl.runtime.names import agent_name
+from earl.runtime.names import agent_name, named_members
 from earl.transport.deployment import normalise_agent, read_deployment
 from earl.transport.zenoh_transport import (
     TransportError,
@@ -75,7 +75,7 @@ def prepare_transport(
                 "name one with --deployment, or give your own --zenoh-config"
             )
         deployment = read_deployment(path)  # a DeploymentError: exit 1, as `earl launch` says it
-        deployment.check_agents(known)
+        deployment = deployment.check_agents(known)
         if environment is not None:
             deployment = deployment.place_environment(acting_agents(expanded))
         group = deployment.group_of(names)
@@ -121,12 +121,17 @@ def prepare_transport(
 def agents_of(system: System, parameters: Mapping[str, Any], agents: list[str]) -> list[str]:
     """`--agents` normalised (`task` is `task/a`); `ValueError` naming one that the system does not have."""
     known = [agent_name(agent) for agent in expand(system, dict(parameters)).agents]
-    names = [normalise_agent(a) for a in agents]
-    for position, name in enumerate(names):
-        if name not in known:
+    names: list[str] = []
+    for written in agents:
+        name = normalise_agent(written)
+        # a family whole (`pusher[*]/a`, `pusher[K]/a`, `pusher/a`) is every member, as in a robot
+        members = named_members(name, known)
+        if not members:
             raise ValueError(f"--agents: `{name}` is not an agent of this system (its agents: {', '.join(known)})")
-        if name in names[:position]:
-            raise ValueError(f"--agents: `{name}` is named twice")
+        twice = next((member for member in members if member in names), None)
+        if twice is not None:
+            raise ValueError(f"--agents: `{twice}` is named twice")
+        names += members
     return names
 
 
