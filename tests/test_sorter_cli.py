@@ -272,3 +272,54 @@ def test_launch_runs_a_family_of_agents_a_deploy_toml_names_whole(tmp_path: Path
     received = [line for line in launched.stdout.splitlines() if line.startswith("[sorter/a") and "received" in line]
     assert len(received) == 3 and all(" 0 received" not in line for line in received), launched.stdout
     assert "Traceback" not in launched.stdout + launched.stderr
+
+
+def sorter_dividing_by_zero(tmp_path: Path) -> Path:
+    """The sorter whose `classify/pf` calls a helper of its own package that divides by zero."""
+    spec = tmp_path / "sorter"
+    shutil.copytree(SORTER, spec, ignore=shutil.ignore_patterns("__pycache__"))
+    (spec / "sorting" / "ratios.py").write_text("def ratio(a, b):\n    return a / b\n")
+    code = spec / "sorting" / "sorter.py"
+    text = code.read_text()
+    old = "    outputs.lastPart = d.partId\n"
+    assert old in text
+    code.write_text("from sorting.ratios import ratio\n\n\n" + text.replace(old, old + "    ratio(1, 0)\n"))
+    return spec
+
+
+def test_a_fault_of_the_spec_s_code_says_where_and_its_traceback_is_one_command_away(tmp_path: Path) -> None:
+    """It said only "`classify/pf` raised ZeroDivisionError: division by zero": no file or line of the
+    spec's code, though the traceback was recorded."""
+    spec = sorter_dividing_by_zero(tmp_path)
+    where = "(at sorting/ratios.py:2 in ratio, from sorting/sorter.py:7 in classify)"
+    ran = earl_cli("run", str(spec), "--duration", "2s", cwd=spec)
+    assert ran.returncode == 0, ran.stderr
+    assert f"`classify/pf` raised ZeroDivisionError: division by zero {where}\n" in ran.stdout
+    assert "  tracebacks: run with --trace FILE.mcap, then earl trace faults FILE.mcap\n" in ran.stdout
+    traced = earl_cli("run", str(spec), "--duration", "2s", "--trace", "run.mcap", cwd=spec)
+    assert "  tracebacks: earl trace faults run.mcap\n" in traced.stdout
+    summary = earl_cli("trace", "summary", "run.mcap", cwd=spec)
+    assert (
+        f"division by zero {where}" in summary.stdout
+        and "their tracebacks: earl trace faults run.mcap" in summary.stdout
+    )
+    faults = earl_cli("trace", "faults", "run.mcap", cwd=spec)
+    assert faults.returncode == 0, faults.stderr
+    shown = faults.stdout
+    assert shown.startswith("run.mcap: ") and " distinct\n" in shown.splitlines()[0] + "\n"
+    # the function's frame and the helper's, with their lines of code; none of earl's own
+    entry = shown.split(f"division by zero {where}", 1)[1]
+    assert entry.startswith(", ×")  # raised at every part seen, shown once
+    assert f'File "{spec / "sorting" / "sorter.py"}", line 7, in classify\n      ratio(1, 0)\n' in entry
+    assert f'File "{spec / "sorting" / "ratios.py"}", line 2, in ratio\n      return a / b\n' in entry
+    assert "ZeroDivisionError: division by zero" in entry and "earl/runtime" not in shown
+
+
+def test_earl_trace_faults_of_a_run_without_faults_and_of_no_trace(tmp_path: Path, sorter_trace: Path) -> None:
+    listed = earl_cli("trace", "faults", str(sorter_trace))
+    assert listed.returncode == 0 and listed.stdout == "run.mcap: 0 faults, 0 distinct\n"
+    assert earl_cli("trace", "faults", str(tmp_path / "none.mcap")).returncode == 2
+    junk = tmp_path / "junk.mcap"
+    junk.write_text("not a trace")
+    refused = earl_cli("trace", "faults", str(junk))
+    assert refused.returncode == 1 and refused.stderr.startswith("earl trace: ") and "Traceback" not in refused.stderr

@@ -38,6 +38,7 @@ from earl.cli.common import (
 )
 from earl.cli.output import print_diagnostics
 from earl.diagnostics import EarlError
+from earl.runtime.fault_places import fault_place
 from earl.transport.deployment import DeploymentError
 
 if TYPE_CHECKING:
@@ -754,9 +755,15 @@ def _summary(simulation: Any, wall: float, arguments: argparse.Namespace) -> Non
             soft_wrap=True,
         )
         first = faults[0]
+        place = brief(fault_place(first.traceback))
         console.print(
-            f"  t={first.time / 1e9:.6f} s {first.subsystem} ({first.kind}): {brief(first.message)}", soft_wrap=True
+            f"  t={first.time / 1e9:.6f} s {first.subsystem} ({first.kind}): {brief(first.message)}{place}",
+            soft_wrap=True,
         )
+        if any(fault.traceback for fault in faults):
+            where = arguments.trace or "FILE.mcap"
+            after = "" if arguments.trace else "run with --trace FILE.mcap, then "
+            console.print(f"  tracebacks: {after}earl trace faults {where}", soft_wrap=True)
     ratio = simulation.time / wall if wall > 0 else float("inf")
     mode = "real time" if arguments.realtime else "virtual time"
     console.print(f"ran {simulation.time:.3f} s of {mode} in {wall:.2f} s of wall time ({ratio:.1f}x real time)")

@@ -19,7 +19,7 @@ def register(commands: Any) -> None:
         "trace",
         help="read an MCAP trace written by `earl run --trace`",
         description="Read a trace written by `earl run --trace FILE.mcap`.",
-        epilog="example:\n  earl trace summary run.mcap\n\nexit codes: 0 ok, 1 not a readable earl trace, 2 usage error (no such file, no ACTION), "
+        epilog="examples:\n  earl trace summary run.mcap\n  earl trace faults run.mcap\n\nexit codes: 0 ok, 1 not a readable earl trace, 2 usage error (no such file, no ACTION), "
         "130 interrupted (Ctrl-C)",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -34,6 +34,19 @@ def register(commands: Any) -> None:
     )
     summary.add_argument("file", metavar="FILE.mcap")
     summary.set_defaults(run=run_summary)
+    faults = actions.add_parser(
+        "faults",
+        help="each fault with the traceback of the spec's code that raised it",
+        description="Each fault of the run with where it happened and, for a function or predicate of the\n"
+        "spec that raised, the traceback of the spec's own code (earl's frames left out). A fault\n"
+        "repeated (the same subsystem, kind, message and traceback) is shown once, with how many\n"
+        "times and when it first and last happened.",
+        epilog="example:\n  earl trace faults run.mcap\n\nexit codes: 0 listed (also when the run had none), "
+        "1 not a readable earl trace, 2 usage error (no such file), 130 interrupted (Ctrl-C)",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    faults.add_argument("file", metavar="FILE.mcap")
+    faults.set_defaults(run=run_faults)
     trace.set_defaults(run=lambda _arguments: (trace.print_help(), 2)[1])
 
     plot = commands.add_parser(
@@ -105,12 +118,56 @@ def run_summary(arguments: argparse.Namespace) -> int:
     kinds = f" ({fault_kinds(str(fault['kind']) for fault in summary.faults)})" if summary.faults else ""
     console.print(f"{summary.messages} messages on links, {len(summary.faults)} faults{kinds}")
     for fault in summary.faults[:10]:
-        console.print(
-            f"  t={fault['time'] * 1e-9:.6f} s {fault['subsystem']} ({fault['kind']}): {brief(str(fault['message']))}",
-            soft_wrap=True,
-        )
+        console.print(f"  {_fault_line(fault)}", soft_wrap=True)
     if len(summary.faults) > 10:
         console.print(f"  … and {len(summary.faults) - 10} more")
+    if any(fault.get("traceback") for fault in summary.faults):
+        console.print(f"their tracebacks: earl trace faults {path}", soft_wrap=True)
+    return EXIT_OK
+
+
+def _fault_line(fault: dict[str, Any]) -> str:
+    """`t=0.950000 s sorter/a.cs (exception): `classify/pf` raised … (at sorting/sorter.py:8 in classify)`."""
+    from earl.runtime.fault_places import fault_place
+
+    place = fault_place(str(fault.get("traceback") or ""))
+    return f"t={fault['time'] * 1e-9:.6f} s {fault['subsystem']} ({fault['kind']}): {brief(str(fault['message']))}{brief(place)}"
+
+
+#: the distinct faults `earl trace faults` shows at most: a message with a value in it can make each new
+FAULTS_SHOWN = 20
+
+
+def run_faults(arguments: argparse.Namespace) -> int:
+    from earl.runtime.trace_reader import CUT, TraceError, read_faults
+
+    path = Path(arguments.file)
+    if not path.is_file():
+        return usage_error(_not_a_file(arguments.file))
+    try:
+        faults, cut = read_faults(path)
+    except TraceError as error:
+        sys.stderr.write(f"earl trace: {error}\n")
+        return EXIT_FAILED
+    console = table_console()
+    # one entry per fault as it repeats, every iteration, in the order they first happened
+    repeated: dict[tuple[str, ...], list[dict[str, Any]]] = {}
+    for fault in faults:
+        key = tuple(str(fault.get(name, "")) for name in ("subsystem", "kind", "message", "function", "traceback"))
+        repeated.setdefault(key, []).append(fault)
+    kinds = f" ({fault_kinds(str(fault.get('kind', '')) for fault in faults)})" if faults else ""
+    console.print(f"{path.name}: {len(faults)} faults{kinds}, {len(repeated)} distinct", soft_wrap=True)
+    for same in list(repeated.values())[:FAULTS_SHOWN]:
+        first, last = same[0], same[-1]
+        times = f", ×{len(same)} until t={last['time'] * 1e-9:.6f} s" if len(same) > 1 else ""
+        console.print(f"\n{_fault_line(first)}{times}", soft_wrap=True)
+        text = str(first.get("traceback") or "")
+        for line in text.rstrip("\n").split("\n") if text else []:
+            console.print(f"  {brief(line)}", soft_wrap=True)
+    if len(repeated) > FAULTS_SHOWN:
+        console.print(f"\n… and {len(repeated) - FAULTS_SHOWN} more distinct faults")
+    if cut:
+        console.print(f"{path.name}: {CUT}")
     return EXIT_OK
 
 

@@ -211,6 +211,23 @@ def summarise(path: Path) -> TraceSummary:
     return summary
 
 
+def read_faults(path: Path) -> tuple[list[dict[str, Any]], bool]:
+    """The faults of a trace in the order they happened, each as written (`subsystem`, `kind`,
+    `message`, `function`, `traceback`, …) with its `time` in nanoseconds; and whether the file had no
+    valid end (read up to its first damaged record). Only the faults' topic is read."""
+    channels = _channels(path)
+    if trace_topics.RUN not in channels:
+        raise _not_an_earl_trace(path, channels)
+    _refuse_a_newer_format(path)
+    cut: list[bool] = []
+    faults: list[dict[str, Any]] = []
+    for topic, _, time, data in _messages(path, [trace_topics.FAULTS], cut):
+        if not isinstance(data, dict):
+            raise _not_from_earl(path, topic)
+        faults.append({"time": time, **data})
+    return faults, bool(cut)
+
+
 def _refuse_a_newer_format(path: Path) -> None:
     """A trace of a newer format than this earl reads is said to be one, before its messages are read
     as this earl's: they may be written otherwise, which would read as damage. The format is in the
