@@ -158,7 +158,13 @@ def test_a_failing_function_makes_the_error_condition_true_and_the_fsm_recovers(
     [fault] = sim.faults
     assert fault.kind == kind
     assert message in fault.message
-    assert fault.time == 2 * MS and fault.state == "work" and fault.function == "trip"
+    # seconds, as sim.time and context.time are; the exact nanoseconds beside them
+    assert (
+        fault.time == pytest.approx(0.002)
+        and fault.time_ns == 2 * MS
+        and fault.state == "work"
+        and fault.function == "trip"
+    )
     if kind in ("exception", "undeclared-read"):
         # the traceback starts in the user's code and shows the line that failed
         assert "stages.py" in fault.traceback and "earl/runtime" not in fault.traceback

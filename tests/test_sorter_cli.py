@@ -4,6 +4,7 @@ user wrote it. Real processes, real files."""
 
 from __future__ import annotations
 
+import json
 import shutil
 import subprocess
 import sys
@@ -323,3 +324,32 @@ def test_earl_trace_faults_of_a_run_without_faults_and_of_no_trace(tmp_path: Pat
     junk.write_text("not a trace")
     refused = earl_cli("trace", "faults", str(junk))
     assert refused.returncode == 1 and refused.stderr.startswith("earl trace: ") and "Traceback" not in refused.stderr
+
+
+def test_a_fault_s_time_is_seconds_as_the_python_api_s_other_times_and_the_trace_stamps_it_alike(
+    tmp_path: Path,
+) -> None:
+    """`Fault.time` was integer nanoseconds (950000000) where `sim.time` and `context.time` are seconds."""
+    import earl
+    from earl.runtime.trace_reader import read_faults
+
+    spec = sorter_dividing_by_zero(tmp_path)
+    (spec / "sorting" / "ratios.py").write_text(
+        "import json, pathlib\n\n\ndef ratio(a, b, context=None):\n"
+        "    pathlib.Path(__file__).with_name('seen.json').write_text(json.dumps(context.time))\n"
+        "    return a / b\n"
+    )
+    code = spec / "sorting" / "sorter.py"
+    code.write_text(code.read_text().replace("ratio(1, 0)", "ratio(1, 0, context)"))
+    trace = tmp_path / "run.mcap"
+    simulation = earl.simulate(earl.load(spec / "system.earl"), trace=str(trace))
+    simulation.advance_to(0.96)
+    simulation.close()
+    first = simulation.faults[0]
+    assert first.kind == "exception" and isinstance(first.time, float)
+    # the time the function that raised was called at
+    assert first.time == json.loads((spec / "sorting" / "seen.json").read_text()) == pytest.approx(0.95)
+    assert first.time_ns == 950_000_000 and "ratios.py" in first.traceback
+    # the trace keeps its nanoseconds
+    faults, _ = read_faults(trace)
+    assert faults[0]["time"] == 950_000_000 and faults[0]["message"] == first.message

@@ -757,7 +757,7 @@ def _summary(simulation: Any, wall: float, arguments: argparse.Namespace) -> Non
         first = faults[0]
         place = brief(fault_place(first.traceback))
         console.print(
-            f"  t={first.time / 1e9:.6f} s {first.subsystem} ({first.kind}): {brief(first.message)}{place}",
+            f"  t={first.time:.6f} s {first.subsystem} ({first.kind}): {brief(first.message)}{place}",
             soft_wrap=True,
         )
         if any(fault.traceback for fault in faults):

@@ -253,15 +253,15 @@ class SubsystemEngine:
         self.faults += 1
         state = self.state
         self.recorder.fault(
-            Fault(
+            Fault.at(
                 time,
                 self.name,
                 kind,
                 message,
-                state.name if state else "",
-                state.behaviour.name if state else "",
-                function,
-                trace,
+                state=state.name if state else "",
+                behaviour=state.behaviour.name if state else "",
+                function=function,
+                traceback=trace,
             )
         )
 

@@ -1,7 +1,9 @@
 """What a run reports as it goes: state changes, behaviours, messages, memory, faults.
 
 The engine reports to a `Recorder`; the MCAP trace writer is one, the run summary
-another.  Times are integer nanoseconds of run time (simulated or wall).
+another.  Times are integer nanoseconds of run time (simulated or wall), but for a `Fault`, which the
+Python API hands out (`Simulation.faults`): its `time` is seconds, as the API's other times are, and
+its `time_ns` the exact nanoseconds.
 """
 
 from __future__ import annotations
@@ -29,18 +31,37 @@ class TransitionName(str):
 
 @dataclass
 class Fault:
-    """Something went wrong in a subsystem; the run goes on (docs/semantics.md, "Faults")."""
+    """Something went wrong in a subsystem; the run goes on (docs/semantics.md, "Faults";
+    docs/python-api.md, "Faults", says each field)."""
 
-    time: int
+    #: seconds of run time, as `Simulation.time` counts it: the `context.time` of the iteration it happened in
+    time: float
+    #: the subsystem it happened in, `sorter/a.cs`
     subsystem: str
-    #: "exception" | "undeclared-write" | "type" | "return-value" | "predicate" | "no-transition" | "overflow" |
-    #: "deadline" | "zero-time-loop" (which ends the run)
+    #: "exception" | "undeclared-write" | "undeclared-read" | "type" | "return-value" | "predicate" |
+    #: "no-transition" | "overflow" | "deadline" | "zero-time-loop" (which ends the run)
     kind: str
     message: str
+    #: the FSM state and its behaviour the subsystem was in ("" before its FSM started)
     state: str = ""
     behaviour: str = ""
+    #: the partial transition function (or Python predicate) at fault, `classify` ("" for none)
     function: str = ""
+    #: the traceback of the spec's own code that raised, earl's frames left out ("" for none)
     traceback: str = ""
+    #: the same instant as `time` in whole nanoseconds, exact: what the trace stamps the fault with
+    #: (the run's events count nanoseconds, as the trace does); from `time` when not given
+    time_ns: int = field(default=-1, repr=False)
+
+    def __post_init__(self) -> None:
+        if self.time_ns < 0:
+            self.time_ns = round(self.time * 1_000_000_000)
+
+    @classmethod
+    def at(cls, time_ns: int, subsystem: str, kind: str, message: str, **rest: str) -> Fault:
+        """A fault at `time_ns` nanoseconds of run time (how the engine counts it)."""
+        # as a function's `context.time` is computed: the fault of a function has the time it was called at
+        return cls(float(time_ns * 1e-9), subsystem, kind, message, time_ns=time_ns, **rest)
 
 
 @dataclass

@@ -546,7 +546,7 @@ class TraceWriter(Recorder):
         channel = self._channel(trace_topics.FAULTS, "earl.Fault", _FAULT_SCHEMA, {})
         self._write(
             channel,
-            fault.time,
+            fault.time_ns,
             {
                 "subsystem": fault.subsystem,
                 "kind": fault.kind,
