@@ -353,3 +353,84 @@ def test_a_fault_s_time_is_seconds_as_the_python_api_s_other_times_and_the_trace
     # the trace keeps its nanoseconds
     faults, _ = read_faults(trace)
     assert faults[0]["time"] == 950_000_000 and faults[0]["message"] == first.message
+
+
+def test_earl_plot_draws_a_window_of_the_run_where_a_10_ms_state_shows(sorter_trace: Path, tmp_path: Path) -> None:
+    """`dispatching` lasts one 10 ms period of `sorter/a.cs`: too narrow to see in a plot of the whole
+    run. `--from`/`--to` draw the window around it: the axis is the window, each signal starts it with
+    the value it held, the states are cut to it."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from earl.runtime.plot import draw_signals
+    from earl.runtime.trace_reader import read_signals, within
+
+    whole = read_signals(sorter_trace, ["sorter/a.cs.sorted"])
+    start, stop, _ = next(band for band in whole.bands["sorter/a.cs"] if band[2] == "dispatching")
+    assert stop - start == pytest.approx(0.01)
+    window = within(whole, start - 0.025, stop + 0.02)  # between two iterations
+    assert window.start == pytest.approx(start - 0.025) and window.end == pytest.approx(stop + 0.02)
+    [series] = window.series
+    assert series.times[0] == window.start and series.held  # the count held when the window starts
+    assert all(window.start <= time <= window.end for time in series.times)
+    states = [state for _, _, state in window.bands["sorter/a.cs"]]
+    assert states == ["watching", "dispatching", "watching"]
+    figure = draw_signals(window)
+    assert figure.axes[0].get_xlim() == pytest.approx((window.start, window.end))
+    picture = tmp_path / "window.png"
+    plot = earl_cli(
+        "plot",
+        str(sorter_trace),
+        "--signal",
+        "sorter/a.cs.sorted",
+        "--from",
+        f"{start - 0.02:.3f}",
+        "--to",
+        f"{(stop + 0.02) * 1000:.0f}ms",
+        "-o",
+        str(picture),
+    )
+    assert plot.returncode == 0 and plot.stderr == "" and picture.stat().st_size > 0, plot.stderr
+
+
+@pytest.mark.parametrize(
+    ("window", "said"),
+    [
+        (["--from", "-1"], "earl: error: --from -1: a time of the run is 0 s or more\n"),
+        (
+            ["--to", "soon"],
+            "earl: error: --to: `soon` is not a time; write e.g. `10s`, `500ms`, `2.5` (seconds) or `1min`\n",
+        ),
+        (["--from", "2", "--to", "1"], "earl: error: --from 2 is not before --to 1: the window would be empty\n"),
+        (
+            ["--from", "1s", "--to", "1000ms"],
+            "earl: error: --from 1s is not before --to 1000ms: the window would be empty\n",
+        ),
+    ],
+)
+def test_a_window_that_is_no_time_or_empty_is_a_usage_error(
+    sorter_trace: Path, tmp_path: Path, window: list[str], said: str
+) -> None:
+    picture = tmp_path / "x.png"
+    plot = earl_cli("plot", str(sorter_trace), "--signal", "sorter/a.cs.sorted", *window, "-o", str(picture))
+    assert plot.returncode == 2 and plot.stderr == said and not picture.exists()
+
+
+def test_a_window_after_the_trace_s_end_or_without_values_is_said(sorter_trace: Path, tmp_path: Path) -> None:
+    after = earl_cli(
+        "plot", str(sorter_trace), "--signal", "sorter/a.cs.sorted", "--from", "5", "-o", str(tmp_path / "a.png")
+    )
+    assert after.returncode == 1
+    assert after.stderr == "earl plot: the trace ends at 4.000000 s, by --from 5 s: nothing to draw after it\n"
+    # the first part is dispatched at 0.95 s: no push before it
+    early = earl_cli(
+        "plot",
+        str(sorter_trace),
+        "--signal",
+        "sorter/a.cs.push[*].partId",
+        "--to",
+        "0.5",
+        "-o",
+        str(tmp_path / "b.png"),
+    )
+    assert early.returncode == 1 and "earl plot: no signal has a value from 0 s to 0.5 s: " in early.stderr

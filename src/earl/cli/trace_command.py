@@ -60,9 +60,12 @@ def register(commands: Any) -> None:
         "brackets after a family's name choose a member by its declared index (windingCurrent[1]\n"
         "is member 1 of windingCurrent[K in 1..6]), brackets after an array an element counted\n"
         "from 0 (currentJointPos[0] is its first); [*] is every member or element.",
-        epilog="example:\n  earl plot run.mcap --signal manip/a.cs.windingCurrent[1] -o current.png\n\n"
-        "exit codes: 0 written, 1 the file is not a readable earl trace or lacks a signal, 2 usage error\n"
-        "(no such file, a malformed signal, an empty or unwritable -o), 130 interrupted (Ctrl-C)",
+        epilog="examples:\n  earl plot run.mcap --signal manip/a.cs.windingCurrent[1] -o current.png\n"
+        "  earl plot run.mcap --signal manip/a.cs.windingCurrent[1] --from 2.99 --to 3.02   (a window of 30 ms)\n\n"
+        "exit codes: 0 written, 1 the file is not a readable earl trace or lacks a signal (or has none\n"
+        "in the --from/--to window, or ends before --from), 2 usage error (no such file, a malformed\n"
+        "signal, an empty or unwritable -o, a --from or --to that is no time of 0 or more, --from not\n"
+        "before --to), 130 interrupted (Ctrl-C)",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     plot.add_argument("file", metavar="FILE.mcap")
@@ -73,6 +76,13 @@ def register(commands: Any) -> None:
         metavar="SIGNAL",
         help="a signal to draw (repeatable); x[1] of a family is member 1, v[0] of an array its first element",
     )
+    plot.add_argument(
+        "--from",
+        dest="start",
+        metavar="TIME",
+        help="draw the run from this time on, e.g. 2.5 (seconds) or 2500ms (default: its start)",
+    )
+    plot.add_argument("--to", dest="stop", metavar="TIME", help="draw the run up to this time (default: its end)")
     plot.add_argument("-o", "--output", default="plot.png", metavar="FILE.png", help="default plot.png")
     plot.add_argument("--title", help="a title over the figure")
     plot.set_defaults(run=run_plot)
@@ -186,13 +196,20 @@ def run_plot(arguments: argparse.Namespace) -> int:
     problem = plot_output_problem(output)
     if problem is not None:
         return usage_error(f"cannot write {arguments.output!r}: {problem}")
+    try:
+        start = _time_of("--from", arguments.start)
+        stop = _time_of("--to", arguments.stop)
+    except UsageError as error:
+        return usage_error(str(error))
+    if start is not None and stop is not None and not start < stop:
+        return usage_error(f"--from {arguments.start} is not before --to {arguments.stop}: the window would be empty")
     for signal in arguments.signal:
         # a signal not written as one is a usage error, not one the trace lacks
         malformed = signal_text_problem(signal)
         if malformed is not None:
             return usage_error(f"--signal {malformed}")
     try:
-        left_out = plot_signals(path, arguments.signal, output, arguments.title)
+        left_out = plot_signals(path, arguments.signal, output, arguments.title, start, stop)
     except TraceError as error:
         sys.stderr.write(f"earl plot: {error}\n")
         return EXIT_FAILED
@@ -202,6 +219,21 @@ def run_plot(arguments: argparse.Namespace) -> int:
         sys.stderr.write(f"earl plot: {line}\n")
     print(f"wrote {arguments.output}")
     return EXIT_OK
+
+
+def _time_of(option: str, given: str | None) -> float | None:
+    """Seconds of run time that `--from` or `--to` names (`2.5`, `2500ms`); None when not given."""
+    from earl.runtime.durations import parse_duration
+
+    if given is None:
+        return None
+    if given.strip().startswith("-"):
+        raise UsageError(f"{option} {given}: a time of the run is 0 s or more")
+    try:
+        return parse_duration(given, zero=True)
+    except ValueError as error:
+        said = str(error).replace("a duration", "a time").replace("the duration", "the time")
+        raise UsageError(f"{option}: {said}") from None
 
 
 def _not_a_file(given: str) -> str:

@@ -11,7 +11,7 @@ from earl.model.elements import Memory, OutputBuffer, Subsystem, System
 from earl.model.expressions import Literal
 from earl.model.text import subsystem_name
 from earl.model.types import ArrayType, PrimitiveType, StructType
-from earl.runtime.trace_reader import CUT, Signals, read_signals, signal_element
+from earl.runtime.trace_reader import CUT, Signals, read_signals, signal_element, within
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -184,19 +184,29 @@ LEGEND_FONT = 7
 LINE_STYLES = ("-", "--", ":", "-.")
 
 
-def plot_signals(trace: Path, signals: list[str], output: Path, title: str | None = None) -> list[str]:
+def plot_signals(
+    trace: Path,
+    signals: list[str],
+    output: Path,
+    title: str | None = None,
+    start: float | None = None,
+    stop: float | None = None,
+) -> list[str]:
     """Write a PNG (or SVG/PDF, by the suffix): one panel per element of a subsystem, its FSM states behind.
 
     Each panel's legend is to the right of it, outside the axes, so that it hides no data: the figure
     is as much wider as the widest legend needs.
 
-    Returns a line for each signal left out because it had no value in the run (`Signals.empty`)."""
+    `start` and `stop` (seconds; None: the run's start or end) draw a window of the run (`within`).
+
+    Returns a line for each signal left out because it had no value in the run, or the window
+    (`Signals.empty`)."""
     import matplotlib
 
     matplotlib.use("Agg")  # files only: no display needed, none opened
     import matplotlib.pyplot as plt
 
-    data = read_signals(trace, signals)
+    data = within(read_signals(trace, signals), start, stop)
     figure = draw_signals(data, title)
     figure.savefig(output, dpi=110)
     plt.close(figure)
@@ -236,7 +246,8 @@ def draw_signals(data: Signals, title: str | None = None) -> Figure:
                 linestyle=LINE_STYLES[number // 10 % len(LINE_STYLES)],
                 marker="o" if sparse else None,
                 markersize=3,
-                markevery=list(range(len(series.times))) if sparse else None,
+                # a mark for each message: not the value held when a window starts
+                markevery=list(range(int(series.held), len(series.times))) if sparse else None,
             )
             lines.append(line)
         # the signals first, then the states (one entry each, however many stays)
@@ -263,6 +274,8 @@ def draw_signals(data: Signals, title: str | None = None) -> Figure:
             axis.set_yticks([0.0, 1.0], ["false", "true"])
             axis.set_ylim(-0.25, 1.25)
         axis.grid(True, alpha=0.3)
+        if data.windowed:  # the window's ends, not the first and last sample in it
+            axis.set_xlim(data.start, data.end)
     axes[-1][0].set_xlabel("time [s]")
     if title:
         figure.suptitle(title)

@@ -500,6 +500,8 @@ class Series:
     values: list[float]
     #: whether the signal is a Boolean, its values 0.0 (false) and 1.0 (true)
     boolean: bool = False
+    #: whether its first sample is the value it held when a window of the run starts (`within`), no message
+    held: bool = False
 
 
 @dataclass
@@ -514,6 +516,47 @@ class Signals:
     empty: list[str] = field(default_factory=list)
     #: whether the file had no valid end and was read up to its first damaged record
     cut: bool = False
+    #: where the plot's time axis starts: 0, or the start of a window (`earl plot --from`)
+    start: float = 0.0
+    #: whether the signals were cut to a window of the run (`within`): its ends are the time axis's
+    windowed: bool = False
+
+
+def within(data: Signals, start: float | None, stop: float | None) -> Signals:
+    """`data` from `start` to `stop` seconds (None: the run's start or end), for `earl plot --from/--to`.
+
+    A value holds until the next, so each signal starts the window with the value it held at `start`;
+    a signal with no value in the window is left out with a line that says so (`Signals.empty`), and
+    the states are cut to the window. A TraceError when the window begins at or after the trace's end,
+    or no signal has a value in it."""
+    if start is None and stop is None:
+        return data
+    begin = start or 0.0
+    if begin >= data.end:
+        raise TraceError(f"the trace ends at {data.end:.6f} s, by --from {begin:g} s: nothing to draw after it")
+    end = data.end if stop is None else min(stop, data.end)
+    series: list[Series] = []
+    empty = list(data.empty)
+    for found in data.series:
+        before = [i for i, time in enumerate(found.times) if time <= begin]
+        inside = [i for i, time in enumerate(found.times) if begin < time <= end]
+        times = [found.times[i] for i in inside]
+        values = [found.values[i] for i in inside]
+        if before:  # the value held at the window's start
+            times.insert(0, begin)
+            values.insert(0, found.values[before[-1]])
+        if not times or all(math.isnan(value) for value in values):
+            empty.append(f"`{found.subsystem}.{found.name}` had no value from {begin:g} s to {end:g} s")
+            continue
+        held = bool(before) and found.times[before[-1]] < begin  # not a message sent at `begin` itself
+        series.append(Series(found.subsystem, found.name, times, values, found.boolean, held))
+    if not series:
+        raise TraceError(f"no signal has a value from {begin:g} s to {end:g} s: {'; '.join(empty)}")
+    bands = {
+        subsystem: [(max(a, begin), min(b, end), state) for a, b, state in stays if b > begin and a < end]
+        for subsystem, stays in data.bands.items()
+    }
+    return Signals(series, bands, end, empty, data.cut, begin, True)
 
 
 def read_signals(path: Path, names: list[str]) -> Signals:
