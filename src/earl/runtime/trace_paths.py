@@ -31,8 +31,9 @@ def path_problem(
     `memory` is the subsystem's memory schema with its families' first indices (None when its memory
     is not recorded); `buffers` the schema of each recorded output buffer (`push[2]`, `beltSpeed`) by
     the link leaving it; `declared` every output buffer a link leaves, recorded or not (the FSM
-    channel's metadata; None in a trace written before it said); `has_leaves(prefix)` whether the messages held a value under `prefix` (a
-    field the schema leaves out, an array of arrays, is known only from them)."""
+    channel's metadata; None in a trace written before it said); `has_leaves(prefix)` whether the
+    messages held a value under `prefix` (a field the schema leaves out, an array of arrays, is known
+    only from them)."""
     steps = [(match.group(1), match.group(2)) for match in _STEP.finditer(inner)]
     element = _element(inner)
     if "".join(match.group(0) for match in _STEP.finditer(inner)) != inner[len(element) :]:
@@ -114,7 +115,7 @@ def _unwrapped(schema: Any) -> Any:
 def _walk(
     schema: Any, named: str, steps: list[tuple[str | None, str | None]], has_leaves: Callable[[str], bool]
 ) -> str | None:
-    """`_path_problem`'s steps after the element (`named` so far) through `schema`."""
+    """`path_problem`'s steps after the element (`named` so far) through `schema`."""
     current = schema
     for index, field in steps:
         current = _present(current)
