@@ -178,7 +178,7 @@ def test_a_fault_in_the_condition_of_a_star_transition_names_it_as_declared(tmp_
     simulation = earl.simulate(earl.load(spec), check=False)  # `earl check` refuses the index (EARL-E030)
     try:
         simulation.advance_to(0.02)  # at 20 ms, n == 3 in s0: `s0 -> s1` does not hold, the `*` line is tried
-        faults = [(fault.time, fault.kind, fault.message) for fault in simulation.faults]
+        faults = [(fault.time_ns, fault.kind, fault.message) for fault in simulation.faults]
     finally:
         simulation.close()
     assert faults[0] == (
