@@ -120,7 +120,7 @@ def agent_view(agent: Agent, system: System | None = None) -> Diagram:
         destination = f"{destination_node}:{port_name('ib', indexed_name(link.input))}:w"
         backward = _ORDER[link.destination.kind] < _ORDER[link.source.kind]
         data_type = type_text(link.output.data_type)
-        for statement in link_statements(number, source, destination, label, data_type, backward):
+        for statement in link_statements(number, source, destination, label, data_type, backward).all():
             graph.add(statement)
 
     if system is not None:
@@ -170,5 +170,5 @@ def _external_links(agent: Agent, system: System, graph: Graph, names: list[str]
         statements = link_statements(number + 10_000, source, destination, link_label(link.link), link.data_type, False)
         graph.outside += [
             statement.replace("];", ', style="dashed"];') if "->" in statement else statement
-            for statement in statements
+            for statement in statements.all()
         ]

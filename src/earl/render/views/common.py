@@ -73,25 +73,45 @@ def node_id(*parts: str) -> str:
     return "n_" + "".join(c if c.isalnum() else "_" for c in text)
 
 
-def link_statements(number: int, source: str, destination: str, name: str, data_type: str, backward: bool) -> list[str]:
+@dataclass(frozen=True)
+class LinkStatements:
+    """The DOT statements of one link: its nodes (its label, and a backward link's turn) and its edges."""
+
+    nodes: list[str]
+    edges: list[str]
+
+    def all(self) -> list[str]:
+        return self.nodes + self.edges
+
+
+def link_statements(
+    number: int, source: str, destination: str, name: str, data_type: str, backward: bool
+) -> LinkStatements:
     """A link drawn through a small label node, so its name and data type sit on its own path.
 
     A `backward` link runs against the layout's direction (a Virtual Effector's state going
-    back to the Control Subsystem): its label sits just before the Input Buffer it feeds, and
-    its first half is declared from the label to the Output Buffer (drawn without arrowheads,
-    so it reads the same), which dot then routes back through the frame past the blocks in
-    between.  Left free of the layout (`constraint=false`), that half looped along the
+    back to the Control Subsystem): its label sits just before the Input Buffer it feeds.  It
+    leaves its Output Buffer eastwards, as every link does, to a turn point one rank after
+    its block, and runs from there back to its label past the blocks in between; both halves
+    are declared forwards (towards the turn) and drawn without arrowheads, so they read the
+    same.  Declared from the label straight to the Output Buffer's east side, the path had to
+    reach that side from the west: dot drew it under (or through) its own block and across the
+    border of its robot; left free of the layout (`constraint=false`), it looped along the
     frame's border or outside it.
     """
     node = f"link_{number}"
     label = f"<{html(name)}<br/><i>{html(data_type)}</i>>"
-    first = (
-        f'{node} -> {source} [dir="none", tooltip="{html(name)}"];'
-        if backward
-        else f'{source} -> {node} [arrowhead="none", tooltip="{html(name)}"];'
+    nodes = [f'{node} [shape="plain", fontsize="9", label={label}, tooltip="{html(name)}"];']
+    arrival = f'{node} -> {destination} [tooltip="{html(name)}"];'
+    if not backward:
+        return LinkStatements(nodes, [f'{source} -> {node} [arrowhead="none", tooltip="{html(name)}"];', arrival])
+    turn = f"turn_{number}"
+    nodes.append(f'{turn} [shape="point", width="0.01", height="0.01", label="", tooltip="{html(name)}"];')
+    return LinkStatements(
+        nodes,
+        [
+            f'{source} -> {turn} [dir="none", tooltip="{html(name)}"];',
+            f'{node} -> {turn} [dir="none", tooltip="{html(name)}"];',
+            arrival,
+        ],
     )
-    return [
-        f'{node} [shape="plain", fontsize="9", label={label}, tooltip="{html(name)}"];',
-        first,
-        f'{node} -> {destination} [tooltip="{html(name)}"];',
-    ]

@@ -169,12 +169,12 @@ def system_view(
         source = f"{nodes[id(link.source)]}:{_port('ob', link.source_end)}:e"
         destination = f"{nodes[id(link.destination)]}:{_port('ib', link.destination_end)}:w"
         backward = positions[id(link.destination)] < positions[id(link.source)]
-        node, *link_edges = link_statements(number, source, destination, name, link.data_type, backward)
+        link_parts = link_statements(number, source, destination, name, link.data_type, backward)
         source_robot = placements[id(link.source)].robot
         destination_robot = placements[id(link.destination)].robot
         shared = source_robot if source_robot == destination_robot else None
-        link_nodes.setdefault(shared, []).append(node)
-        edges.extend(link_edges)
+        link_nodes.setdefault(shared, []).extend(link_parts.nodes)
+        edges.extend(link_parts.edges)
 
     for number, robot in enumerate(system.robots):
         robot_name = f"{robot.name}/r"
