@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping
 from html import escape
 
@@ -46,7 +47,8 @@ code code { background: none; padding: 0; }
 table { border-collapse: collapse; margin: 14px 0 22px; font-size: 13.5px; }
 caption { caption-side: top; text-align: left; font-weight: 600; padding: 0 0 6px; }
 caption .note { font-weight: 400; margin-top: 2px; }
-th, td { border: 1px solid var(--rule); padding: 4px 8px; vertical-align: top; text-align: left; }
+th, td { border: 1px solid var(--rule); padding: 4px 8px; vertical-align: top; text-align: left;
+         overflow-wrap: break-word; }
 th { background: var(--shade); }
 table.matrix td.bullet, table.matrix th { text-align: center; }
 table.matrix thead tr:nth-child(2) th { writing-mode: vertical-rl; transform: rotate(180deg); white-space: nowrap;
@@ -62,15 +64,31 @@ figure img { max-width: 100%; height: auto; border: 1px solid var(--rule); backg
 figure .diagram { overflow-x: auto; max-width: 100%; }
 figure .diagram img { max-width: none; }
 figcaption { color: var(--muted); font-size: 13px; margin-top: 4px; }
+@media (max-width: 960px) {
+  nav { position: static; width: auto; max-height: 45vh; border-right: none; border-bottom: 1px solid var(--rule); }
+  main { margin-left: 0; padding: 16px 14px 60px; }
+  h1 { font-size: 22px; }
+}
 @media print { nav { display: none; } main { margin-left: 0; } }
 """
+
+
+#: Where a long name may break in a narrow column: after a dot, colon, comma or underscore, and
+#: between the words of a camelCase name (`manip/a.motor<wbr>Controller[K]/ve.<wbr>fsm`).
+_BREAK = re.compile(r"(?<=[.:,_])(?=[^\s.:,_])|(?<=[a-z])(?=[A-Z])")
+
+
+def breakable(text: str) -> str:
+    """`text` escaped for HTML with `<wbr>` where a long name may break: a narrow window wraps a
+    table's long names there instead of pushing the table off the page (copying the text is unchanged)."""
+    return "<wbr>".join(escape(piece) for piece in _BREAK.split(text))
 
 
 def inline(part: Inline) -> str:
     if isinstance(part, Text):
         return escape(part.text)
     if isinstance(part, Code):
-        return f"<code>{escape(part.text)}</code>"
+        return f"<code>{breakable(part.text)}</code>"
     if isinstance(part, Link):
         return f'<a href="#{escape(part.anchor)}">{content(part.content)}</a>'
     if isinstance(part, Strong):
