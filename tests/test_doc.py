@@ -894,3 +894,77 @@ def test_markdown_and_mermaid_show_ampersands_and_entities_as_written(tmp_path: 
     assert any('"&amp;<x>"' in cell for cell in _cells(read))
     mermaid = mermaid_of(Subject(system), "fsm", None)
     assert "&lt;" not in mermaid and "#38;lt;" in mermaid
+
+
+class _Rows(HTMLParser):
+    """The rows of one table of an HTML page (by its id), each a list of its cells' text, spaces collapsed."""
+
+    def __init__(self, table: str) -> None:
+        super().__init__()
+        self.table = table
+        self.rows: list[list[str]] = []
+        self.caption = ""
+        self._depth = 0  # inside the table: how many tables deep
+        self._text: list[str] | None = None
+        self._in_caption = False
+
+    def handle_starttag(self, tag: str, attrs: list[tuple[str, str | None]]) -> None:
+        if tag == "table" and (self._depth or dict(attrs).get("id") == self.table):
+            self._depth += 1
+        elif self._depth and tag == "tr":
+            self.rows.append([])
+        elif self._depth and tag in ("td", "th"):
+            self._text = []
+        elif self._depth and tag == "caption":
+            self._in_caption = True
+
+    def handle_endtag(self, tag: str) -> None:
+        if tag == "table" and self._depth:
+            self._depth -= 1
+        elif tag in ("td", "th") and self._text is not None:
+            self.rows[-1].append(" ".join("".join(self._text).split()))
+            self._text = None
+        elif tag == "caption":
+            self._in_caption = False
+
+    def handle_data(self, data: str) -> None:
+        if self._text is not None:
+            self._text.append(data)
+        elif self._in_caption:
+            self.caption += data
+
+
+def _table(html: str, table: str) -> list[list[str]]:
+    parser = _Rows(table)
+    parser.feed(html)
+    assert parser.rows, f"no table {table}"
+    return parser.rows
+
+
+def test_the_document_tabulates_parameters_with_their_values_and_where_they_were_given(tmp_path: Path) -> None:
+    """`N=6`, `WHEELS=2` and agents' and subsystems' parameters appeared nowhere, and `--param N=3` was not
+    recorded: the system, each agent and each subsystem with parameters get a table of them (type, value,
+    what the spec computes it from, the spec's line or the --param that gave it, a person's comment), and
+    the subtitle names the --param options."""
+    assert main(["doc", str(EXAMPLE), "--param", "N=3", "-o", str(tmp_path / "pp")]) == 0
+    html = (tmp_path / "pp" / "index.html").read_text(encoding="utf-8")
+    assert "(indexed families drawn once; --param N=3)" in html
+    rows = _table(html, "parameters")
+    assert rows[0] == ["parameter", "type", "value", "given by", "comment"]
+    assert rows[1][:4] == ["N", "int", "3", "--param N=3"]
+    assert "The manipulator has N joints" in rows[1][4]
+    joint = _table(html, "parameters-manip-a-motorController-K-ve")
+    assert joint[1][:3] == ["joint", "int", "K: 1 (K = 1), 2 (K = 2), 3 (K = 3)"]
+    assert re.fullmatch(r"spec, system\.earl:\d+", joint[1][3])
+
+    mobile = ROOT / "examples" / "mobile_robot" / "system.earl"
+    assert main(["doc", str(mobile), "-o", str(tmp_path / "mr")]) == 0
+    html = (tmp_path / "mr" / "index.html").read_text(encoding="utf-8")
+    system = {row[0]: row for row in _table(html, "parameters")[1:]}
+    assert system["WHEELS"][1:3] == ["int", "2"] and system["WHEELS"][3].startswith("spec, system.earl:")
+    base = {row[0]: row for row in _table(html, "parameters-base-a")[1:]}
+    assert base["TRACK_WIDTH"][1:3] == ["double", "0.42"]
+    cs = {row[0]: row for row in _table(html, "parameters-base-a-cs")[1:]}
+    assert cs["STANDSTILL"][2] == "0.05" and "rad/s" in cs["STANDSTILL"][4]
+    markdown = (tmp_path / "mr" / "index.md").read_text(encoding="utf-8")
+    assert "Parameters of the system mobileRobot" in markdown and "`WHEELS` | `int` | `2` | spec" in markdown

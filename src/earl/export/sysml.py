@@ -28,6 +28,7 @@ from earl.diagnostics import EarlError, Severity
 from earl.export.sysml_expressions import ExpressionWriter, literal
 from earl.export.sysml_names import Namespace, name_text, quoted, readable
 from earl.lang.resolver import resolve
+from earl.model.comment_paragraphs import comment_paragraphs
 from earl.model.elements import (
     FSM,
     Agent,
@@ -99,52 +100,6 @@ def export_sysml(system: System, parameters: Mapping[str, Value] | None = None) 
 
 
 # ---------------------------------------------------------------------- small helpers
-def _comment_lines(comments: Comments | None, closing: bool = True) -> list[str]:
-    """A person's `//` comments as paragraphs of plain sentences: markers and separator rules dropped,
-    the lines of one comment block joined (the doc is wrapped again as a whole). Of the comments above
-    the element only the block next to it counts: one that a blank line parts from it heads a section
-    of the file (an imported file's header above its first declaration), not the element. `closing`:
-    with those that close the element's block (`// end of the arm's limits` before its `}`), written
-    about it too, as is the one after its `}`; not the system's, which end the file (`// vim: set ft=earl:`)."""
-    if comments is None:
-        return []
-    leading = list(comments.leading)
-    if "" in leading:
-        leading = leading[len(leading) - leading[::-1].index("") :]  # after the last blank line
-    blocks = [
-        leading,
-        [comments.trailing] if comments.trailing else [],
-        comments.closing if closing else [],
-        [comments.after] if comments.after else [],
-    ]
-    result: list[str] = []
-    for block in blocks:
-        paragraph: list[str] = []
-        for line in block:
-            text = line.strip()
-            text = text[2:] if text.startswith("//") else text
-            text = text.strip()
-            # A ruler (`// ---- Figure 9 …`) heads a section of the file, not the element under it.
-            if not text or text.startswith("----"):
-                if paragraph:
-                    result.append(" ".join(paragraph))
-                paragraph = []
-                continue
-            if paragraph and _starts_an_item(text):  # a list keeps its items apart
-                result.append(" ".join(paragraph))
-                paragraph = []
-            paragraph.append(text)
-        if paragraph:
-            result.append(" ".join(paragraph))
-    return result
-
-
-def _starts_an_item(text: str) -> bool:
-    """`- a point`, `* a point`, `1. a step`: a line that starts an item of a list."""
-    head = text.split(maxsplit=1)[0]
-    return head in ("-", "*", "•") or (head[:-1].isdigit() and head[-1] in ".)")
-
-
 def _where(location: SourceLocation | None) -> str | None:
     # The file's own name, not the path it was read by, so the export does not depend on the working directory.
     return None if location is None else f"{Path(location.file).name}:{location.line}"
@@ -231,7 +186,7 @@ class _Writer:
         """The person's comments on an element and at its clauses, what the export adds, and where it was written."""
         where = _where(location)
         self.doc(
-            *_comment_lines(self.comments.get(location) if location else None),
+            *comment_paragraphs(self.comments.get(location) if location else None),
             *self.clause_notes(location),
             *extra,
             *([f"From {where}."] if where else []),
@@ -246,7 +201,7 @@ class _Writer:
         for key, comments in (said or {}).items():
             # a state's clause spreads over several lines, keyed `obligatory 0`, `obligatory 1`, …
             clause = key.split()[0]
-            lines = _comment_lines(comments)
+            lines = comment_paragraphs(comments)
             if lines:
                 notes.append(f"At `{clause}`: {' '.join(lines)}")
         return notes
@@ -274,7 +229,7 @@ class _Writer:
         with self.block(f"package {name_text(package)}"):
             settings = ", ".join(f"{p.name} = {literal(_parameter_value(p))}" for p in self.system.parameters)
             self.doc(
-                *_comment_lines(self.declared.comments, closing=False),
+                *comment_paragraphs(self.declared.comments, closing=False),
                 f"EARL system `{self.system.name}`{origin}"
                 + (f", exported with {settings}" if settings else "")
                 + ". Every indexed family is expanded into its members; the short name of each element is its "
@@ -309,7 +264,7 @@ class _Writer:
                             f"attribute {name_text(field.name)} : {self.typed(field.data_type, field.optional)}"
                         )
                         # A field someone commented gets the comment as its doc, and where it was written.
-                        if _comment_lines(self.comments.get(field.location) if field.location else None):
+                        if comment_paragraphs(self.comments.get(field.location) if field.location else None):
                             with self.block(declaration):
                                 self.element_doc(field.location)
                         else:

@@ -73,9 +73,10 @@ figcaption { color: var(--muted); font-size: 13px; margin-top: 4px; }
 """
 
 
-#: Where a long name may break in a narrow column: after a dot, colon, comma or underscore, and
+#: Where a long name may break in a narrow column: after a dot, colon, comma or underscore before a
+#: letter (a number such as `0.25` stays whole), and
 #: between the words of a camelCase name (`manip/a.motor<wbr>Controller[K]/ve.<wbr>fsm`).
-_BREAK = re.compile(r"(?<=[.:,_])(?=[^\s.:,_])|(?<=[a-z])(?=[A-Z])")
+_BREAK = re.compile(r"(?<=[.:,_])(?=[A-Za-z])|(?<=[a-z])(?=[A-Z])")
 
 
 def breakable(text: str) -> str:

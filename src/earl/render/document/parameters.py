@@ -1,0 +1,102 @@
+"""The parameters of a system, an agent or a subsystem as the document tabulates them: each with its
+type, what the spec writes, the value it takes and where that value was given (the spec or `--param`).
+
+A parameter of an indexed family drawn once may be computed from the family's index (`param joint:
+int = K`): its value is then given for each member.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from earl.model.comment_paragraphs import comment_paragraphs
+from earl.model.elements import Family, Parameter
+from earl.model.expand import family_members
+from earl.model.expressions import ConstantError, Literal, evaluate_constant
+from earl.model.text import expression_text, literal_text
+from earl.model.types import type_text
+
+Value = bool | int | float | str
+Environment = dict[str, Value]
+
+#: A family drawn once lists the value of each member up to this many; beyond, the first and last ones.
+LISTED_MEMBERS = 8
+
+
+@dataclass(frozen=True)
+class ParameterRow:
+    name: str
+    data_type: str
+    #: the spec's expression, when it is more than the value (`N - 1`, `K`); "" for a plain value
+    written: str
+    value: str
+    given: str  # `--param N=3`, or `spec, line 5`
+    comments: list[str] = field(default_factory=list)
+
+
+def parameter_rows(
+    parameters: Sequence[Parameter],
+    outer: Environment,
+    given: Mapping[str, Value] | None = None,
+    family: Family | None = None,
+    index: int | None = None,
+) -> tuple[list[ParameterRow], Environment]:
+    """The rows of `parameters` declared in a block whose outer parameters have the values `outer`, and the
+    environment inside the block.  `given`: the values set by `--param` (system parameters only);
+    `family`/`index`: the block's family, and which member it is (None: the family drawn once)."""
+    given = given or {}
+    members: list[Environment] = [dict(outer)]
+    if family is not None:
+        if index is not None:
+            members = [{**outer, family.index: index}]
+        else:
+            try:
+                members = [{**outer, family.index: member} for member in family_members(family, outer)]
+            except ConstantError:
+                members = [dict(outer)]
+    rows = []
+    for parameter in parameters:
+        values: list[Value | None] = []
+        for environment in members:
+            try:
+                value = evaluate_constant(parameter.value, environment)
+            except (ConstantError, TypeError):
+                value = None  # the checker reports what is wrong with it
+            if value is not None:
+                if getattr(parameter.data_type, "name", "") in ("double", "float32", "float64") and type(value) is int:
+                    value = float(value)
+                environment[parameter.name] = value
+            values.append(value)
+        if parameter.name in given:
+            where = f"--param {parameter.name}={literal_text(given[parameter.name])}"
+        elif parameter.location is not None:
+            where = f"spec, {Path(parameter.location.file).name}:{parameter.location.line}"
+        else:
+            where = "spec"
+        written = "" if isinstance(parameter.value, Literal) else expression_text(parameter.value)
+        rows.append(
+            ParameterRow(
+                parameter.name,
+                type_text(parameter.data_type),
+                written,
+                _values_text(values, family if len(members) > 1 else None, members),
+                where,
+                comment_paragraphs(parameter.comments),
+            )
+        )
+    return rows, members[0] if len(members) == 1 else dict(outer)
+
+
+def _values_text(values: list[Value | None], family: Family | None, members: list[Environment]) -> str:
+    if any(value is None for value in values):
+        return "—"
+    texts = [literal_text(value) for value in values if value is not None]
+    if family is None or len(set(texts)) == 1:
+        return texts[0] if texts else "—"
+    indices = [environment[family.index] for environment in members]
+    pairs = [f"{text} ({family.index} = {literal_text(index)})" for text, index in zip(texts, indices, strict=True)]
+    if len(pairs) > LISTED_MEMBERS:
+        pairs = [*pairs[: LISTED_MEMBERS - 2], "…", pairs[-1]]
+    return ", ".join(pairs)
