@@ -968,3 +968,37 @@ def test_the_document_tabulates_parameters_with_their_values_and_where_they_were
     assert cs["STANDSTILL"][2] == "0.05" and "rad/s" in cs["STANDSTILL"][4]
     markdown = (tmp_path / "mr" / "index.md").read_text(encoding="utf-8")
     assert "Parameters of the system mobileRobot" in markdown and "`WHEELS` | `int` | `2` | spec" in markdown
+
+
+def test_a_document_of_a_broken_spec_says_so_at_the_top_and_lists_errors_first(tmp_path: Path) -> None:
+    """`earl doc` of a spec with errors exits 1, but its title area said nothing: the errors were listed
+    only at the end, after notes.  Under the subtitle it now says how many errors and warnings there are,
+    linked to the check results, which list errors, then warnings, then notes."""
+    spec = tmp_path / "broken.earl"
+    spec.write_text(
+        EXAMPLE.read_text(encoding="utf-8").replace(
+            "    link cs,fingerController:", "    sparePart/ve {\n    }\n\n    link cs,fingerController:"
+        ),
+        encoding="utf-8",
+    )
+    assert main(["doc", str(spec), "-o", str(tmp_path / "site")]) == 1
+    html = (tmp_path / "site" / "index.html").read_text(encoding="utf-8")
+    findings = check(earl.load(spec))
+    errors = sum(1 for d in findings if d.severity.value == "error")
+    warnings = sum(1 for d in findings if d.severity.value == "warning")
+    assert errors and any(d.severity.value == "note" for d in findings)
+    said = re.search(r'<p class="notice error" id="check-summary">(.*?)</p>', html)
+    assert said is not None and html.index("check-summary") < html.index('<section id="system">')
+    many = f"{errors} error{'s' if errors > 1 else ''}" + (
+        f" and {warnings} warning{'s' if warnings > 1 else ''}" if warnings else ""
+    )
+    assert said.group(1).startswith(f"earl check found {many}. The specification breaks rules")
+    assert '<a href="#check">' in said.group(1)
+    severities = [row[0] for row in _table(html, "findings")[1:]]
+    assert severities == sorted(severities, key=["error", "warning", "note"].index)
+    assert severities[-1] == "note"
+    markdown = (tmp_path / "site" / "index.md").read_text(encoding="utf-8")
+    assert f"> **earl check found {many}." in markdown.split("## ")[0]
+
+    assert main(["doc", str(EXAMPLE), "-o", str(tmp_path / "clean")]) == 0
+    assert "check-summary" not in (tmp_path / "clean" / "index.html").read_text(encoding="utf-8")

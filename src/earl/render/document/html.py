@@ -58,6 +58,9 @@ table.matrix td.bullet { font-size: 18px; line-height: 1; min-width: 34px; }
 td.error { color: #b00020; font-weight: 600; }
 td.warning { color: #9a6700; font-weight: 600; }
 td.note { color: var(--muted); }
+p.notice { padding: 8px 12px; border-left: 4px solid; background: var(--shade); font-weight: 600; }
+p.notice.error { border-color: #b00020; color: #b00020; background: #fdecee; }
+p.notice.warning { border-color: #9a6700; color: #6b4800; background: #fff8e1; }
 tr:target, td:target { background: #fff6cc; }
 figure { margin: 16px 0 28px; }
 figure img { max-width: 100%; height: auto; border: 1px solid var(--rule); background: white; }
@@ -183,6 +186,9 @@ def _navigation(sections: list[Section]) -> str:
 def render_html(document: Document, widths: Mapping[str, float] | None = None) -> str:
     """The page; `widths` gives the natural width in CSS pixels of the diagrams drawn, by path."""
     body = "\n".join(section(s, widths) for s in document.sections)
+    notice = ""
+    if document.notice:
+        notice = f'<p class="notice {document.notice_css}" id="check-summary">{content(document.notice)}</p>\n'
     return (
         "<!DOCTYPE html>\n"
         '<html lang="en">\n<head>\n<meta charset="utf-8">\n'
@@ -190,5 +196,5 @@ def render_html(document: Document, widths: Mapping[str, float] | None = None) -
         '<meta name="generator" content="earl doc">\n'
         f"<title>{escape(document.title)}</title>\n<style>{CSS}</style>\n</head>\n<body>\n"
         f"{_navigation(document.sections)}\n<main>\n<h1>{escape(document.title)}</h1>\n"
-        f'<p class="subtitle">{escape(document.subtitle)}</p>\n{body}\n</main>\n</body>\n</html>\n'
+        f'<p class="subtitle">{escape(document.subtitle)}</p>\n{notice}{body}\n</main>\n</body>\n</html>\n'
     )

@@ -174,6 +174,9 @@ def render_markdown(document: Document) -> str:
     for item in document.sections:
         contents.append(f"- [{content(item.title)}](#{item.anchor})")
         contents += [f"  - [{content(c.title)}](#{c.anchor})" for c in item.blocks if isinstance(c, Section)]
-    parts = [f"# {_escape(document.title)}", f"*{_escape(document.subtitle)}*", "\n".join(contents)]
+    parts = [f"# {_escape(document.title)}", f"*{_escape(document.subtitle)}*"]
+    if document.notice:
+        parts.append(f"> **{content(document.notice)}**")
+    parts.append("\n".join(contents))
     parts += [section(s) for s in document.sections]
     return "\n\n".join(parts) + "\n"

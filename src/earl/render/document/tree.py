@@ -98,6 +98,10 @@ class Document:
     title: str
     subtitle: str
     sections: list[Section]
+    #: Said under the subtitle, before everything else: what `earl check` found, when it found anything.
+    notice: Content = ()
+    #: How the notice is marked: `error` (the spec breaks rules) or `warning`.
+    notice_css: str = ""
 
 
 def text(value: str) -> Content:
