@@ -58,6 +58,7 @@ table.matrix td.bullet { font-size: 18px; line-height: 1; min-width: 34px; }
 td.error { color: #b00020; font-weight: 600; }
 td.warning { color: #9a6700; font-weight: 600; }
 td.note { color: var(--muted); }
+wbr { display: none; }  /* a long name breaks only in a narrow window (below), not where a wide one has room */
 p.notice { padding: 8px 12px; border-left: 4px solid; background: var(--shade); font-weight: 600; }
 p.notice.error { border-color: #b00020; color: #b00020; background: #fdecee; }
 p.notice.warning { border-color: #9a6700; color: #6b4800; background: #fff8e1; }
@@ -70,6 +71,7 @@ figcaption { color: var(--muted); font-size: 13px; margin-top: 4px; }
 @media (max-width: 960px) {
   nav { position: static; width: auto; max-height: 45vh; border-right: none; border-bottom: 1px solid var(--rule); }
   main { margin-left: 0; padding: 16px 14px 60px; }
+  wbr { display: inline; }
   h1 { font-size: 22px; }
 }
 @media print { nav { display: none; } main { margin-left: 0; } }
