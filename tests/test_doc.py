@@ -1002,3 +1002,42 @@ def test_a_document_of_a_broken_spec_says_so_at_the_top_and_lists_errors_first(t
 
     assert main(["doc", str(EXAMPLE), "-o", str(tmp_path / "clean")]) == 0
     assert "check-summary" not in (tmp_path / "clean" / "index.html").read_text(encoding="utf-8")
+
+
+def test_the_buffers_table_says_what_an_input_buffer_with_a_fifo_keeps(tmp_path: Path) -> None:
+    """`goal/ib: NavigationGoal fifo 4 overflow dropOldest` (mobile_robot) was shown as a plain buffer:
+    capacity and overflow policy were nowhere in the document.  A subsystem with a FIFO gets a column
+    saying what each Input Buffer keeps; a capacity naming a parameter is given with its value."""
+    mobile = ROOT / "examples" / "mobile_robot" / "system.earl"
+    assert main(["doc", str(mobile), "-o", str(tmp_path / "mr")]) == 0
+    html = (tmp_path / "mr" / "index.html").read_text(encoding="utf-8")
+    rows = {row[0]: row for row in _table_by_caption(html, "Input and Output Buffers of base/a.cs")}
+    assert rows["buffer"][:3] == ["buffer", "dataType", "keeps"]
+    assert rows["goal/ib"][2] == "a FIFO of 4 messages; when full: dropOldest"
+    assert rows["obstacles/ib"][2] == "the latest message" and rows["status/ob"][2] == "—"
+
+    spec = tmp_path / "queued" / "system.earl"
+    spec.parent.mkdir()
+    spec.write_text(
+        EXAMPLE.read_text(encoding="utf-8").replace(
+            "manipulatorCommand/ib: ManipulatorCommand",
+            "manipulatorCommand/ib: ManipulatorCommand fifo N overflow fault",
+        ),
+        encoding="utf-8",
+    )
+    assert main(["doc", str(spec), "--param", "N=3", "-o", str(tmp_path / "pp")]) == 0
+    html = (tmp_path / "pp" / "index.html").read_text(encoding="utf-8")
+    rows = {row[0]: row for row in _table_by_caption(html, "Input and Output Buffers of manip/a.cs")}
+    assert rows["manipulatorCommand/ib"][2] == "a FIFO of N = 3 messages; when full: fault"
+    # a subsystem without a FIFO keeps its three columns
+    assert _table_by_caption(html, "Input and Output Buffers of task/a.cs")[0] == ["buffer", "dataType", "linked with"]
+
+
+def _table_by_caption(html: str, caption: str) -> list[list[str]]:
+    """The rows of the table whose caption is `caption`."""
+    for found in re.finditer(r"<table[^>]*>(.*?)</table>", html, re.DOTALL):
+        if re.search(r"<caption>" + re.escape(caption) + r"[<]", found.group(0)):
+            parser = _Rows("wanted")
+            parser.feed(found.group(0).replace("<table", '<table id="wanted"', 1))
+            return parser.rows
+    raise AssertionError(f"no table captioned {caption}")

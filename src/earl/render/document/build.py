@@ -17,12 +17,12 @@ from dataclasses import dataclass, field
 
 from earl import __version__
 from earl.diagnostics import Diagnostic, Severity
-from earl.model.elements import Agent, Subsystem, System
-from earl.model.expressions import ElementReference
+from earl.model.elements import Agent, Queue, Subsystem, System
+from earl.model.expressions import ConstantError, ElementReference, evaluate_constant
 from earl.model.kinds import KIND_TITLES, Kind
 from earl.model.location import SourceLocation
 from earl.model.tables import AGENT_TYPES
-from earl.model.text import reference_text
+from earl.model.text import expression_text, literal_text, reference_text
 from earl.model.types import type_text
 from earl.render.build import Subject
 from earl.render.diagram import Diagram
@@ -456,7 +456,7 @@ class DocumentBuilder:
             facts.append(f"Period {subsystem.period.value} {subsystem.period.unit}.")
         if facts:
             section.add(Paragraph(text(" ".join(facts))))
-        rows, _ = parameter_rows(
+        rows, inside = parameter_rows(
             subsystem.parameters,
             self.environment if environment is None else environment,
             family=subsystem.family,
@@ -468,7 +468,7 @@ class DocumentBuilder:
         if findings:
             section.add(self.findings_list(_worst_first(findings)))
         if subsystem.input_buffers or subsystem.output_buffers:
-            section.add(self.buffers_table(subsystem, qualified, scope, links))
+            section.add(self.buffers_table(subsystem, qualified, scope, links, inside))
         if subsystem.memories:
             section.add(self.memory_table(subsystem, qualified, scope))
         if subsystem.primitive_predicates:
@@ -499,8 +499,13 @@ class DocumentBuilder:
             items.append((label, Text(": "), *with_code(d.message), Text(where)))
         return BulletList(items)
 
-    def buffers_table(self, subsystem: Subsystem, qualified: str, scope: Scope, links: BufferLinks) -> Table:
-        header = [[cell("buffer"), cell("dataType"), cell("linked with")]]
+    def buffers_table(
+        self, subsystem: Subsystem, qualified: str, scope: Scope, links: BufferLinks, environment: Environment
+    ) -> Table:
+        """Each buffer with its dataType and what it is linked with; where an Input Buffer keeps a FIFO
+        (`goal/ib: NavigationGoal fifo 4 overflow dropOldest`), a column says what each Input Buffer keeps."""
+        queues = any(buffer.queue is not None for buffer in subsystem.input_buffers)
+        header = [[cell("buffer"), cell("dataType")] + ([cell("keeps")] if queues else []) + [cell("linked with")]]
         rows = []
         for kind, buffers in (("ib", subsystem.input_buffers), ("ob", subsystem.output_buffers)):
             for buffer in buffers:
@@ -511,10 +516,15 @@ class DocumentBuilder:
                         others.append(Text(", "))
                     arrow = "← " if kind == "ib" else "→ "
                     others += [Text(arrow), Link(other_anchor, code(other_name)), Text(f" ({link_name})")]
+                keeps: list[Cell] = []
+                if queues:
+                    queue = getattr(buffer, "queue", None)
+                    keeps = [cell(_queue_content(queue, environment) if kind == "ib" else text("—"))]
                 rows.append(
                     [
                         cell(code(f"{name}/{kind}"), anchor=slug(kind, qualified, name)),
                         cell(self.type_content(type_text(buffer.data_type))),
+                        *keeps,
                         cell(tuple(others) or text("—")),
                     ]
                 )
@@ -818,6 +828,20 @@ def _cs(agent: Agent) -> Subsystem:
     cs = agent.control_subsystem
     assert cs is not None  # inter_agent_links only returns agents with a control subsystem
     return cs
+
+
+def _queue_content(queue: Queue | None, environment: Environment) -> Content:
+    """`the latest message`, or `a FIFO of 4 messages; when full: dropOldest` (the capacity's expression
+    and its value where it names parameters: `QUEUE = 8`)."""
+    if queue is None:
+        return text("the latest message")
+    written = expression_text(queue.capacity)
+    try:
+        value = literal_text(evaluate_constant(queue.capacity, environment))
+    except (ConstantError, TypeError):
+        value = written
+    capacity: Content = code(value) if value == written else (Code(written), Text(" = "), Code(value))
+    return (Text("a FIFO of "), *capacity, Text(" messages; when full: "), Code(queue.overflow))
 
 
 _SEVERITY_ORDER = {Severity.ERROR: 0, Severity.WARNING: 1, Severity.NOTE: 2}
