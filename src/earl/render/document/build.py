@@ -27,6 +27,7 @@ from earl.model.types import type_text
 from earl.render.build import Subject
 from earl.render.diagram import Diagram
 from earl.render.document.parameters import Environment, ParameterRow, parameter_rows
+from earl.render.document.remarks import Remarks
 from earl.render.document.tree import (
     BulletList,
     Cell,
@@ -121,6 +122,29 @@ class DocumentBuilder:
     owners: list[tuple[SourceLocation, str, str]] = field(default_factory=list)
     #: The values of the system's parameters, in which agents' and subsystems' parameters are computed.
     environment: Environment = field(default_factory=dict)
+    remarks: Remarks = field(init=False)
+
+    def __post_init__(self) -> None:
+        self.remarks = Remarks(self.subject.declared)
+
+    def commented(self, table: Table, elements: Sequence[object]) -> Table:
+        """`table` with a last column of the comments written at `elements` (one a row, in order), when any
+        has one: units and explanations ("in radians") the SysML export carries, shown with their rows."""
+        said = [self.remarks.of(element) for element in elements]
+        if not any(said):
+            return table
+        table.header[0].append(cell("comment", rowspan=len(table.header)))
+        for row, remark in zip(table.rows, said, strict=False):
+            row.append(cell(with_code(remark) if remark else ()))
+        return table
+        table.header[-1].append(
+            cell("comment", rowspan=len(table.header)) if len(table.header) > 1 else cell("comment")
+        )
+        if len(table.header) > 1:
+            table.header[0].append(table.header[-1].pop())
+        for row, remark in zip(table.rows, said, strict=False):
+            row.append(cell(with_code(remark) if remark else ()))
+        return table
 
     # ------------------------------------------------------------------ inline helpers
     def figure(self, diagram: Diagram, caption: str) -> Figure:
@@ -241,6 +265,9 @@ class DocumentBuilder:
                 )
             )
         )
+        said = self.remarks.of(system, closing=False)
+        if said:
+            section.add(Paragraph(with_code(said)))
         rows, self.environment = parameter_rows(system.parameters, {}, self.subject.parameters)
         if rows:
             section.add(self.parameters_table(rows, f"Parameters of the system {system.name}", "parameters"))
@@ -253,7 +280,7 @@ class DocumentBuilder:
         )
         links = inter_agent_links(system)
         if links:
-            section.add(self.links_table(links))
+            section.add(self.commented(self.links_table(links), [link.link for link in links]))
             carried = closure(system, [name for link in links for name in _type_words(link.data_type)])
             if carried:
                 diagram = types_view(carried, system.name, "dataTypes between agents")
@@ -389,6 +416,9 @@ class DocumentBuilder:
             facts.append(Link(slug("ss", qualified), code(subsystem_name(subsystem))))
         facts.append(Text("."))
         section.add(Paragraph(tuple(facts)))
+        said = self.remarks.of(agent)
+        if said:
+            section.add(Paragraph(with_code(said)))
         rows, environment = parameter_rows(agent.parameters, self.environment, family=agent.family, index=agent.index)
         if rows:
             section.add(self.parameters_table(rows, f"Parameters of {name}", slug("parameters", name)))
@@ -456,6 +486,9 @@ class DocumentBuilder:
             facts.append(f"Period {subsystem.period.value} {subsystem.period.unit}.")
         if facts:
             section.add(Paragraph(text(" ".join(facts))))
+        said = self.remarks.of(subsystem)
+        if said:
+            section.add(Paragraph(with_code(said)))
         rows, inside = parameter_rows(
             subsystem.parameters,
             self.environment if environment is None else environment,
@@ -468,11 +501,13 @@ class DocumentBuilder:
         if findings:
             section.add(self.findings_list(_worst_first(findings)))
         if subsystem.input_buffers or subsystem.output_buffers:
-            section.add(self.buffers_table(subsystem, qualified, scope, links, inside))
+            buffers = [*subsystem.input_buffers, *subsystem.output_buffers]
+            section.add(self.commented(self.buffers_table(subsystem, qualified, scope, links, inside), buffers))
         if subsystem.memories:
-            section.add(self.memory_table(subsystem, qualified, scope))
+            section.add(self.commented(self.memory_table(subsystem, qualified, scope), subsystem.memories))
         if subsystem.primitive_predicates:
-            section.add(self.predicates_table(subsystem, qualified, scope))
+            predicates = subsystem.primitive_predicates
+            section.add(self.commented(self.predicates_table(subsystem, qualified, scope), predicates))
         if subsystem.fsm is not None or subsystem.basic_behaviours:
             section.add(self.conditions_table(subsystem, qualified, scope))
         if subsystem.fsm is not None:
@@ -483,7 +518,8 @@ class DocumentBuilder:
                 )
             )
         if subsystem.partial_transition_functions:
-            section.add(self.functions_table(subsystem, qualified, scope))
+            functions = subsystem.partial_transition_functions
+            section.add(self.commented(self.functions_table(subsystem, qualified, scope), functions))
         if subsystem.basic_behaviours:
             section.add(self.composition_table(subsystem, qualified, scope))
             for behaviour in subsystem.basic_behaviours:
@@ -710,12 +746,15 @@ class DocumentBuilder:
                     fields += [Code(f"{field_.name}: "), *self.type_content(type_text(field_.data_type))]
                     if field_.optional:
                         fields.append(Text(" (optional)"))
+                    said = self.remarks.of(field_)
+                    if said:
+                        fields += [Text(" ("), *with_code(said), Text(")")]
             else:
                 fields += [Text("= "), *self.type_content(type_text(definition.data_type))]
             rows.append(
                 [cell(code(definition.name), anchor=slug("type", definition.name)), cell(tuple(fields) or text("—"))]
             )
-        section.add(Table(text("Data types of the specification"), header, rows))
+        section.add(self.commented(Table(text("Data types of the specification"), header, rows), system.types))
         section.add(self.figure(types_view(system.types, system.name), "All dataTypes of the specification"))
         return section
 

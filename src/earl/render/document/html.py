@@ -90,22 +90,23 @@ def breakable(text: str) -> str:
     return "<wbr>".join(escape(piece) for piece in _BREAK.split(text))
 
 
-def inline(part: Inline) -> str:
+def inline(part: Inline, monospace: bool = False) -> str:
+    """`monospace`: inside code, whose names may break where `breakable` lets them."""
     if isinstance(part, Text):
-        return escape(part.text)
+        return breakable(part.text) if monospace else escape(part.text)
     if isinstance(part, Code):
         return f"<code>{breakable(part.text)}</code>"
     if isinstance(part, Link):
-        return f'<a href="#{escape(part.anchor)}">{content(part.content)}</a>'
+        return f'<a href="#{escape(part.anchor)}">{content(part.content, monospace)}</a>'
     if isinstance(part, Strong):
-        return f"<strong>{content(part.content)}</strong>"
+        return f"<strong>{content(part.content, monospace)}</strong>"
     if isinstance(part, Monospace):
-        return f"<code>{content(part.content)}</code>"
+        return f"<code>{content(part.content, True)}</code>"
     raise TypeError(part)
 
 
-def content(parts: Content) -> str:
-    return "".join(inline(part) for part in parts)
+def content(parts: Content, monospace: bool = False) -> str:
+    return "".join(inline(part, monospace) for part in parts)
 
 
 def _cell(tag: str, item: Cell) -> str:
