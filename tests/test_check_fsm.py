@@ -794,3 +794,15 @@ def test_a_value_of_an_integer_type_holds_only_whole_numbers_of_its_range(
     found = probe_text(first, second, extra="        n/ib: int\n        u/ib: uint8\n")
     assert [m.rsplit("e.g. when ", 1)[-1] for m in found.get("EARL-E060", [])] == ([overlap] if overlap else [])
     assert [m.split("`")[1] for m in found.get("EARL-W062", [])] == ([f"{dead}/t"] if dead else [])
+
+
+def test_a_transition_never_taken_is_told_apart_from_another_between_the_same_states() -> None:
+    """`n -> t when ready/pp` and `n -> t when not ready/pp` are both `n,t/t`: W062 said "transition
+    `n,t/t` … can never be taken" without saying which; it gives its number among them and its line, as
+    the document's Table 5 writes them."""
+    spec = Path(__file__).parent / "doc_specs" / "edge" / "system.earl"
+    messages = [d.message for d in check(earl.load(spec)) if d.code == "EARL-W062"]
+    assert messages == [
+        "transition `n,t/t` #2 (line 31) of solo/a.cs can never be taken: its condition never holds when "
+        "`nothing/bb` stops"
+    ]

@@ -1067,3 +1067,25 @@ def test_the_comments_of_the_spec_are_shown_with_their_elements(tmp_path: Path, 
     types = {row[0]: row for row in _table_by_caption(html, "Data types of the specification")}
     assert "remaining: double (metres to the goal)" in types["Report"][1]
     assert types["Order"][2] == "An order for one worker: where to go."
+
+
+def test_table_5_tells_apart_two_transitions_between_the_same_states(tmp_path: Path) -> None:
+    """Table 5 named `dispatching,waiting/t` twice alike: each of two transitions between the same states
+    has its number among them and its line (as `earl check` names it), one alone its name only."""
+    spec = Path(__file__).parent / "doc_specs" / "warehouse" / "system.earl"
+    assert main(["doc", str(spec), "-o", str(tmp_path / "site")]) in (0, 1)
+    html = (tmp_path / "site" / "index.html").read_text(encoding="utf-8")
+    caption = "Table 5: initial conditions labelling supervisor/a.cs.fsm transitions"
+    names = [row[0] for row in _table_by_caption(html, caption + " and terminal conditions of supervisor/a.cs.bb")]
+    lines = [
+        number
+        for number, line in enumerate(spec.read_text(encoding="utf-8").splitlines(), start=1)
+        if line.strip().startswith("dispatching -> waiting")
+    ]
+    assert names[1:6] == [
+        "dispatching,stopped/t",
+        f"dispatching,waiting/t #1 (line {lines[0]})",
+        f"dispatching,waiting/t #2 (line {lines[1]})",
+        "waiting,dispatching/t",
+        "waiting,stopped/t",
+    ]

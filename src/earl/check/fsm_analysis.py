@@ -567,9 +567,20 @@ def analyse(context: CheckContext, subsystem: Subsystem, fsm: FSM, owner: str) -
     #: transitions that a `*` stands for (one per other state), named as written
     starred = {id(t) for t in fsm.transitions if t.from_any_state}
 
+    #: a second transition between the same two states has the same name: it is told apart by its number
+    #: among them and its line, as the document's Table 5 writes it (`dispatching,waiting/t` #2 (line 67))
+    sharing: dict[str, list[int]] = {}
+    for transition in fsm.transitions:
+        if id(transition) not in starred:  # a `*` is named apart already
+            sharing.setdefault(transition.name, []).append(id(transition))
+
     def named(transition: Transition) -> str:
         if id(transition) in starred:
             return f"`*,{transition.destination}/t` (from `{transition.source}`)"
+        same = sharing.get(transition.name, [])
+        if len(same) > 1 and id(transition) in same:
+            line = f" (line {transition.location.line})" if transition.location is not None else ""
+            return f"`{transition.name}/t` #{same.index(id(transition)) + 1}{line}"
         return f"`{transition.name}/t`"
 
     #: per transition: when `fsm.selectState()` takes it (its behaviour stopped, nothing before it held)
@@ -947,7 +958,9 @@ _register(
     "§2.2, Table 5",
     "A transition whose initial condition never holds when its state's behaviour stops (under the "
     "assumptions), or whenever it holds a transition tried before it (a higher priority) holds too, is dead "
-    "specification. A `* -> x` transition is dead when it can be taken from no state.",
+    "specification. A `* -> x` transition is dead when it can be taken from no state. One of two transitions "
+    "between the same states (both `n,t/t`) is named with its number among them and its line: "
+    "`n,t/t` #2 (line 31).",
 )
 _register(
     "EARL-I063",

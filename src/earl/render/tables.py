@@ -45,6 +45,7 @@ class TransitionRow:  # Table 5, upper part
     destination: str
     predicate: str
     priority: int | None
+    line: int | None = None  # where it was written: two transitions between the same states differ there
 
 
 @dataclass(frozen=True)
@@ -123,7 +124,14 @@ def transition_table(subsystem: Subsystem) -> list[TransitionRow]:
     if subsystem.fsm is None:
         return []
     return [
-        TransitionRow(t.name, t.source, t.destination, expression_text(t.condition.expression), t.priority)
+        TransitionRow(
+            t.name,
+            t.source,
+            t.destination,
+            expression_text(t.condition.expression),
+            t.priority,
+            t.location.line if t.location is not None else None,
+        )
         for t in subsystem.fsm.transitions
     ]
 

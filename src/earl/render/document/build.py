@@ -600,6 +600,9 @@ class DocumentBuilder:
         #: transitions between the same two states, with different conditions, are valid and share a name:
         #: the second `one,two` is anchored `…-one-two-2`, so every id of the page stays unique
         seen: dict[str, int] = {}
+        total: dict[str, int] = {}
+        for row in transitions:
+            total[row.name] = total.get(row.name, 0) + 1
         for row in transitions:
             seen[row.name] = seen.get(row.name, 0) + 1
             anchor = slug("t", qualified, row.name) + ("" if seen[row.name] == 1 else f"-{seen[row.name]}")
@@ -607,6 +610,8 @@ class DocumentBuilder:
                 name: Content = (Code(f"i,{row.destination}/t"), Text(f" where i ≠ {row.destination}"))
             else:
                 name = code(f"{row.name}/t")
+            if total[row.name] > 1:  # as `earl check` names it: `dispatching,waiting/t` #2 (line 67)
+                name += (Text(f" #{seen[row.name]}" + (f" (line {row.line})" if row.line is not None else "")),)
             rows.append(
                 [
                     cell(name, anchor=anchor),
