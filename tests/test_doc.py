@@ -1089,3 +1089,15 @@ def test_table_5_tells_apart_two_transitions_between_the_same_states(tmp_path: P
         "waiting,dispatching/t",
         "waiting,stopped/t",
     ]
+
+
+def test_table_6_lists_a_behaviour_whose_transition_function_is_empty(tmp_path: Path) -> None:
+    """`nothing/bb { tf = {} … }` was left out of Table 6 without a word: it has a row saying it has no stage."""
+    spec = Path(__file__).parent / "doc_specs" / "edge" / "system.earl"
+    assert main(["doc", str(spec), "-o", str(tmp_path / "site")]) in (0, 1)
+    html = (tmp_path / "site" / "index.html").read_text(encoding="utf-8")
+    rows = _table(html, "table6-solo-a-cs")
+    assert rows[2] == ["nothing/bb", "no stage: its transition function is empty (tf = {})"]
+    assert [row[0] for row in rows[3:]] == ["three/bb", "f2/pf", "f3/pf"]
+    markdown = (tmp_path / "site" / "index.md").read_text(encoding="utf-8")
+    assert "| no stage: its transition function is empty (`tf = {}`) |" in markdown

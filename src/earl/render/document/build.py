@@ -58,6 +58,8 @@ from earl.render.names import (
     subsystem_name,
 )
 from earl.render.tables import (
+    Column,
+    CompositionTable,
     assumption_table,
     composition_table,
     condition_table,
@@ -713,7 +715,44 @@ class DocumentBuilder:
         for row in table.rows:
             spans[row.behaviour] = spans.get(row.behaviour, 0) + 1
         seen: set[str] = set()
+        # a behaviour whose transition function is empty (`tf = {}`) has no function to list: it has a row
+        # saying so, where it was left out of the table without a word
+        empty = {b.name for b in subsystem.basic_behaviours if b.name not in spans}
+        ordered = [b.name for b in subsystem.basic_behaviours]
+        for name in ordered:
+            if name in empty:
+                rows.append(
+                    [
+                        cell((Link(scope.anchor(name, "bb"), code(f"{name}/bb")),)),
+                        cell(
+                            (Text("no stage: its transition function is empty ("), Code("tf = {}"), Text(")")),
+                            colspan=1 + len(memory) + len(outputs),
+                            css="note",
+                        ),
+                    ]
+                )
+                continue
+            rows += self._composition_rows(table, name, spans, seen, scope, [*memory, *outputs])
+        caption = text(
+            f"Table 6: compositions of Transition Functions {qualified}.bb.tf.pf; a bullet marks the Internal Memory "
+            "and Output Buffers each Partial Transition Function produces"
+        )
+        return Table(caption, header, rows, slug("table6", qualified), css="matrix")
+
+    def _composition_rows(
+        self,
+        table: CompositionTable,
+        behaviour: str,
+        spans: dict[str, int],
+        seen: set[str],
+        scope: Scope,
+        columns: list[Column],
+    ) -> list[list[Cell]]:
+        """Table 6's rows of one behaviour: a row per function of its transition function, in stage order."""
+        rows: list[list[Cell]] = []
         for row in table.rows:
+            if row.behaviour != behaviour:
+                continue
             cells: list[Cell] = []
             if row.behaviour not in seen:
                 seen.add(row.behaviour)
@@ -725,14 +764,10 @@ class DocumentBuilder:
                 )
             function_name = code(f"{row.function}/pf")
             cells.append(cell((Link(scope.anchor(row.function, "pf"), function_name),) if row.known else function_name))
-            for column in [*memory, *outputs]:
+            for column in columns:
                 cells.append(cell("•", css="bullet") if table.bullet(row, column) else cell("", css="bullet"))
             rows.append(cells)
-        caption = text(
-            f"Table 6: compositions of Transition Functions {qualified}.bb.tf.pf; a bullet marks the Internal Memory "
-            "and Output Buffers each Partial Transition Function produces"
-        )
-        return Table(caption, header, rows, slug("table6", qualified), css="matrix")
+        return rows
 
     # ------------------------------------------------------------------ data types and check results
     def types_section(self, system: System) -> Section:
