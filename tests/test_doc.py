@@ -1101,3 +1101,17 @@ def test_table_6_lists_a_behaviour_whose_transition_function_is_empty(tmp_path: 
     assert [row[0] for row in rows[3:]] == ["three/bb", "f2/pf", "f3/pf"]
     markdown = (tmp_path / "site" / "index.md").read_text(encoding="utf-8")
     assert "| no stage: its transition function is empty (`tf = {}`) |" in markdown
+
+
+def test_a_family_of_agents_is_introduced_as_a_family_of_subsystems_is(tmp_path: Path) -> None:
+    """`worker[I in 1..M]/a`'s section lacked the "An indexed family, drawn once: …" sentence that a family
+    of subsystems has; it now opens with it, saying how many agents it stands for."""
+    spec = Path(__file__).parent / "doc_specs" / "warehouse" / "system.earl"
+    assert main(["doc", str(spec), "-o", str(tmp_path / "site")]) in (0, 1)
+    markdown = (tmp_path / "site" / "index.md").read_text(encoding="utf-8")
+    section = markdown.split("## Agent `worker[I]/a`", 1)[1]
+    first = section.strip().splitlines()[0]
+    assert first.startswith("An indexed family, drawn once: worker[I]/a for I ∈ 1..M (3 agents). Type ")
+    assert (
+        "An indexed family" not in markdown.split("## Agent `supervisor/a`", 1)[1].split("## Agent")[0].split("###")[0]
+    )

@@ -408,6 +408,14 @@ class DocumentBuilder:
         section = Section((Text("Agent "), Code(name)), slug("agent", name), 2)
         row = self.subject.agent_type(agent)
         facts: list[Inline] = []
+        if agent.family is not None and agent.index is None:  # as a family of subsystems is introduced
+            members = len(self.subject.context.instances(agent))
+            facts.append(
+                Text(
+                    f"An indexed family, drawn once: {name} for {agent.family.index} ∈ {reference_range(agent)}"
+                    f" ({_count(members, 'agent')}). "
+                )
+            )
         if row is not None:
             facts += [Text("Type "), Strong(text(row.name)), Text(f" ({row.description}, Table 1). ")]
         facts.append(Text("Subsystems: "))
@@ -945,9 +953,8 @@ def _type_words(written: str) -> list[str]:
     return _WORD.findall(written)
 
 
-def reference_range(subsystem: Subsystem) -> str:
-    from earl.model.text import expression_text
-
-    family = subsystem.family
+def reference_range(element: Subsystem | Agent) -> str:
+    """`1..N`: the range of a family's index, as written."""
+    family = element.family
     assert family is not None
     return f"{expression_text(family.first)}..{expression_text(family.last)}"
