@@ -489,8 +489,11 @@ def test_document_is_usable_in_a_window_800_pixels_wide(site: Path, tmp_path: Pa
                   const outside = Array.from(document.querySelectorAll('caption, td, th'))
                     .filter(cell => cell.getBoundingClientRect().right > window.innerWidth + 1)
                     .map(cell => cell.innerText.slice(0, 60));
+                  // a rule's code on one line: `EARL-I063` broke after its hyphen
+                  const rules = Array.from(document.querySelectorAll('td.rule code'))
+                    .map(code => code.getClientRects().length);
                   return {navBottom: nav.bottom, mainTop: main.top, mainLeft: main.left,
-                          pageWidth: document.documentElement.scrollWidth, scrolling, outside};
+                          pageWidth: document.documentElement.scrollWidth, scrolling, outside, rules};
                 })()"""
             )
             page.screenshot(path=str(screenshot))
@@ -500,6 +503,7 @@ def test_document_is_usable_in_a_window_800_pixels_wide(site: Path, tmp_path: Pa
     assert layout["pageWidth"] <= 800
     assert layout["scrolling"] == []
     assert layout["outside"] == []
+    assert layout["rules"] and set(layout["rules"]) == {1}
     print(f"screenshot: {screenshot}")
 
 
@@ -1115,3 +1119,32 @@ def test_a_family_of_agents_is_introduced_as_a_family_of_subsystems_is(tmp_path:
     assert (
         "An indexed family" not in markdown.split("## Agent `supervisor/a`", 1)[1].split("## Agent")[0].split("###")[0]
     )
+
+
+def test_a_finding_links_to_the_row_of_the_element_it_is_about(tmp_path: Path) -> None:
+    """Check results linked to the subsystem's section where the element has a row of its own: W044 about
+    `lost/pp` links to its row of Table 4, W062 about the second `n,t/t` to its row of Table 5, I063 about
+    `stop/bb` to its row; the subsystem's section still lists them."""
+    warehouse = Path(__file__).parent / "doc_specs" / "warehouse" / "system.earl"
+    assert main(["doc", str(warehouse), "-o", str(tmp_path / "wh")]) in (0, 1)
+    html = (tmp_path / "wh" / "index.html").read_text(encoding="utf-8")
+    rows = _table(html, "findings")[1:]
+
+    def where(rule: str, message: str) -> str:
+        [found] = [row[2] for row in rows if row[1] == rule and row[3].startswith(message)]
+        return found
+
+    assert where("EARL-W044", "timeout(report[1]/ib) in lost/pp").startswith("supervisor/a.cs.lost/pp (")
+    assert where("EARL-I063", "stop/bb never ends").startswith("supervisor/a.cs.stop/bb (")
+    assert '<a href="#pp-supervisor-a-cs-lost"><code>' in html and 'id="pp-supervisor-a-cs-lost"' in html
+    section = html.split('<section id="ss-supervisor-a-cs">', 1)[1].split("<table", 1)[0]
+    assert "EARL-W044" in section and "EARL-I063" in section  # listed in the subsystem's section too
+    page = _Page()
+    page.feed(html)
+    assert sorted(set(page.links) - page.ids) == []
+
+    edge = Path(__file__).parent / "doc_specs" / "edge" / "system.earl"
+    assert main(["doc", str(edge), "-o", str(tmp_path / "edge")]) in (0, 1)
+    html = (tmp_path / "edge" / "index.html").read_text(encoding="utf-8")
+    assert re.search(r'<td class="rule"><code>EARL-W062</code></td><td><a href="#t-solo-a-cs-n-t-2">', html)
+    assert 'id="t-solo-a-cs-n-t-2"' in html

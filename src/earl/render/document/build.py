@@ -122,6 +122,9 @@ class DocumentBuilder:
     type_names: set[str] = field(default_factory=set)
     #: Where each diagnostic belongs: the anchor of the innermost element whose source holds it.
     owners: list[tuple[SourceLocation, str, str]] = field(default_factory=list)
+    #: The rows of a subsystem's tables a finding can link to (a buffer, a predicate, a transition …),
+    #: inside the subsystem's section, which lists its findings.
+    rows: list[tuple[SourceLocation, str, str]] = field(default_factory=list)
     #: The values of the system's parameters, in which agents' and subsystems' parameters are computed.
     environment: Environment = field(default_factory=dict)
     remarks: Remarks = field(init=False)
@@ -244,12 +247,44 @@ class DocumentBuilder:
                 if subsystem.location is not None:
                     name = qualified_subsystem_name(agent, subsystem)
                     self.owners.append((subsystem.location, slug("ss", name), name))
+                self._rows(agent, subsystem)
 
-    def owner_of(self, location: SourceLocation | None) -> tuple[str, str] | None:
+    def _rows(self, agent: Agent, subsystem: Subsystem) -> None:
+        """The rows of the subsystem's tables that have anchors, by where their elements were written."""
+        qualified = qualified_subsystem_name(agent, subsystem)
+
+        def add(element: object, anchor: str, name: str) -> None:
+            location = getattr(element, "location", None)
+            if isinstance(location, SourceLocation):
+                self.rows.append((location, anchor, f"{qualified}.{name}"))
+
+        for parameter in subsystem.parameters:
+            add(parameter, slug(slug("parameters", qualified), parameter.name), parameter.name)
+        for kind, buffers in (("ib", subsystem.input_buffers), ("ob", subsystem.output_buffers)):
+            for buffer in buffers:
+                add(buffer, slug(kind, qualified, indexed_name(buffer)), f"{indexed_name(buffer)}/{kind}")
+        for memory in subsystem.memories:
+            add(memory, slug("m", qualified, indexed_name(memory)), f"{indexed_name(memory)}/m")
+        for predicate in subsystem.primitive_predicates:
+            add(predicate, slug("pp", qualified, predicate.name), f"{predicate.name}/pp")
+        for function in subsystem.partial_transition_functions:
+            add(function, slug("pf", qualified, function.name), f"{function.name}/pf")
+        for behaviour in subsystem.basic_behaviours:
+            add(behaviour, slug("bb", qualified, behaviour.name), f"{behaviour.name}/bb")
+        if subsystem.fsm is not None:
+            seen: dict[str, int] = {}  # numbered as Table 5 anchors them
+            for transition in subsystem.fsm.transitions:
+                seen[transition.name] = seen.get(transition.name, 0) + 1
+                number = "" if seen[transition.name] == 1 else f"-{seen[transition.name]}"
+                add(transition, slug("t", qualified, transition.name) + number, f"{transition.name}/t")
+
+    def owner_of(self, location: SourceLocation | None, rows: bool = True) -> tuple[str, str] | None:
+        """The anchor and name of the innermost element whose source holds `location`: with `rows`, a row
+        of a subsystem's tables where one holds it, else the section (a subsystem's, an agent's …)."""
         if location is None:
             return None
         best: tuple[int, str, str] | None = None
-        for span, anchor, name in self.owners:
+        for span, anchor, name in self.owners + (self.rows if rows else []):
             if span.file == location.file and span.line <= location.line <= span.end_line:
                 size = span.end_line - span.line
                 if best is None or size < best[0]:
@@ -507,7 +542,9 @@ class DocumentBuilder:
         )
         if rows:
             section.add(self.parameters_table(rows, f"Parameters of {qualified}", slug("parameters", qualified)))
-        findings = [d for d in self.diagnostics if (self.owner_of(d.location) or ("", ""))[0] == section.anchor]
+        findings = [
+            d for d in self.diagnostics if (self.owner_of(d.location, rows=False) or ("", ""))[0] == section.anchor
+        ]
         if findings:
             section.add(self.findings_list(_worst_first(findings)))
         if subsystem.input_buffers or subsystem.output_buffers:
@@ -829,7 +866,7 @@ class DocumentBuilder:
             rows.append(
                 [
                     cell(d.severity.value, css=_SEVERITY_CSS[d.severity]),
-                    cell(code(d.code) if d.code else text("—")),
+                    cell(code(d.code) if d.code else text("—"), css="rule"),
                     cell(where),
                     cell(message),
                 ]

@@ -58,6 +58,7 @@ table.matrix td.bullet { font-size: 18px; line-height: 1; min-width: 34px; }
 td.error { color: #b00020; font-weight: 600; }
 td.warning { color: #9a6700; font-weight: 600; }
 td.note { color: var(--muted); }
+td.rule { white-space: nowrap; }  /* `EARL-I063` broke after its hyphen */
 wbr { display: none; }  /* a long name breaks only in a narrow window (below), not where a wide one has room */
 p.notice { padding: 8px 12px; border-left: 4px solid; background: var(--shade); font-weight: 600; }
 p.notice.error { border-color: #b00020; color: #b00020; background: #fdecee; }
