@@ -1148,3 +1148,75 @@ def test_a_finding_links_to_the_row_of_the_element_it_is_about(tmp_path: Path) -
     html = (tmp_path / "edge" / "index.html").read_text(encoding="utf-8")
     assert re.search(r'<td class="rule"><code>EARL-W062</code></td><td><a href="#t-solo-a-cs-n-t-2">', html)
     assert 'id="t-solo-a-cs-n-t-2"' in html
+
+
+#: For each text of an SVG's nodes and of the frame's name tab: how far its visible glyphs (the spaces
+#: padding it left out) stay inside the box around it, in px (negative: it runs over the border); and for
+#: each stage of an activity, how far left of its label's glyphs the control flow runs past it.
+_TEXT_FIT = """(() => {
+  const visible = t => {
+    const s = t.textContent; let a = 0, b = s.length - 1;
+    while (a <= b && /\\s/.test(s[a])) a++;
+    while (b >= a && /\\s/.test(s[b])) b--;
+    if (a > b) return null;
+    const first = t.getExtentOfChar(a), last = t.getExtentOfChar(b);
+    return [first.x, last.x + last.width];
+  };
+  const fits = [], stages = [];
+  document.querySelectorAll('g.node, g.cluster').forEach(g => {
+    const title = g.querySelector('title').textContent;
+    const shapes = [...g.querySelectorAll(':scope polygon, :scope path')].map(s => s.getBBox());
+    g.querySelectorAll('text').forEach(t => {
+      const span = visible(t); if (!span) return;
+      const box = t.getBBox(); const y = box.y + box.height / 2;
+      // the smallest shape around the text's middle: a node's border, the frame's name tab
+      const around = shapes.filter(b => b.y <= y && y <= b.y + b.height && b.x <= span[0] + 1
+                                        && span[1] - 1 <= b.x + b.width + 40)
+                           .sort((p, q) => p.width - q.width)[0];
+      if (!around) return;
+      if (title.startsWith('cluster_stage')) {
+        // how far right of the label each edge passing at its height runs (negative: through it)
+        const clear = [...document.querySelectorAll('g.edge path')].map(e => e.getBBox())
+          .filter(e => e.y <= box.y + box.height && box.y <= e.y + e.height && e.x + e.width >= span[0])
+          .map(e => e.x - span[1]);
+        stages.push([t.textContent.trim(), +Math.min(99, ...clear).toFixed(1)]);
+      } else {
+        fits.push([title, t.textContent.trim(),
+                   +Math.min(span[0] - around.x, around.x + around.width - span[1]).toFixed(1)]);
+      }
+    });
+  });
+  return {fits, stages};
+})()"""
+
+
+def test_the_text_of_activity_diagrams_stays_inside_its_borders(site: Path, tmp_path: Path) -> None:
+    """Bold action names (`outputManipState/pf`, `sendManipulatorCommand/pf`) touched or overran their
+    border, the `)` of a frame's name tab ran over the tab (13 diagrams), and the control flow struck
+    through `stage 1` in a narrow stage: dot measures the text narrower than a browser draws it.  Drawn
+    by Chromium, every glyph is now at least 1.5 px inside its border and every stage's label left of
+    the control flow."""
+    sync_api, executable = _chromium()
+    edge = Path(__file__).parent / "doc_specs" / "edge" / "system.earl"  # `three/bb`: stages of one `f1/pf`
+    assert main(["doc", str(edge), "-o", str(tmp_path / "edge")]) in (0, 1)
+    diagrams = [
+        *sorted((site / "diagrams").glob("act-*.svg")),
+        tmp_path / "edge" / "diagrams" / "act-solo-a-cs-three.svg",
+    ]
+    assert len(diagrams) > 10
+    crowded: list[tuple[str, str, str, float]] = []
+    struck: list[tuple[str, str, float]] = []
+    with sync_api.sync_playwright() as playwright:
+        browser = playwright.chromium.launch(executable_path=executable, args=["--no-sandbox"])
+        try:
+            page = browser.new_page()
+            for diagram in diagrams:
+                page.goto(diagram.as_uri(), wait_until="load")
+                found = page.evaluate(_TEXT_FIT)
+                crowded += [(diagram.name, title, said, gap) for title, said, gap in found["fits"] if gap < 1.5]
+                struck += [(diagram.name, label, gap) for label, gap in found["stages"] if gap < 2]
+                assert any(title == "cluster_frame" for title, _, _ in found["fits"])
+        finally:
+            browser.close()
+    assert crowded == []
+    assert struck == []

@@ -42,11 +42,13 @@ def wrapped(text: str, width: int = 44) -> list[str]:
 
 
 def frame_label(header: str) -> str:
-    """The SysML frame's name tab, `ibd [Agent] manip/a`: the diagram kind bold, the rest plain."""
+    """The SysML frame's name tab, `ibd [Agent] manip/a`: the diagram kind bold, the rest plain, and a space
+    after it: dot measures the text narrower than a browser draws it, and the `)` of `…execute()` ran over the
+    tab's border."""
     kind, _, rest = header.partition(" ")
     return (
         '<<table border="1" cellborder="0" cellspacing="0" cellpadding="4" bgcolor="white">'
-        f"<tr><td><b>{html(kind)}</b>&#160;{html(rest)}</td></tr></table>>"
+        f"<tr><td><b>{html(kind)}</b>&#160;{html(rest)}&#160;</td></tr></table>>"
     )
 
 

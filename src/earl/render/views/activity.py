@@ -28,11 +28,13 @@ def stage_set_name(stage: list[ElementReference], subsystem: Subsystem | None) -
 
 
 def _action_label(reference: ElementReference, function: PartialTransitionFunction | None) -> str:
-    rows = [f"<tr><td><b>{html(reference_text(reference))}</b></td></tr>"]
+    # a space either side: dot measures the bold name narrower than a browser draws it, and the rounded
+    # border's corners took the rest (`outputManipState/pf` touched it)
+    rows = [f"<tr><td><b>&#160;{html(reference_text(reference))}&#160;</b></td></tr>"]
     if function is not None and function.writes:
         writes = ", ".join(reference_text(w) for w in function.writes)
         for line in wrapped(f"→ {writes}", 40):
-            rows.append(f'<tr><td><font point-size="9" color="#555555">{html(line)}</font></td></tr>')
+            rows.append(f'<tr><td><font point-size="9" color="#555555">&#160;{html(line)}&#160;</font></td></tr>')
     return (
         '<<table border="1" style="rounded" cellborder="0" cellspacing="0" cellpadding="3" bgcolor="#f7f9fc">'
         + "".join(rows)
@@ -63,6 +65,15 @@ def activity_view(behaviour: BasicBehaviour, owner: str, subsystem: Subsystem | 
             tooltip = html(reference_text(reference))
             graph.add(f'  {node} [shape="plain", label={_action_label(reference, function)}, tooltip="{tooltip}"];')
         parallel = len(actions) > 1
+        if len(actions) == 1:
+            # The control flow runs down the middle of a stage of one action, and struck through its label
+            # (`stage 1`, at the top left) when the action was narrow: an invisible spacer as wide as the
+            # label either side of the action keeps the label left of it.
+            width = f"{len(title) * 0.075 + 0.1:.2f}"  # inches: a 9 pt letter is about 0.07 in wide
+            spacer = f'shape="box", style="invis", label="", width="{width}", height="0.02", fixedsize="true"'
+            graph.add(f"  spacer_{number}_l [{spacer}];")
+            graph.add(f"  spacer_{number}_r [{spacer}];")
+            graph.add(f'  {{ rank=same; spacer_{number}_l -> {actions[0]} -> spacer_{number}_r [style="invis"]; }}')
         if parallel:
             width = str(max(1.2, 1.9 * len(actions)))
             graph.add(f"  fork_{number} [{_BAR.format(width=width)}];")
