@@ -937,3 +937,31 @@ def test_a_link_going_back_leaves_its_output_buffer_eastwards_and_crosses_no_blo
                 from_outputs += 1
                 assert min(x for x, _ in points) >= blocks[end][2] - 2, f"{edge.get('tooltip')} turns round {end}"
     assert from_outputs
+
+
+@pytest.mark.parametrize(("spec", "target"), [(EXAMPLE, "grip/a.cs"), (EXAMPLE, "manip/a.cs"), (MOBILE, "base/a.cs")])
+def test_a_self_loop_starts_away_from_where_other_transitions_arrive(spec: Path, target: str) -> None:
+    """grip/a.cs: the arrowhead of `start → move` landed where the `move → move` loop began, so the two
+    read as one line.  Every loop now starts at least 8 pt from the tip of every other transition into
+    its state."""
+    import json
+
+    from earl.render.graphviz import _dot
+
+    diagram = build_diagram(earl.load(spec), "fsm", target)
+    layout = json.loads(_dot(diagram.laid_out, "json"))
+    loops = [edge for edge in layout["edges"] if edge["tail"] == edge["head"]]
+    assert loops
+    for loop in loops:
+        start = _edge_points(layout, loop)[0]
+        tips = [
+            (float(x), float(y))
+            for edge in layout["edges"]
+            if edge["head"] == loop["head"] and edge is not loop
+            for operation in edge.get("_hdraw_", [])
+            if operation.get("op") in ("P", "p")
+            for x, y in operation["points"]
+        ]
+        assert tips
+        nearest = min(((x - start[0]) ** 2 + (y - start[1]) ** 2) ** 0.5 for x, y in tips)
+        assert nearest >= 8, f"{loop.get('tooltip')} starts {nearest:.1f} pt from an arrowhead"

@@ -88,7 +88,13 @@ def fsm_view(fsm: FSM, owner: str, subsystem: Subsystem | None = None, expand: b
             source = node_id("state", transition.source)
         tooltip = html(f"{transition.name}/t")
         names.append(f"{transition.name}/t")
-        graph.add(f'{source} -> {destination} [label={transition_label(transition)}, tooltip="{tooltip}"];')
+        # A transition back into its own state leaves the middle of its east side and comes back under its
+        # south-east corner: left to dot, it left the top of that side, where a transition arriving from above
+        # lands, whose arrowhead then met the loop's start (grip/a.cs's move).  Under the state, it crossed the
+        # transitions leaving for the states below.
+        ports = 'tailport="e", headport="se", ' if source == destination else ""
+        label = transition_label(transition)
+        graph.add(f'{source} -> {destination} [{ports}label={label}, tooltip="{tooltip}"];')
     assumed = assumptions_label(fsm)
     if assumed is not None:
         # inside the frame and tied to no state: a comment of the state machine itself, as a SysML note
