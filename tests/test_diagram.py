@@ -965,3 +965,37 @@ def test_a_self_loop_starts_away_from_where_other_transitions_arrive(spec: Path,
         assert tips
         nearest = min(((x - start[0]) ** 2 + (y - start[1]) ** 2) ** 0.5 for x, y in tips)
         assert nearest >= 8, f"{loop.get('tooltip')} starts {nearest:.1f} pt from an arrowhead"
+
+
+@pytest.mark.parametrize(
+    ("spec", "agent", "expand"),
+    [
+        (EXAMPLE, "manip/a", True),
+        (EXAMPLE, "manip/a", False),
+        (EXAMPLE, "grip/a", True),
+        (MOBILE, "base/a", True),
+        (WAREHOUSE, "worker[1]/a", True),
+        (WAREHOUSE, "supervisor/a", False),
+    ],
+)
+def test_no_link_crosses_the_agent_view_s_name_tab(spec: Path, agent: str, expand: bool) -> None:
+    """`--view agent --target manip/a --expand --param N=2`: the dashed `task,manip` link crossed the
+    `ibd [Agent] manip/a` tab (it ran from task/a, placed under the frame, up round its top-left corner).
+    No drawn link passes within 3 pt of the tab."""
+    import json
+
+    from earl.render.graphviz import _dot
+
+    diagram = build_diagram(earl.load(spec, {"N": 2} if spec == EXAMPLE else None), "agent", agent, expand=expand)
+    layout = json.loads(_dot(diagram.laid_out, "json"))
+    [frame] = [o for o in layout["objects"] if o.get("name") == "cluster_frame"]
+    x, y = (float(v) for v in frame["lp"].split(","))
+    half_width, half_height = float(frame["lwidth"]) * 36 + 3, float(frame["lheight"]) * 36 + 3
+    crossing = {
+        edge.get("tooltip")
+        for edge in layout["edges"]
+        if "invis" not in edge.get("style", "")
+        for px, py in _edge_points(layout, edge)
+        if abs(px - x) <= half_width and abs(py - y) <= half_height
+    }
+    assert crossing == set()
