@@ -700,7 +700,7 @@ def test_the_agents_table_puts_each_member_in_the_robot_that_lists_it(tmp_path: 
     assert rows == {
         "| [`worker[1]/a`](#agent-worker-1-a)": "`fleetRobot/r`",
         "| [`worker[2]/a`](#agent-worker-2-a)": "`fleetRobot/r`",
-        "| [`worker[3]/a`](#agent-worker-3-a)": "—",
+        "| [`worker[3]/a`](#agent-worker-3-a)": "no robot",
     }
 
 
@@ -1220,3 +1220,29 @@ def test_the_text_of_activity_diagrams_stays_inside_its_borders(site: Path, tmp_
             browser.close()
     assert crowded == []
     assert struck == []
+
+
+def test_table_1_and_the_links_table_say_what_they_count_and_where_each_belongs(tmp_path: Path) -> None:
+    """Table 1's caption said "counts of one member for a family" beside manip/a's |ve| 6 (a family of
+    subsystems counts every member); its robot column said "—" for an agent in no robot but "no robot (…)"
+    for a family's members; a robot's `link` references were shown nowhere; and Table 4 broke a line
+    between a unary minus and its operand (`> -` / `STANDSTILL`)."""
+    assert main(["doc", str(EXAMPLE), "-o", str(tmp_path / "pp")]) == 0
+    html = (tmp_path / "pp" / "index.html").read_text(encoding="utf-8")
+    agents = {row[0]: row for row in _table(html, "agents")}
+    assert agents["manip/a"][5] == "6"  # |ve|: motorController[K in 1..N]/ve, N = 6
+    caption = _Rows("agents")
+    caption.feed(html)
+    assert "a family of subsystems or links counts every member" in caption.caption
+    links = _table(html, "links")
+    assert links[0][-1] == "robot" and {row[-1] for row in links[1:]} == {"manipulationRobot/r"}
+
+    mobile = ROOT / "examples" / "mobile_robot" / "system.earl"
+    assert main(["doc", str(mobile), "-o", str(tmp_path / "mr")]) == 0
+    html = (tmp_path / "mr" / "index.html").read_text(encoding="utf-8")
+    agents = {row[0]: row for row in _table(html, "agents")}
+    assert agents["coordinator/a"][1] == "no robot" and agents["base/a"][1] == "mobileRobot/r"
+    assert "robot" not in _table(html, "links")[0]  # no robot lists a link: no robot column
+    assert '<span class="whole">-STANDSTILL</span>' in html and ".whole { white-space: nowrap; }" in html.replace(
+        "td.rule, ", ""
+    )

@@ -71,6 +71,7 @@ from earl.render.views.activity import activity_view
 from earl.render.views.agent import agent_links, agent_view
 from earl.render.views.fsm import fsm_view
 from earl.render.views.system import (
+    NO_ROBOT,
     InterAgentLink,
     end_name,
     inter_agent_links,
@@ -397,22 +398,35 @@ class DocumentBuilder:
             rows.append(
                 [
                     cell((Link(slug("agent", name), code(name)),)),
-                    cell(code(robot) if robot != "—" else text(robot)),
+                    cell(code(robot) if robot != NO_ROBOT else text(robot)),
                     type_cell,
                     cell(row.description if row is not None else ""),
                     *[cell(str(count)) for count in counts],
                 ]
             )
         known = ", ".join(f"{t.name} ({t.description})" for t in AGENT_TYPES)
+        # a family of subsystems counts every member (`|ve|` 6 for motorController[K in 1..6]/ve): the caption
+        # had said "counts of one member for a family" beside manip/a's 6
         caption = text(
-            f"Agents and their types (Table 1; counts of one member for a family). Table 1's types: {known}."
+            "Agents and their types (Table 1; a family of subsystems or links counts every member, a family of "
+            f"agents shows the counts of one member). Table 1's types: {known}."
         )
         return Table(caption, header, rows, "agents")
 
     def links_table(self, links: list[InterAgentLink]) -> Table:
-        header = [[cell("link"), cell("from"), cell("to"), cell("dataType")]]
+        """Each inter-agent link with its buffers and data type; where robots list links (`twoRobots/r { …
+        link left,right }`), which robot lists each (that had been shown nowhere)."""
+        system = self.subject.shown
+        listing = {
+            reference.name: [r.name + "/r" for r in system.robots if any(ref.name == reference.name for ref in r.links)]
+            for robot in system.robots
+            for reference in robot.links
+        }
+        header = [[cell("link"), cell("from"), cell("to"), cell("dataType")] + ([cell("robot")] if listing else [])]
         rows = []
         for link in links:
+            robots = listing.get(link.link.name_text, [])
+            robot_cell = [cell(code(", ".join(robots)) if robots else text("—"))] if listing else []
             source = qualified_subsystem_name(link.source, _cs(link.source))
             destination = qualified_subsystem_name(link.destination, _cs(link.destination))
             rows.append(
@@ -428,6 +442,7 @@ class DocumentBuilder:
                         )
                     ),
                     cell(self.type_content(link.data_type)),
+                    *robot_cell,
                 ]
             )
         return Table(

@@ -58,7 +58,7 @@ table.matrix td.bullet { font-size: 18px; line-height: 1; min-width: 34px; }
 td.error { color: #b00020; font-weight: 600; }
 td.warning { color: #9a6700; font-weight: 600; }
 td.note { color: var(--muted); }
-td.rule { white-space: nowrap; }  /* `EARL-I063` broke after its hyphen */
+td.rule, .whole { white-space: nowrap; }  /* `EARL-I063` broke after its hyphen */
 wbr { display: none; }  /* a long name breaks only in a narrow window (below), not where a wide one has room */
 p.notice { padding: 8px 12px; border-left: 4px solid; background: var(--shade); font-weight: 600; }
 p.notice.error { border-color: #b00020; color: #b00020; background: #fdecee; }
@@ -85,9 +85,26 @@ figcaption { color: var(--muted); font-size: 13px; margin-top: 4px; }
 _BREAK = re.compile(r"(?<=[.:,_])(?=[A-Za-z])|(?<=[a-z])(?=[A-Z])")
 
 
+#: A unary minus and its operand (`-STANDSTILL` in `x > -STANDSTILL`): a browser breaks a line after a
+#: hyphen, which parted them; a binary minus is written with spaces (`a - b`).
+_NEGATED = re.compile(r"(?:^|(?<=[\s(,\[]))-[\w.\[\]*/]+")
+
+
 def breakable(text: str) -> str:
     """`text` escaped for HTML with `<wbr>` where a long name may break: a narrow window wraps a
-    table's long names there instead of pushing the table off the page (copying the text is unchanged)."""
+    table's long names there instead of pushing the table off the page (copying the text is unchanged);
+    a negated operand is kept whole."""
+    parts = []
+    position = 0
+    for found in _NEGATED.finditer(text):
+        parts.append(_with_breaks(text[position : found.start()]))
+        parts.append(f'<span class="whole">{escape(found.group())}</span>')
+        position = found.end()
+    parts.append(_with_breaks(text[position:]))
+    return "".join(parts)
+
+
+def _with_breaks(text: str) -> str:
     return "<wbr>".join(escape(piece) for piece in _BREAK.split(text))
 
 

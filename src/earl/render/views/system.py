@@ -310,16 +310,20 @@ def member_placement_lines(system: System, agent: Agent, placement: Placement) -
     return lines
 
 
+NO_ROBOT = "no robot"
+
+
 def robot_text(system: System, agent: Agent, placement: Placement) -> str:
     """Table 1's robot column: `fleetRobot/r`; for a split family `fleetRobot/r (worker[1]/a),
-    otherFleet/r (worker[2]/a), no robot (worker[3]/a)`; `—` for an agent in no robot."""
+    otherFleet/r (worker[2]/a), no robot (worker[3]/a)`; `no robot` for an agent in none, as a split
+    family's members in none are said to be (it had been `—`)."""
     parts = []
     for share in placement.shares:
         name = f"{system.robots[share.robot].name}/r"
         parts.append(name if share.members is None else f"{name} ({member_names(agent, share.members)})")
     if parts and placement.outside:
         parts.append(f"no robot ({member_names(agent, placement.outside)})")
-    return ", ".join(parts) or "—"
+    return ", ".join(parts) or NO_ROBOT
 
 
 def _robot_members(reference: ElementReference, agents: dict[Key, Agent]) -> list[Agent]:
