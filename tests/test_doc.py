@@ -1064,6 +1064,11 @@ def test_the_comments_of_the_spec_are_shown_with_their_elements(tmp_path: Path, 
     memory = {row[0]: row for row in _table_by_caption(html, "Table 3: base/a.cs.m dataTypes")}
     assert memory["goalWayClear/m"][3].startswith("written by avoid/pf")
     assert memory["velocity/m"][3] == ""
+    caption = "Table 5: initial conditions labelling base/a.cs.fsm transitions and terminal conditions of base/a.cs.bb"
+    conditions = {row[0]: row for row in _table_by_caption(html, caption)}
+    assert conditions["drive,avoidObstacle/t"][3].startswith("An obstacle outranks a new goal")
+    assert conditions["avoidObstacle,idle/t"][3] == "a cancel outranks a clear path"
+    assert conditions["start/bb"][3].startswith("Within each first stage")
 
     warehouse = Path(__file__).parent / "doc_specs" / "warehouse" / "system.earl"
     assert main(["doc", str(warehouse), *options, "-o", str(tmp_path / "wh")]) in (0, 1)

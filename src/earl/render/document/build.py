@@ -571,7 +571,10 @@ class DocumentBuilder:
             predicates = subsystem.primitive_predicates
             section.add(self.commented(self.predicates_table(subsystem, qualified, scope), predicates))
         if subsystem.fsm is not None or subsystem.basic_behaviours:
-            section.add(self.conditions_table(subsystem, qualified, scope))
+            transitions = subsystem.fsm.transitions if subsystem.fsm is not None else []
+            # a row per transition, the `bb` header row when there are transitions, a row per behaviour
+            rows_of: list[object] = [*transitions, *([None] if transitions else []), *subsystem.basic_behaviours]
+            section.add(self.commented(self.conditions_table(subsystem, qualified, scope), rows_of))
         if subsystem.fsm is not None:
             section.add(
                 self.figure(
