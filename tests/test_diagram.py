@@ -999,3 +999,11 @@ def test_no_link_crosses_the_agent_view_s_name_tab(spec: Path, agent: str, expan
         if abs(px - x) <= half_width and abs(py - y) <= half_height
     }
     assert crossing == set()
+
+
+def test_the_agent_view_marks_an_input_buffer_that_keeps_a_fifo() -> None:
+    """`goal/ib: NavigationGoal fifo 4 overflow dropOldest`: the agent view showed it as any buffer; its
+    port says `{fifo 4, dropOldest}` after its name, as UML writes a property's modifiers."""
+    texts = svg_text(build_diagram(earl.load(MOBILE), "agent", "base/a").svg())
+    assert "goal/ib {fifo 4, dropOldest}" in texts
+    assert "obstacles/ib {" not in texts

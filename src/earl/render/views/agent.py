@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 from earl.model.elements import Agent, InputBuffer, Link, OutputBuffer, Subsystem, System
 from earl.model.kinds import KIND_TITLES, Kind
+from earl.model.text import expression_text
 from earl.model.types import type_text
 from earl.render.diagram import Diagram
 from earl.render.dot import FILL, Graph, html
@@ -74,13 +75,22 @@ def port_name(direction: str, element_key_text: str) -> str:
     return "p_" + direction + "_" + "".join(c if c.isalnum() else "_" for c in element_key_text)
 
 
+def _queue_text(buffer: InputBuffer) -> str:
+    """` {fifo 4, dropOldest}` after an Input Buffer that keeps a FIFO, as UML writes a property's
+    modifiers; nothing after one that keeps the latest message."""
+    if buffer.queue is None:
+        return ""
+    return f" {{fifo {expression_text(buffer.queue.capacity)}, {buffer.queue.overflow}}}"
+
+
 def subsystem_block(subsystem: Subsystem) -> str:
     title = [f"<i>«{html(KIND_TITLES[subsystem.kind])}»</i>", f"<b>{html(subsystem_name(subsystem))}</b>"]
     notes = [note for note in (family_note(subsystem),) if note]
     if subsystem.period is not None:
         notes.append(f"period {subsystem.period.value} {subsystem.period.unit}")
     inputs = [
-        Port(port_name("ib", indexed_name(b)), element_name(b, Kind.INPUT_BUFFER)) for b in subsystem.input_buffers
+        Port(port_name("ib", indexed_name(b)), element_name(b, Kind.INPUT_BUFFER) + _queue_text(b))
+        for b in subsystem.input_buffers
     ]
     outputs = [
         Port(port_name("ob", indexed_name(b)), element_name(b, Kind.OUTPUT_BUFFER)) for b in subsystem.output_buffers
