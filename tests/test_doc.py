@@ -970,6 +970,12 @@ def test_the_document_tabulates_parameters_with_their_values_and_where_they_were
     assert base["TRACK_WIDTH"][1:3] == ["double", "0.42"]
     cs = {row[0]: row for row in _table(html, "parameters-base-a-cs")[1:]}
     assert cs["STANDSTILL"][2] == "0.05" and "rad/s" in cs["STANDSTILL"][4]
+    # a parameter named in an expression links to its row: the innermost one of that name
+    assert '<a href="#parameters-base-a-cs-STANDSTILL">STANDSTILL</a>' in html
+    assert '<a href="#parameters-WHEELS">WHEELS</a>' in html
+    page = _Page()
+    page.feed(html)
+    assert sorted(set(page.links) - page.ids) == []
     markdown = (tmp_path / "mr" / "index.md").read_text(encoding="utf-8")
     assert "Parameters of the system mobileRobot" in markdown and "`WHEELS` | `int` | `2` | spec" in markdown
 
@@ -1248,6 +1254,5 @@ def test_table_1_and_the_links_table_say_what_they_count_and_where_each_belongs(
     agents = {row[0]: row for row in _table(html, "agents")}
     assert agents["coordinator/a"][1] == "no robot" and agents["base/a"][1] == "mobileRobot/r"
     assert "robot" not in _table(html, "links")[0]  # no robot lists a link: no robot column
-    assert '<span class="whole">-STANDSTILL</span>' in html and ".whole { white-space: nowrap; }" in html.replace(
-        "td.rule, ", ""
-    )
+    negated = '<span class="whole">-<a href="#parameters-base-a-cs-STANDSTILL">STANDSTILL</a></span>'
+    assert negated in html and ".whole { white-space: nowrap; }" in html.replace("td.rule, ", "")

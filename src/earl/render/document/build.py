@@ -83,6 +83,9 @@ from earl.render.views.types import agent_types, closure, types_view
 
 _REFERENCE = re.compile(r"\b([A-Za-z_]\w*)((?:\[[^\]]*\])?)/(pp|ib|ob|mi|mo|m|bb|pf)\b")
 _WORD = re.compile(r"[A-Za-z_]\w*")
+#: a bare name that may be a parameter: not a field (`.x`), a call (`any(`), or a name with its kind (`x/pp`)
+_PARAMETER = re.compile(r"(?<!\w)(?:(?<=\.\.)|(?<!\.))[A-Za-z_]\w*(?![\w(/\[])")  # `1..N`, not `.x`
+_STRING = re.compile(r'"(?:[^"\\]|\\.)*"')
 _SEVERITY_CSS = {Severity.ERROR: "error", Severity.WARNING: "warning", Severity.NOTE: "note"}
 
 
@@ -96,6 +99,8 @@ class Scope:
 
     prefix: str  # the subsystem's qualified name
     names: dict[tuple[str, str], str] = field(default_factory=dict)  # (name, kind) → anchor
+    #: the parameters in scope (the subsystem's, its agent's, the system's) → the anchor of their rows
+    parameters: dict[str, str] = field(default_factory=dict)
 
     @staticmethod
     def _kind(kind: str) -> str:
@@ -181,14 +186,24 @@ class DocumentBuilder:
         """An expression in one monospace run, each `name/kind` linked to the row that defines it."""
         parts: list[Inline] = []
         position = 0
-        for match in _REFERENCE.finditer(expression):
-            anchor = scope.find(match.group(1), match.group(2), match.group(3))
-            if anchor is None:
-                continue
-            if match.start() > position:
-                parts.append(Text(expression[position : match.start()]))
-            parts.append(Link(anchor, text(match.group())))
-            position = match.end()
+        found = [
+            (match.start(), match.end(), anchor)
+            for match in _REFERENCE.finditer(expression)
+            if (anchor := scope.find(match.group(1), match.group(2), match.group(3))) is not None
+        ]
+        # a parameter (`STANDSTILL`, `N`) links to its row of a parameters table, outside string literals
+        strings = [(m.start(), m.end()) for m in _STRING.finditer(expression)]
+        for match in _PARAMETER.finditer(expression):
+            anchor = scope.parameters.get(match.group())
+            taken = any(start < match.end() and match.start() < end for start, end, _ in found)
+            quoted = any(start <= match.start() < end for start, end in strings)
+            if anchor is not None and not taken and not quoted:
+                found.append((match.start(), match.end(), anchor))
+        for start, end, anchor in sorted(found):
+            if start > position:
+                parts.append(Text(expression[position:start]))
+            parts.append(Link(anchor, text(expression[start:end])))
+            position = end
         if position < len(expression):
             parts.append(Text(expression[position:]))
         return (Monospace(tuple(parts)),)
@@ -532,6 +547,11 @@ class DocumentBuilder:
             scope.define(function.name, function.name, "pf")
         for behaviour in subsystem.basic_behaviours:
             scope.define(behaviour.name, behaviour.name, "bb")
+        # the innermost declaration of a name hides the outer ones, as in the language
+        scope.parameters = {p.name: slug("parameters", p.name) for p in self.subject.shown.parameters}
+        agent_anchor = slug("parameters", agent_name(agent))
+        scope.parameters |= {p.name: slug(agent_anchor, p.name) for p in agent.parameters}
+        scope.parameters |= {p.name: slug(slug("parameters", qualified), p.name) for p in subsystem.parameters}
 
         title = (Code(qualified), Text(f" — {KIND_TITLES[subsystem.kind]}"))
         section = Section(title, slug("ss", qualified), 3)

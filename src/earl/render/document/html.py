@@ -123,8 +123,24 @@ def inline(part: Inline, monospace: bool = False) -> str:
     raise TypeError(part)
 
 
+_ENDS_NEGATING = re.compile(r"(?:^|(?<=[\s(,\[]))-$")
+
+
 def content(parts: Content, monospace: bool = False) -> str:
-    return "".join(inline(part, monospace) for part in parts)
+    out = []
+    position = 0
+    while position < len(parts):
+        part = parts[position]
+        after = parts[position + 1] if position + 1 < len(parts) else None
+        if monospace and isinstance(part, Text) and isinstance(after, Link) and _ENDS_NEGATING.search(part.text):
+            # `-` then a linked name (`> -STANDSTILL`, the parameter linked): kept on one line with it
+            out.append(inline(Text(part.text[:-1]), monospace))
+            out.append(f'<span class="whole">-{inline(after, monospace)}</span>')
+            position += 2
+            continue
+        out.append(inline(part, monospace))
+        position += 1
+    return "".join(out)
 
 
 def _cell(tag: str, item: Cell) -> str:
