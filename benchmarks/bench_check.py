@@ -9,8 +9,8 @@
     effectors and 2N links between them (a rule that compared every effector with every link
     of its agent once made N = 10,000 take 78 s).
 (e) Large FSMs: conditions comparing numbers (8 values, 10 comparisons of each, a state left by
-    30 or 40 prioritised transitions) and Boolean inputs (60 predicates, one state left by 200
-    prioritised transitions). The peers are the same analysis on dd's pure-Python BDDs
+    30 or 40 prioritised transitions), Boolean inputs (60 predicates, one state left by 200
+    prioritised transitions) and two families of 24 Boolean inputs paired by index. The peers are the same analysis on dd's pure-Python BDDs
     (`dd.autoref`, earl's backend where dd's wheel brings no CUDD), and, for 30 comparing
     transitions, also with the variables in the order of first use: earl before 2026-11-22's
     eleventh session (17 s). Every variant must report exactly the same findings.
@@ -455,6 +455,45 @@ def booleans_spec(predicates: int, transitions: int, seed: int = 1) -> str:
     return "\n".join(lines)
 
 
+def families_spec(members: int) -> str:
+    """Two families of Boolean inputs and a predicate pairing them member by member, `any(K in 1..N:
+    a[K]/ib and b[K]/ib)`: 2^N BDD nodes with every `a` above every `b`, as the order of first use puts
+    them (N = 20 took a minute before 2026-11-23); 2N with the members interleaved by index."""
+    return f"""system families{members}
+
+r/r {{ a/a }}
+
+a/a {{
+    cs {{
+        period 1 ms
+        a[K in 1..{members}]/ib: boolean
+        b[K in 1..{members}]/ib: boolean
+        e/ib: boolean
+        anyA/pp = any(K in 1..{members}: a[K]/ib)
+        anyB/pp = any(K in 1..{members}: b[K]/ib)
+        pair/pp = any(K in 1..{members}: a[K]/ib and b[K]/ib)
+        run/bb {{
+            tf = {{}}
+            tc = e/ib
+        }}
+        fsm {{
+            initial s0
+            state s0: run/bb
+            state s1: run/bb
+            state s2: run/bb
+            state s3: run/bb
+            s0 -> s1 when anyA/pp
+            s0 -> s2 when anyB/pp
+            s0 -> s3 when pair/pp
+            s1 -> s0 when true
+            s2 -> s0 when true
+            s3 -> s0 when true
+        }}
+    }}
+}}
+"""
+
+
 def _variant(
     context: CheckContext, subsystem: Subsystem, fsm: FSM, pure_python: bool, first_use: bool
 ) -> tuple[dict[str, set[str]], Timing]:
@@ -479,11 +518,13 @@ def bench_large_fsms(quick: bool, runs: int) -> list[dict[str, Any]]:
         ("8 values x 10 comparisons, 30 prioritised transitions", comparisons_spec(8, 10, 30), True),
         ("8 values x 10 comparisons, 40 prioritised transitions", comparisons_spec(8, 10, 40), False),
         ("60 Boolean predicates, 200 prioritised transitions from one state", booleans_spec(60, 200), False),
+        ("two families of 24 members paired by index", families_spec(24), False),
     ]
     if quick:
         cases = [
             ("8 values x 10 comparisons, 20 prioritised transitions", comparisons_spec(8, 10, 20), True),
             ("30 Boolean predicates, 60 prioritised transitions from one state", booleans_spec(30, 60), False),
+            ("two families of 24 members paired by index", families_spec(24), False),
         ]
     print(f"earl backend: {fsm_analysis.BDD.__module__}", flush=True)
     rows = []

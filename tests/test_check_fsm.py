@@ -716,6 +716,41 @@ def test_each_value_s_comparisons_sit_side_by_side_in_the_bdd_by_their_constants
     ]  # fmt: skip
 
 
+def test_members_of_two_families_are_interleaved_by_index_while_the_bdds_are_built() -> None:
+    """With every `a[K]/ib` above every `b[K]/ib` (the order of first use), `any(K in 1..N: a[K]/ib and
+    b[K]/ib)` has 2^N nodes: N = 20 took a minute, N = 24 minutes. The members are placed by index as they
+    are declared, so the BDD built is small, and `order_variables` keeps them so."""
+    from earl.check.fsm_analysis import _Encoder
+
+    members = 14
+    extra = (
+        f"        a[K in 1..{members}]/ib: boolean\n        b[K in 1..{members}]/ib: boolean\n"
+        f"        anyA/pp = any(K in 1..{members}: a[K]/ib)\n        anyB/pp = any(K in 1..{members}: b[K]/ib)\n"
+        f"        pair/pp = any(K in 1..{members}: a[K]/ib and b[K]/ib)\n"
+    )
+    system = earl.loads(
+        PROBE.replace("TC", "true")
+        .replace("FIRST", "anyA/pp or anyB/pp")
+        .replace("SECOND", "pair/pp")
+        .replace("        false/pp = false\n", "        false/pp = false\n" + extra),
+        "probe.earl",
+    )
+    context = context_for(system)
+    subsystem = next(s for _, s in context.subsystems())
+    assert subsystem.fsm is not None
+    encoder = _Encoder(context, subsystem)
+    for transition in subsystem.fsm.transitions:
+        encoder.encode(transition.condition.expression)
+    built = encoder.definitions_met  # `pair/pp` is its variable, tied to its definition here
+    assert max(formula.dag_size for formula in built) < 4 * members  # 2^N in the order of first use
+    encoder.order_variables()
+    levels = encoder.bdd.var_levels
+    order = [encoder.names[name] for name in sorted(levels, key=levels.__getitem__)]
+    read = [name for name in order if name.startswith(("a[", "b["))]
+    assert read == [f"{family}[{k}]/ib" for k in range(1, members + 1) for family in "ab"]
+    assert max(formula.dag_size for formula in built) < 4 * members
+
+
 @pytest.mark.parametrize("seed", range(3))
 def test_many_prioritised_transitions_over_many_comparisons_are_analysed_as_in_the_order_of_first_use(
     seed: int,

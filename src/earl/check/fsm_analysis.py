@@ -64,9 +64,11 @@ from earl.model.expressions import (
     ElementReference,
     Expression,
     FieldAccess,
+    IndexAccess,
     Literal,
     Not,
     Read,
+    reads,
 )
 from earl.model.kinds import Kind
 from earl.model.text import expression_text, reference_text, subsystem_name
@@ -167,18 +169,51 @@ class _Encoder:
         self.call_arguments: dict[str, Read] = {}
         #: per predicate's variable: the variables its definition is written in (`order_variables`)
         self.defined_over: dict[str, set[str]] = {}
+        #: per variable, and per compared value (its text): the member of a family or the element of an
+        #: array it reads (`order_variables` puts `a[3]/ib` beside `b[3]/ib`)
+        self.members: dict[str, _Member] = {}
+        self.compared_members: dict[str, _Member] = {}
+        self._families: dict[str, int] = {}  # family → rank of first use
+        self._last_member: tuple[tuple[int, ...], int] | None = None  # the greatest placed so far
 
-    def variable(self, text: str) -> Function:
+    def variable(self, text: str, expression: Expression | None = None) -> Function:
         """The Boolean named by `text` (the whole text: two long formulas alike in their first words
-        are two Booleans); messages show it shortened."""
+        are two Booleans), which stands for `expression`; messages show it shortened."""
         name = self.by_text.get(text)
         if name is None:
             name = self.by_text[text] = f"v{len(self.by_text)}"
             self.names[name] = _shortened(text)
             self.bdd.declare(name)
+            member = None if expression is None else _member_read(expression)
+            if member is not None:
+                self.members[name] = member
+                self._place(name, member)
         if self._depth == 0:
             self.surface.add(name)
         return self.bdd.var(name)
+
+    def _place(self, name: str, member: _Member) -> None:
+        """Declare a member's variable beside the members of other families with its index, not at the
+        bottom: `order_variables` comes only once every formula is built, and with all of `a[1..N]/ib`
+        above all of `b[1..N]/ib`, building `any(K in 1..N: a[K]/ib and b[K]/ib)` takes 2^N nodes."""
+        rank = self._families.setdefault(member.family, len(self._families))
+        placed = (member.indices, rank)
+        if self._last_member is None or placed >= self._last_member:
+            self._last_member = placed  # its place is the bottom, where `declare` put it
+            return
+        levels = self.bdd.var_levels
+        order = sorted((n for n in levels if n != name), key=levels.__getitem__)
+        at = next(
+            (
+                level
+                for level, other in enumerate(order)
+                if other in self.members
+                and (self.members[other].indices, self._families[self.members[other].family]) > placed
+            ),
+            len(order),
+        )
+        order.insert(at, name)
+        self.bdd.reorder({n: level for level, n in enumerate(order)})
 
     def encode(self, expression: Expression) -> Function:
         folded = constant_value(expression)
@@ -190,7 +225,7 @@ class _Encoder:
             if len(expression.operands) > _MOST_OPERANDS:
                 # `any(K in 1..N: …)` unrolled for a large N: one Boolean of its own, so that no
                 # BDD grows with N (dd's operations recurse once per variable)
-                return self.variable(expression_text(expression))
+                return self.variable(expression_text(expression), expression)
             operands = [self.encode(o) for o in expression.operands]
             result = operands[0]
             for operand in operands[1:]:
@@ -208,12 +243,12 @@ class _Encoder:
                 expression = Call(expression.function, (argument,), expression.location)
             if isinstance(argument, Read):
                 return self._call(expression.function, argument)
-            return self.variable(expression_text(expression))
-        return self.variable(expression_text(expression))
+            return self.variable(expression_text(expression), expression)
+        return self.variable(expression_text(expression), expression)
 
     def _call(self, function: str, argument: Read) -> Function:
         """`newData(x/ib)`, `timeout(x/ib)`, `stale(x/ib)`: a Boolean each, related by `constraints`."""
-        variable = self.variable(expression_text(Call(function, (argument,))))
+        variable = self.variable(expression_text(Call(function, (argument,))), argument)
         self.calls[(function, expression_text(argument))] = variable
         self.call_arguments[expression_text(argument)] = argument
         return variable
@@ -257,8 +292,11 @@ class _Encoder:
                 # `s/ib.b == false` is `not s/ib.b`: the Boolean itself, not an atom of its own
                 value = self.encode(value_side)
                 return value if (operator == "==") == right else ~value
-            variable = self.variable(text)
+            variable = self.variable(text, value_side)
             value_text = expression_text(value_side)
+            member = _member_read(value_side)
+            if member is not None:
+                self.compared_members.setdefault(value_text, member)
             self.comparisons.setdefault(value_text, []).append((operator, right, variable))
             whole_numbers = self.typer.integer_range(value_side)
             if whole_numbers is not None:
@@ -269,28 +307,55 @@ class _Encoder:
         ):
             same = self.encode(comparison.left).equiv(self.encode(comparison.right))
             return same if operator == "==" else ~same
-        return self.variable(text)
+        return self.variable(text, comparison)
 
     def order_variables(self) -> None:
         """Put the variables in an order that keeps the BDDs small (call once every formula is encoded,
         before `constraints`): each compared value's comparisons side by side, sorted by their
-        constants, each predicate just after the last variable of its definition.
+        constants; what reads members of families (or elements of arrays) interleaved by index
+        (`a[1]/ib`, `b[1]/ib`, `a[2]/ib`, …); each predicate just after the last variable of its
+        definition; the rest in the order of first use.
 
         The order of first use interleaves the comparisons of different values, and a BDD then
         carries every value's region at once: 8 values of 10 comparisons and 40 prioritised
-        transitions took a minute. Side by side, a value's regions form a chain one node wide."""
-        key: dict[str, tuple[Any, ...]] = {}
-        for group, atoms in enumerate(self.comparisons.values()):
-            by_constant = sorted(atoms, key=_constant_order)
-            for rank, (_, _, variable) in enumerate(by_constant):
+        transitions took a minute. Side by side, a value's regions form a chain one node wide.
+        It also puts all of `a[1..N]/ib` before all of `b[1..N]/ib`, where `any(K in 1..N: a[K]/ib
+        and b[K]/ib)` has 2^N nodes (N = 24: minutes); interleaved it has 2N."""
+        groups: dict[str, int] = {}  # compared value → its group's position of first use
+        ranks: dict[str, tuple[str, int]] = {}  # comparison's variable → (compared value, rank by constant)
+        for value_text, atoms in self.comparisons.items():
+            for rank, (_, _, variable) in enumerate(sorted(atoms, key=_constant_order)):
                 if variable.var is not None:  # always: an atom is one variable
-                    key.setdefault(variable.var, (1, group, rank))
-        for position, name in enumerate(self.names):  # in the order of first use
+                    ranks.setdefault(variable.var, (value_text, rank))
+        position_of = {name: position for position, name in enumerate(self.names)}
+        for name, (value_text, _) in ranks.items():
+            groups[value_text] = min(groups.get(value_text, position_of[name]), position_of[name])
+        members = {name: member for name, member in self.members.items() if name not in ranks}
+        members.update(
+            {name: self.compared_members[value] for name, (value, _) in ranks.items() if value in self.compared_members}
+        )
+        # every member's slot is where the first of them was used, then by index, then by family
+        first_member = min((position_of[name] for name in members), default=0)
+        families: dict[str, int] = {}
+        for name in sorted(members, key=position_of.__getitem__):
+            families.setdefault(members[name].family, len(families))
+
+        def slot(name: str, position: int) -> tuple[int, tuple[int, ...], int]:
+            member = members.get(name)
+            if member is None:
+                return (position, (), 0)
+            return (first_member, member.indices, families[member.family])
+
+        key: dict[str, tuple[Any, ...]] = {}
+        for name, position in position_of.items():  # in the order of first use
             over = self.defined_over.get(name)
-            if over is not None and over and all(v in key for v in over):
+            if name in ranks:
+                value_text, rank = ranks[name]
+                key[name] = (*slot(name, groups[value_text]), rank)
+            elif over and all(v in key for v in over):
                 key[name] = (*max(key[v] for v in over), position)
             else:
-                key.setdefault(name, (0, position))
+                key[name] = (*slot(name, position), 0)
         order = sorted(self.names, key=key.__getitem__)
         self.bdd.reorder({name: level for level, name in enumerate(order)})
 
@@ -397,6 +462,25 @@ class _Encoder:
             assignment[name] = value
             formula = bdd.let({name: True}, formula) if value else low
         return assignment
+
+
+@dataclass(frozen=True)
+class _Member:
+    """A member of a family, or an element of an array, that a variable reads: `a[3]/ib` is (`a`, (3,))."""
+
+    family: str
+    indices: tuple[int, ...]
+
+
+def _member_read(expression: Expression) -> _Member | None:
+    """The first read of `expression` with whole-number indices (family indices, then array elements)."""
+    for read in reads(expression):
+        indices = [*read.target.indices, *(a.index for a in read.path if isinstance(a, IndexAccess))]
+        values = [index.value for index in indices if isinstance(index, Literal)]
+        whole = tuple(v for v in values if isinstance(v, int) and not isinstance(v, bool))
+        if whole:
+            return _Member(read.target.name, whole)
+    return None
 
 
 def _whole_number_samples(constants: list[Fraction], least: int, greatest: int) -> list[object]:
