@@ -498,6 +498,22 @@ def probe_text(
     return found
 
 
+@pytest.mark.parametrize(
+    ("first", "second"),
+    [
+        ("arr/ib[N - 1] > 1.0", "arr/ib[2] <= 1.0"),
+        ("arr/ib[1 + 1] > 1.0", "arr/ib[2] <= 1.0"),
+        ("any(J in 1..1: arr/ib[J + 1] > 1.0)", "arr/ib[N - 1] <= 1.0"),
+        ("flags/ib[N - 1]", "not flags/ib[2]"),
+    ],
+)
+def test_an_index_made_of_constants_reads_the_element_its_value_names(first: str, second: str) -> None:
+    """`arr/ib[N - 1]` with N = 3 is `arr/ib[2]`: as two values, the two conditions were said to overlap
+    (E060) and to leave the behaviour stuck (W061)."""
+    extra = "        param N: int = 3\n        arr/ib: double[N]\n        flags/ib: boolean[N]\n"
+    assert probe_text(first, second, extra=extra) == {}
+
+
 def test_two_predicates_computed_by_python_are_two_booleans_whatever_they_read() -> None:
     extra = '        pa/pp(v/ib) = python "m:f"\n        pb/pp(v/ib) = python "m:g"\n'
     found = probe_text("pa/pp", "not pb/pp", extra=extra)

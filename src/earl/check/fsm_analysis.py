@@ -49,7 +49,7 @@ from fractions import Fraction
 from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
-from earl.check.constants import ORDERINGS, Constant, constant_value
+from earl.check.constants import ORDERINGS, Constant, constant_value, indices_folded
 from earl.check.context import CheckContext
 from earl.check.expression_types import BOOLEAN, ExpressionTyper
 from earl.check.registry import Finding, rule
@@ -231,6 +231,8 @@ class _Encoder:
             for operand in operands[1:]:
                 result = (result & operand) if expression.operator == "and" else (result | operand)
             return result
+        # `arr/ib[N - 1]` is `arr/ib[2]`: one value, compared with the same constants
+        expression = indices_folded(expression)
         if isinstance(expression, Read) and expression.target.kind is Kind.PRIMITIVE_PREDICATE and not expression.path:
             return self._predicate(expression)
         if isinstance(expression, Comparison):
