@@ -1377,6 +1377,22 @@ def test_members_of_an_agent_family_linked_differently_are_checked_each(fed: int
     ]
 
 
+def test_a_buffer_fed_only_by_an_output_buffer_nothing_writes_waits_for_ever() -> None:
+    """`sup`'s `send/pf` writes its memory, not `o/ob`: `o/ob` is never sent (EARL-W040), so `worker[1]`,
+    the one it feeds, waits for ever as surely as its unlinked siblings; the message names the sender."""
+    text = WORKERS.replace("FED", "1").replace("send/pf(x/mi -> o/ob)", "send/pf(x/mi -> x/mo)")
+    [never_sent, unlinked] = findings(text, "EARL-E016")
+    assert never_sent.message == (
+        "state `one` of worker[1]/a.cs waits for ever: `i/ib` is obligatory, fed only by `sup/a.cs.o/ob`, which no "
+        "function of any behaviour writes, so it is never sent, and the state has no `timeout`"
+    )
+    assert never_sent.hint is not None and never_sent.hint.startswith(
+        "add `o/ob` to the writes of a function of sup/a.cs"
+    )
+    assert unlinked.message.startswith("state `one` of worker[2..3]/a.cs waits for ever: `i/ib` is obligatory, no link")
+    assert findings(WORKERS.replace("FED", "1"), "EARL-E016")[0].message.startswith("state `one` of worker[2..3]/a.cs")
+
+
 def test_members_of_a_subsystem_family_linked_differently_are_checked_each() -> None:
     text = add(
         "a4/a {\n    cs {\n        o/ob: double\n    }\n"
@@ -1386,8 +1402,11 @@ def test_members_of_a_subsystem_family_linked_differently_are_checked_each() -> 
         "    link cs,d: cs.o -> d[1]/ve.in\n}\n"
     )
     assert [d.message for d in findings(text, "EARL-E016")] == [
+        # `cs` has no behaviour that writes `o/ob`: `d[1]` is linked but never receives either
+        "state `one` of a4/a.d[1]/ve waits for ever: `in/ib` is obligatory, fed only by `a4/a.cs.o/ob`, which no "
+        "function of any behaviour writes, so it is never sent, and the state has no `timeout`",
         "state `one` of a4/a.d[2..3]/ve waits for ever: `in/ib` is obligatory, no link feeds it, and the state "
-        "has no `timeout`"
+        "has no `timeout`",
     ]
     assert [d.message for d in findings(text, "EARL-W011")] == [
         "`a4/a.d[2..3]/ve.in/ib` is fed by no link: it never receives a message"

@@ -37,6 +37,19 @@ def reference_key(reference: ElementReference) -> str:
 MemberKey = tuple[str, int | None]
 
 
+def written_output_buffers(subsystem: Subsystem) -> frozenset[str]:
+    """The names of the output buffers some function of some behaviour of `subsystem` writes: the others
+    are never sent (`tf.pf.ob.send()` sends only what a function wrote, docs/semantics.md)."""
+    used = {f.name for b in subsystem.basic_behaviours for stage in b.transition_function.stages for f in stage}
+    return frozenset(
+        w.name
+        for f in subsystem.partial_transition_functions
+        if f.name in used
+        for w in f.writes
+        if w.kind is Kind.OUTPUT_BUFFER
+    )
+
+
 def member_key(reference: ElementReference) -> MemberKey:
     """`reference_key` as a (name, index) pair: the lookup tables' key, with no text to build."""
     indices = reference.indices

@@ -7,7 +7,7 @@ from collections.abc import Iterable, Iterator
 from fractions import Fraction
 
 from earl.check.constants import constant_value
-from earl.check.context import CheckContext, reference_key
+from earl.check.context import CheckContext, reference_key, written_output_buffers
 from earl.check.expression_types import BOOLEAN, ExpressionTyper
 from earl.check.registry import Finding, rule
 from earl.diagnostics import Severity
@@ -292,14 +292,7 @@ def output_buffers_written(context: CheckContext) -> Iterator[Finding]:
     any behaviour writes is never sent, and whatever it is linked to never receives data."""
     for agent in context.declared.agents:
         for subsystem in agent.subsystems:
-            used = {f.name for b in subsystem.basic_behaviours for stage in b.transition_function.stages for f in stage}
-            written = {
-                w.name
-                for f in subsystem.partial_transition_functions
-                if f.name in used
-                for w in f.writes
-                if w.kind is Kind.OUTPUT_BUFFER
-            }
+            written = written_output_buffers(subsystem)
             for buffer in subsystem.output_buffers:
                 if buffer.name not in written:
                     yield Finding(

@@ -6,10 +6,11 @@ from collections import defaultdict
 from collections.abc import Iterable, Iterator
 from operator import attrgetter
 
-from earl.check.context import CheckContext, ResolvedLink
+from earl.check.context import CheckContext, ResolvedLink, written_output_buffers
 from earl.check.registry import Finding, rule
 from earl.diagnostics import Severity
 from earl.model.elements import Agent, Link, LinkNamePart, State, Subsystem, default_link_name
+from earl.model.expressions import ElementReference
 from earl.model.kinds import KIND_TITLES, Kind
 from earl.model.tables import PERMITTED_LINKS, permitted_link
 from earl.model.text import expression_text, instance_name, subsystem_name
@@ -248,16 +249,12 @@ def _family_link_name(names: list[str], parts: Iterable[LinkNamePart], index: st
 def waits_for_nothing_for_ever(context: CheckContext) -> Iterator[Finding]:
     """A state's obligatory Input Buffers are received by waiting until each has a new message, at most
     for the state's `timeout`. An obligatory buffer that no link feeds never gets one: in a state without
-    a timeout the subsystem would wait there for ever, silently."""
+    a timeout the subsystem would wait there for ever, silently. So does one whose links all come from
+    output buffers that no function of any behaviour writes (EARL-W040): those are never sent."""
     for members in context.distinct_subsystem_groups():
         _, subsystem = members[0]
         if subsystem.fsm is None:
             continue
-        fed = {
-            instance_name(buffer.name, buffer.index)
-            for buffer in subsystem.input_buffers
-            if context.links_into.get(id(buffer))
-        }
         for state in subsystem.fsm.states:
             if state.timeout is not None:
                 continue
@@ -267,17 +264,53 @@ def waits_for_nothing_for_ever(context: CheckContext) -> Iterator[Finding]:
                 if buffer is None:
                     continue
                 name = instance_name(buffer.name, buffer.index)
-                if name in fed or name in told:
+                if name in told:
                     continue
-                told.add(name)
                 for agent, member in members:  # each member is linked on its own: each is said
+                    why = _never_receives(context, member, reference)
+                    if why is None:
+                        continue
+                    told.add(name)
+                    said, hint = why
                     yield Finding(
                         f"state `{state.name}` of {subsystem_name(agent, member)} waits for ever: "
-                        f"`{name}/ib` is obligatory, no link feeds it, "
-                        "and the state has no `timeout`",
+                        f"`{name}/ib` is obligatory, {said}, and the state has no `timeout`",
                         reference.location or state.location,
-                        "link an Output Buffer to it, give the state's buffer group a `timeout`, or make it optional",
+                        f"{hint}, give the state's buffer group a `timeout`, or make it optional",
                     )
+
+
+def _never_receives(context: CheckContext, subsystem: Subsystem, reference: ElementReference) -> tuple[str, str] | None:
+    """Why the input buffer `reference` of `subsystem` never takes a message, and what would feed it:
+    no link feeds it, or every link that does comes from an output buffer nothing writes; None when
+    some link may bring one."""
+    buffer = context.input_buffer(subsystem, reference)
+    if buffer is None:
+        return None
+    links = context.links_into.get(id(buffer), [])
+    if not links:
+        return "no link feeds it", "link an Output Buffer to it"
+    unwritten = [link for link in links if link.source_buffer.name not in written_output_buffers(link.source_subsystem)]
+    if len(unwritten) < len(links):
+        return None
+    sources = list(
+        dict.fromkeys(
+            f"`{subsystem_name(link.source_agent, link.source_subsystem)}."
+            f"{instance_name(link.source_buffer.name, link.source_buffer.index)}/ob`"
+            for link in unwritten
+        )
+    )
+    first = unwritten[0]
+    sender = subsystem_name(first.source_agent, first.source_subsystem)
+    said = (
+        f"fed only by {_listed(sources)}, which no function of any behaviour writes, so "
+        f"{'it is' if len(sources) == 1 else 'they are'} never sent"
+    )
+    return said, f"add `{first.source_buffer.name}/ob` to the writes of a function of {sender}"
+
+
+def _listed(names: list[str]) -> str:
+    return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
 
 
 @rule("EARL-E017", Severity.ERROR, "something paces every state of a subsystem", "§2.2, Figure 5")
