@@ -805,6 +805,32 @@ CASES: list[Case] = [
     ),
     Case(
         "EARL-W047",
+        edit(
+            (
+                "            tf = {compute/pf} then {emit/pf}",
+                "            tf = {compute/pf} then {compute/pf, emit/pf}",
+            )
+        ),
+        11,
+        37,
+        "`compute/pf` is in stage 1 and again in stage 2 of `run/bb` of a1/a.cs",
+        BASE,
+    ),
+    Case(
+        "EARL-W047",
+        edit(
+            (
+                "        emit/pf(x/mi -> out/ob)\n",
+                "        emit/pf(x/mi -> out/ob)\n        stage pf = {compute/pf, emit/pf}\n        stage pfo = {emit/pf}\n",
+            )
+        ),
+        11,
+        22,
+        "`emit/pf` is in stage set `pf` and again in stage set `pfo` of a1/a.cs",
+        BASE,
+    ),
+    Case(
+        "EARL-W047",
         edit(("    a2/a\n    link a1,a2\n", "    a2/a\n    a1/a\n    link a1,a2\n")),
         45,
         5,

@@ -253,7 +253,9 @@ def _module_hint(module: str, function: str) -> str:
 def lists_say_each_thing_once(context: CheckContext) -> Iterator[Finding]:
     """What a partial transition function or a Python predicate reads and writes, the functions of one stage,
     the agents and links of a robot: each is named once. A repeat changes nothing when the system runs (a
-    set is meant), so it is a slip, often for another name that was meant and is now missing."""
+    set is meant), so it is a slip, often for another name that was meant and is now missing. The manual's
+    `pf` and `pfo` sets are disjoint (§3.2): a function is in one stage of a transition function, and in one
+    stage set; named in two, it runs twice an iteration, once on what the other stage made of the memory."""
     # the lists as written: expanded, `x[K]/ib, x[1]/ib` are one buffer twice in member 1, which no edit of the
     # declaration could name once
     declared = [(agent, subsystem) for agent in context.declared.agents for subsystem in agent.subsystems]
@@ -271,6 +273,12 @@ def lists_say_each_thing_once(context: CheckContext) -> Iterator[Finding]:
         for stage_set in subsystem.stage_sets:
             lists.append((f"the stage set `{stage_set.name}` of {owner} holds", stage_set.functions))
         yield from _repeats(lists)
+        for behaviour in subsystem.basic_behaviours:
+            stages = [(f"stage {n}", stage) for n, stage in enumerate(behaviour.transition_function.stages, start=1)]
+            twice = ", and it would run twice an iteration"
+            yield from _in_two_stages(stages, f"of `{behaviour.name}/bb` of {owner}", "stages", twice)
+        sets = [(f"stage set `{stage_set.name}`", stage_set.functions) for stage_set in subsystem.stage_sets]
+        yield from _in_two_stages(sets, f"of {owner}", "stage sets", "")
     for robot in context.declared.robots:
         yield from _repeats(
             [(f"robot `{robot.name}/r` holds", robot.agents), (f"robot `{robot.name}/r` refers to", robot.links)]
@@ -289,6 +297,24 @@ def _repeats(lists: list[tuple[str, list[ElementReference]]]) -> Iterator[Findin
                     "name it once; was another name meant?",
                 )
             named.add(text)
+
+
+def _in_two_stages(
+    stages: list[tuple[str, list[ElementReference]]], owner: str, plural: str, consequence: str
+) -> Iterator[Finding]:
+    """A function named in two stages (or stage sets), said where it is named again: once per function."""
+    first: dict[str, str] = {}
+    for stage, functions in stages:
+        for reference in functions:
+            text = _written(reference)
+            if first.setdefault(text, stage) != stage:
+                yield Finding(
+                    f"`{text}` is in {first[text]} and again in {stage} {owner}: the manual's `pf` and `pfo` "
+                    f"sets are disjoint (§3.2){consequence}",
+                    reference.location,
+                    f"keep it in one of the {plural}; was another function meant?",
+                )
+                first[text] = stage  # a third stage is said again, not the second one again
 
 
 def _written(reference: ElementReference) -> str:
