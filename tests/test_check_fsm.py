@@ -514,6 +514,25 @@ def test_an_index_made_of_constants_reads_the_element_its_value_names(first: str
     assert probe_text(first, second, extra=extra) == {}
 
 
+@pytest.mark.parametrize(
+    ("first", "second"),
+    [
+        ("d/ib", "d/ib"),  # a number where a Boolean belongs
+        ('s/ib.mode < "b"', 's/ib.mode >= "b"'),  # strings ordered
+        ("bad/pp", "not bad/pp and v/ib > 1.0"),  # through a predicate's definition
+    ],
+)
+def test_a_condition_with_a_type_error_is_said_once_not_again_by_the_fsm_analysis(first: str, second: str) -> None:
+    """`when d/ib` on a `double` is EARL-E030; the analysis took `d/ib` for a Boolean of its own and
+    reported an overlap "when d/ib = true" (E060) and a stuck state (W061) the author never wrote."""
+    extra = '        d/ib: double\n        bad/pp = s/ib.mode < "b"\n'
+    text = PROBE.replace("TC", "true").replace("FIRST", first).replace("SECOND", second)
+    text = text.replace("        false/pp = false\n", "        false/pp = false\n" + extra)
+    codes = [d.code for d in check(earl.loads(text, "probe.earl"))]
+    assert "EARL-E030" in codes
+    assert not {"EARL-E060", "EARL-W061", "EARL-W062", "EARL-W020"} & set(codes)
+
+
 def test_two_predicates_computed_by_python_are_two_booleans_whatever_they_read() -> None:
     extra = '        pa/pp(v/ib) = python "m:f"\n        pb/pp(v/ib) = python "m:g"\n'
     found = probe_text("pa/pp", "not pb/pp", extra=extra)

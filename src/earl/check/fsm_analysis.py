@@ -51,7 +51,7 @@ from typing import TYPE_CHECKING, Any
 
 from earl.check.constants import ORDERINGS, Constant, constant_value, indices_folded
 from earl.check.context import CheckContext
-from earl.check.expression_types import BOOLEAN, ExpressionTyper
+from earl.check.expression_types import BOOLEAN, UNKNOWN, ExpressionTyper
 from earl.check.registry import Finding, rule
 from earl.check.rules_behaviour import followable_definitions
 from earl.diagnostics import Severity
@@ -608,6 +608,36 @@ def _state_assumptions(
         return assumed, kept, list(dict.fromkeys(reasons))
 
 
+class _IllTyped:
+    """Which formulas have a type error (EARL-E030), their predicates' definitions followed: a number
+    where a Boolean belongs (`when v/ib` on a `double`), strings ordered (`s/ib < "b"`). What such a
+    formula means is unknown, so the analysis says nothing that rests on it: made a Boolean of its own,
+    `v/ib` would be reported as `v/ib = true` in an overlap the author never wrote."""
+
+    def __init__(self, context: CheckContext, subsystem: Subsystem, definitions: dict[str, Expression]) -> None:
+        self.context, self.subsystem, self.definitions = context, subsystem, definitions
+        self._predicates: dict[str, bool] = {}
+
+    def __call__(self, expression: Expression) -> bool:
+        # a typer of its own each time: a typer says each problem once, and a repeat must count too
+        typer = ExpressionTyper(self.context, self.subsystem)
+        if typer.type_of(expression) not in (BOOLEAN, UNKNOWN) or typer.problems:
+            return True
+        return any(self._predicate(read.target.name) for read in reads(expression) if _is_predicate(read))
+
+    def _predicate(self, name: str) -> bool:
+        known = self._predicates.get(name)
+        if known is None:
+            self._predicates[name] = False  # defined through itself (EARL-E045): not a type error
+            definition = self.definitions.get(name)
+            known = self._predicates[name] = definition is not None and self(definition)
+        return known
+
+
+def _is_predicate(read: Read) -> bool:
+    return read.target.kind is Kind.PRIMITIVE_PREDICATE and not read.path
+
+
 def _when(example: str) -> str:
     return example if example == "whatever the inputs" else f"e.g. when {example}"
 
@@ -629,12 +659,20 @@ def analyse(context: CheckContext, subsystem: Subsystem, fsm: FSM, owner: str) -
     findings: dict[str, list[Finding]] = {
         code: [] for code in ("EARL-E064", "EARL-E060", "EARL-W061", "EARL-W062", "EARL-I063", "EARL-W021", "EARL-W020")
     }
+    ill_typed = _IllTyped(context, subsystem, encoder.definitions)
     assumed = bdd.true
-    each_assumed = [encoder.encode(assumption.expression) for assumption in fsm.assumptions]
+    # an assumption with a type error (EARL-E030) assumes nothing here
+    each_assumed = [
+        bdd.true if ill_typed(assumption.expression) else encoder.encode(assumption.expression)
+        for assumption in fsm.assumptions
+    ]
     for formula in each_assumed:
         assumed &= formula
     conditions = {id(t): encoder.encode(t.condition.expression) for t in fsm.transitions}
     stops: dict[str, Function] = {}
+    #: the states where a type error (EARL-E030) in their behaviour's `tc`/`ec` or a leaving condition
+    #: leaves unknown what happens: not analysed, their transitions thought possible
+    unknown: set[str] = {t.source for t in fsm.transitions if t.source and ill_typed(t.condition.expression)}
     for state in fsm.states:
         behaviour = subsystem.basic_behaviour(state.behaviour)
         if behaviour is not None:
@@ -642,6 +680,10 @@ def analyse(context: CheckContext, subsystem: Subsystem, fsm: FSM, owner: str) -
             if behaviour.error_condition is not None:
                 stop |= encoder.encode(behaviour.error_condition.expression)
             stops[state.name] = stop
+            if ill_typed(behaviour.terminal_condition.expression) or (
+                behaviour.error_condition is not None and ill_typed(behaviour.error_condition.expression)
+            ):
+                unknown.add(state.name)
     encoder.order_variables()
     meaning = encoder.constraints()
     if fsm.assumptions and (assumed & meaning) == bdd.false:
@@ -702,6 +744,10 @@ def analyse(context: CheckContext, subsystem: Subsystem, fsm: FSM, owner: str) -
             return said
 
         leaving = [t for t in fsm.transitions if t.source == state.name]
+        if state.name in unknown:
+            for transition in leaving:
+                taken[id(transition)] = bdd.true
+            continue
         if stop == bdd.false and (stops[state.name] & meaning & facts) == bdd.false:
             findings["EARL-I063"].append(
                 Finding(
