@@ -1041,6 +1041,20 @@ def test_rules_the_language_enforces_stop_reading_at_the_spot(
     assert all(d.severity is Severity.ERROR for d in at_spot)
 
 
+def test_a_name_misspelt_in_several_places_is_one_error_saying_where_the_others_are() -> None:
+    """`hi/pp` for `high/pp` in a `tc` and two conditions was three EARL-R022 errors for one slip."""
+    text = edit(
+        ("        go/pp = x/mi > 1.0\n", "        high/pp = x/mi > 1.0\n        go/pp = high/pp\n"),
+        ("            tc = go/pp\n", "            tc = hi/pp\n"),
+        ("run -> run when go/pp", "run -> run when hi/pp or not hi/pp"),
+    )
+    with pytest.raises(EarlError) as raised:
+        earl.loads(text, "spec.earl")
+    [unknown] = [d for d in raised.value.diagnostics if d.code == "EARL-R022"]
+    assert unknown.message == "`a1/a.cs` has no Primitive Predicate `hi` (and 2 more uses, at line 18)"
+    assert unknown.location is not None and (unknown.location.line, unknown.hint) == (13, "did you mean `high`?")
+
+
 def test_every_rule_the_language_enforces_has_a_reading_case() -> None:
     """docs/rules.md names the reading codes that enforce the manual; each has a failing case above."""
     documented = {code for _, how in ENFORCED_BY_THE_LANGUAGE for code in re.findall(r"EARL-[SR]\d{3}", how)}

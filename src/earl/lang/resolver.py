@@ -176,6 +176,42 @@ class _Place:
         return f"{inner} of {self.outer}"
 
 
+def _uses_merged(diagnostics: list[Diagnostic]) -> list[Diagnostic]:
+    """One EARL-R022 per unknown name, at its first use, saying where the others are: a misspelt
+    `hi/pp` used in three conditions is one mistake, not three errors."""
+    uses: dict[str, list[Diagnostic]] = {}
+    for diagnostic in diagnostics:
+        if diagnostic.code == "EARL-R022":
+            uses.setdefault(diagnostic.message, []).append(diagnostic)
+    merged: list[Diagnostic] = []
+    for diagnostic in diagnostics:
+        repeats = uses.get(diagnostic.message) if diagnostic.code == "EARL-R022" else None
+        if repeats is None:
+            merged.append(diagnostic)
+        elif repeats[0] is diagnostic:
+            if len(repeats) > 1:
+                more = "1 more use" if len(repeats) == 2 else f"{len(repeats) - 1} more uses"
+                places = _places(diagnostic.location, [other.location for other in repeats[1:]])
+                diagnostic = replace(diagnostic, message=f"{diagnostic.message} (and {more}{places})")
+            merged.append(diagnostic)
+    return merged
+
+
+def _places(first: SourceLocation | None, others: list[SourceLocation | None]) -> str:
+    """`, at lines 25 and 26` in the first use's file; `file:line` for one in another file."""
+    if any(location is None for location in others):
+        return ""  # a model built in Python: its references have no place
+    here = first is not None and all(location.file == first.file for location in others if location)
+    # each line once: `hi/pp or not hi/pp` is two uses on one line
+    said = list(
+        dict.fromkeys(
+            str(location.line) if here else f"{location.file}:{location.line}" for location in others if location
+        )
+    )
+    listed = said[0] if len(said) == 1 else ", ".join(said[:-1]) + " and " + said[-1]
+    return f", at {'line' if len(said) == 1 else 'lines'} {listed}" if here else f", at {listed}"
+
+
 class _Within:
     """`with resolver._within(…)`: a class, not a generator, for it is entered for every element read."""
 
@@ -266,7 +302,7 @@ class Resolver:
         self._robots(scope)
         self._place = None
         self._tell_wrong_from_outside()
-        return self.diagnostics
+        return _uses_merged(self.diagnostics)
 
     def _names(self) -> None:
         """EARL-R006: a declared name the language could not read back (`my arm`, `a1/a`, `système`, a
