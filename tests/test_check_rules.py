@@ -953,7 +953,7 @@ READING_CASES: list[tuple[str, str, str, int, int, str]] = [
         "EARL-R032",
         edit(("run -> run when go/pp", "run -> walk when go/pp")),
         17,
-        13,
+        20,  # `walk` itself
         "transition `run,walk/t` names the state `walk`, which this FSM does not declare",
     ),
     (

@@ -785,7 +785,7 @@ NAMES = [
             "        false/pp = false\n        b/bb {\n            tf = {}\n            tc = false/pp\n        }\n        fsm {\n            initial idle\n            state idle: b/bb\n            idle -> idel when false/pp\n        }\n"
         ),
         17,
-        13,
+        21,  # the misspelt state, not the whole transition
         "EARL-R032",
         "transition `idle,idel/t` names the state `idel`, which this FSM does n",
         hint="did you mean `idle`?",
@@ -796,7 +796,7 @@ NAMES = [
             "        false/pp = false\n        b/bb {\n            tf = {}\n            tc = false/pp\n        }\n        fsm {\n            initial idle\n            state idle: b/bb\n            idle -> grasp when false/pp\n        }\n"
         ),
         17,
-        13,
+        21,  # the misspelt state, not the whole transition
         "EARL-R032",
         "transition `idle,grasp/t` names the state `grasp`, which this FSM does not declare",
         hint="its states are `idle`; declare `state grasp: BEHAVIOUR/bb` to add one",

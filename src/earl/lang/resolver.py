@@ -1181,11 +1181,14 @@ class Resolver:
                 did_you_mean(fsm.initial, states) or f"add `state {fsm.initial}: {fsm.initial}/bb`",
             )
         for transition in fsm.transitions:
-            for end in ([transition.source] if transition.source is not None else []) + [transition.destination]:
+            ends = {transition.destination: transition.destination_location}
+            if transition.source is not None:
+                ends = {transition.source: transition.source_location, **ends}
+            for end, named_at in ends.items():
                 if end not in states:
                     self.error(
                         f"transition `{transition.name}/t` names the state `{end}`, which this FSM does not declare",
-                        transition.location,
+                        named_at or transition.location,
                         "EARL-R032",
                         did_you_mean(end, states)
                         or (

@@ -575,15 +575,17 @@ class ElementBuilder:
     def transition(self, meta: Meta, children: list[Any]) -> Transition:
         source, destination, condition, *priority = children
         return Transition(
-            None if source is _ANY_STATE else source,
+            None if source is _ANY_STATE else str(source),
             str(destination),
             Predicate(condition, condition.location),
             int(priority[0]) if priority else None,
             self._loc(meta),
+            source_location=self._loc(source) if isinstance(source, Token) else None,
+            destination_location=self._loc(destination) if isinstance(destination, Token) else None,
         )
 
-    def transition_source(self, meta: Meta, children: list[Token]) -> str:
-        return str(children[0])
+    def transition_source(self, meta: Meta, children: list[Token]) -> Token:
+        return children[0]  # the name and where it is (`Transition.source_location`)
 
     def any_state(self, meta: Meta, children: list[Token]) -> object:
         return _ANY_STATE

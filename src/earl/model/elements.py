@@ -331,6 +331,9 @@ class Transition:
     comments: Comments = comments_field()
     #: one of the transitions a `*` line stands for (`concrete_transitions`), named in messages as written
     from_any_state: bool = field(default=False, compare=False, repr=False)
+    #: where the source and destination states are named, for a message about either
+    source_location: SourceLocation | None = location_field()
+    destination_location: SourceLocation | None = location_field()
     kind: ClassVar[Kind] = Kind.TRANSITION
 
     @property
