@@ -1973,3 +1973,68 @@ def test_a_family_as_declared_is_named_with_its_index_in_messages() -> None:
         "worker[K]/a.cs has no `fsm`: it never runs a behaviour, and `earl run` refuses it",
         "worker[K]/a.d[J]/ve has no `fsm`: it never runs a behaviour, and `earl run` refuses it",
     }
+
+
+# ---------------------------------------------------------------- hints that lead to no other error
+
+
+def _hinted(text: str, code: str) -> str:
+    [finding] = findings(text, code)
+    assert finding.hint is not None
+    return finding.hint
+
+
+def test_e017_suggests_waiting_for_a_buffer_a_link_feeds_and_only_a_period_when_none_is() -> None:
+    """The hint named the first input buffer, `idle/ib`, which no link feeds: taken, it made EARL-E016."""
+    unpaced = edit(("    cs { period 1 ms\n        inp/ib", "    cs {\n        idle/ib: double\n        inp/ib"))
+    hint = _hinted(unpaced, "EARL-E017")
+    assert hint.endswith("`state run: run/bb { obligatory inp/ib }`")
+    taken = edit(
+        (
+            "state run: run/bb\n            run -> run when got/pp",
+            "state run: run/bb { obligatory inp/ib }\n            run -> run when got/pp",
+        ),
+        text=unpaced,
+    )
+    assert [d.code for d in findings(taken) if d.severity is Severity.ERROR] == []
+    unlinked = edit(("link a1,a2: a1/a.cs.out -> a2/a.cs.inp\n", ""), ("    link a1,a2\n", ""), text=unpaced)
+    hint = _hinted(unlinked, "EARL-E017")
+    assert "obligatory" not in hint and hint.startswith("give the subsystem a `period`")
+
+
+def test_w043_with_no_behaviour_suggests_declaring_one_with_the_fsm() -> None:
+    """With no behaviour, the hint's `fsm { initial b  state b: b/bb }` named a `b/bb` nobody declared: EARL-R030."""
+    text = add("a3/a {\n    cs {\n        period 1 ms\n    }\n}\n")
+    hint = _hinted(text, "EARL-W043")
+    snippets = re.findall(r"`([^`]+)`", hint)
+    assert len(snippets) == 2
+    taken = text.replace(
+        "        period 1 ms\n    }", "        period 1 ms\n        " + "\n        ".join(snippets) + "\n    }"
+    )
+    said = findings(taken)
+    assert [d.code for d in said if d.severity is Severity.ERROR] == []
+    assert not [d for d in said if d.code == "EARL-W043"]
+
+
+def test_w044_on_a_buffer_family_suggests_waiting_for_the_family_as_a_group_names_it() -> None:
+    """`timeout(rep[J]/ib)` in `any(J …)`: the hint's `obligatory rep/ib` was EARL-R024 (a family needs its index)."""
+    text = edit(
+        ("        inp/ib: double\n", "        inp/ib: double\n        rep[J in 1..2]/ib: double\n"),
+        (
+            "        got/pp = newData(inp/ib)\n",
+            "        got/pp = newData(inp/ib)\n        lost/pp = any(J in 1..2: timeout(rep[J]/ib))\n",
+        ),
+        ("tc = got/pp", "tc = got/pp or lost/pp"),
+    )
+    hint = _hinted(text, "EARL-W044")
+    [group] = re.findall(r"\{ (obligatory [^}]+) \}", hint)
+    assert group == "obligatory rep[*]/ib timeout 50 ms"
+    taken = edit(
+        (
+            "state run: run/bb\n            run -> run when got/pp",
+            f"state run: run/bb {{ {group} }}\n            run -> run when got/pp",
+        ),
+        text=text,
+    )
+    said = findings(taken)
+    assert not [d for d in said if d.severity is Severity.ERROR or d.code == "EARL-W044"]

@@ -499,12 +499,19 @@ def subsystems_have_an_fsm(context: CheckContext) -> Iterator[Finding]:
     for agent in context.declared.agents:
         for subsystem in agent.subsystems:
             if subsystem.fsm is None:
-                behaviour = subsystem.basic_behaviours[0].name if subsystem.basic_behaviours else "b"
+                if subsystem.basic_behaviours:
+                    behaviour = subsystem.basic_behaviours[0].name
+                    hint = f"add one: `fsm {{ initial {behaviour}  state {behaviour}: {behaviour}/bb }}`"
+                else:  # an FSM names a behaviour: one that is not declared is EARL-R030
+                    hint = (
+                        "declare a behaviour and an FSM that runs it: `idle/bb { tf = {} tc = false }` and "
+                        "`fsm { initial idle  state idle: idle/bb }`"
+                    )
                 yield Finding(
                     f"{subsystem_name(agent, subsystem)} has no `fsm`: it never runs a behaviour, and `earl run` "
                     "refuses it",
                     subsystem.location,
-                    f"add one: `fsm {{ initial {behaviour}  state {behaviour}: {behaviour}/bb }}`",
+                    hint,
                 )
 
 
@@ -578,9 +585,15 @@ def timeouts_that_can_happen(context: CheckContext) -> Iterator[Finding]:
                         f"`timeout({reference_text(target)})` in `{predicate.name}/pp` is never true: "
                         f"`{target.name}/ib` is obligatory in no state of {subsystem_name(agent, subsystem)}",
                         node.location or predicate.location,
-                        f"make it obligatory where it is awaited: `state S: B/bb {{ obligatory {target.name}/ib "
+                        f"make it obligatory where it is awaited: `state S: B/bb {{ obligatory {_waited(target)} "
                         "timeout 50 ms }`",
                     )
+
+
+def _waited(target: ElementReference) -> str:
+    """How a buffer group names the buffer `timeout(…)` reads: `x/ib`, or `x[*]/ib` for a family, whose
+    members a group names each (`x[2]/ib`) or all at once; `x/ib` alone is EARL-R024."""
+    return f"{target.name}[*]/ib" if target.indices else f"{target.name}/ib"
 
 
 #: levels an expression may have written out through the predicates it names: the checker's walks over a

@@ -9,8 +9,8 @@ from operator import attrgetter
 from earl.check.context import CheckContext, ResolvedLink, written_output_buffers
 from earl.check.registry import Finding, rule
 from earl.diagnostics import Severity
-from earl.model.elements import Agent, Link, LinkNamePart, State, Subsystem, default_link_name
-from earl.model.expressions import ElementReference
+from earl.model.elements import Agent, InputBuffer, Link, LinkNamePart, State, Subsystem, default_link_name
+from earl.model.expressions import ElementReference, Literal
 from earl.model.kinds import KIND_TITLES, Kind
 from earl.model.tables import PERMITTED_LINKS, permitted_link
 from earl.model.text import expression_text, instance_name, subsystem_name
@@ -309,6 +309,11 @@ def _never_receives(context: CheckContext, subsystem: Subsystem, reference: Elem
     return said, f"add `{first.source_buffer.name}/ob` to the writes of a function of {sender}"
 
 
+def _index(buffer: InputBuffer) -> tuple[Literal, ...]:
+    """The index of an expanded family member (`x[2]/ib`) as a reference writes it."""
+    return () if buffer.index is None else (Literal(buffer.index),)
+
+
 def _listed(names: list[str]) -> str:
     return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
 
@@ -322,16 +327,28 @@ def every_state_is_paced(context: CheckContext) -> Iterator[Finding]:
     for agent, subsystem in context.distinct_subsystems():
         if subsystem.fsm is None or subsystem.period is not None:
             continue
-        inputs = [instance_name(buffer.name, buffer.index) for buffer in subsystem.input_buffers]
-        example = inputs[0] if inputs else "x"
+        # only a buffer some link feeds paces: one no link feeds would wait for ever (EARL-E016)
+        fed = [
+            instance_name(buffer.name, buffer.index)
+            for buffer in subsystem.input_buffers
+            if _never_receives(context, subsystem, ElementReference(buffer.name, Kind.INPUT_BUFFER, _index(buffer)))
+            is None
+        ]
         for state in subsystem.fsm.states:
             if not state.obligatory:
+                hint = "give the subsystem a `period` (`period 10 ms`)"
+                if fed:
+                    hint += (
+                        ", or list the buffers the state waits for: "
+                        f"`state {state.name}: {state.behaviour}/bb {{ obligatory {fed[0]}/ib }}`"
+                    )
+                else:
+                    hint += ": no link feeds an input buffer it could wait for"
                 yield Finding(
                     f"{subsystem_name(agent, subsystem)} has no `period` and state `{state.name}` waits for no "
                     "obligatory buffer, so nothing paces it",
                     state.location,
-                    "give the subsystem a `period` (`period 10 ms`), or list the buffers the state waits for: "
-                    f"`state {state.name}: {state.behaviour}/bb {{ obligatory {example}/ib }}`",
+                    hint,
                 )
 
 
