@@ -533,6 +533,21 @@ def test_a_condition_with_a_type_error_is_said_once_not_again_by_the_fsm_analysi
     assert not {"EARL-E060", "EARL-W061", "EARL-W062", "EARL-W020"} & set(codes)
 
 
+def test_a_transition_the_assumptions_rule_out_is_said_so_and_its_state_is_not_told_to_add_one() -> None:
+    """`v/ib > 20.0` under `assume v/ib < 10.0`: W062 said "its condition never holds", as of a
+    contradiction in itself, and W020 said "add a transition into `b`" though one is there."""
+    text = PROBE.replace("TC", "true").replace("FIRST", "not (v/ib > 20.0)").replace("SECOND", "v/ib > 20.0")
+    text = text.replace("            run -> b when", "            assume v/ib < 10.0\n            run -> b when")
+    said = {d.code: d for d in check(earl.loads(text, "probe.earl")) if d.code in ("EARL-W062", "EARL-W020")}
+    assert said["EARL-W062"].message == (
+        "transition `run,b/t` of x/a.cs can never be taken: its condition never holds under the `assume` "
+        "formulas (`v/ib < 10.0` (line 37))"
+    )
+    assert said["EARL-W020"].hint is not None and said["EARL-W020"].hint.startswith(
+        "`run,b/t` can never be taken: check its condition"
+    )
+
+
 def test_two_predicates_computed_by_python_are_two_booleans_whatever_they_read() -> None:
     extra = '        pa/pp(v/ib) = python "m:f"\n        pb/pp(v/ib) = python "m:g"\n'
     found = probe_text("pa/pp", "not pb/pp", extra=extra)

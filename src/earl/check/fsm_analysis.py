@@ -800,11 +800,22 @@ def analyse(context: CheckContext, subsystem: Subsystem, fsm: FSM, owner: str) -
             taken[id(transition)] = first_to_hold
             before = ordered[:group_start]
             if holds == bdd.false:
-                never = (
-                    "its condition never holds"
-                    if (conditions[id(transition)] & in_state) == bdd.false
-                    else f"its condition never holds when `{behaviour.name}/bb` stops"
-                )
+                condition = conditions[id(transition)]
+                if (condition & meaning) == bdd.false:
+                    never = "its condition never holds"
+                elif (condition & in_state) == bdd.false:
+                    # possible in itself: the assumptions rule it out, and the message says which
+                    ruling_out = [
+                        fsm.assumptions[kept[position]]
+                        for position in _contradicting(
+                            bdd, [each_assumed[index] for index in kept], condition & meaning
+                        )
+                    ]
+                    never = (
+                        f"its condition never holds under the `assume` formulas ({', '.join(map(_quoted, ruling_out))})"
+                    )
+                else:
+                    never = f"its condition never holds when `{behaviour.name}/bb` stops"
                 dead[id(transition)] = Finding(
                     f"transition {named(transition)} of {owner} can never be taken: {never}",
                     transition.location,
@@ -877,11 +888,23 @@ def analyse(context: CheckContext, subsystem: Subsystem, fsm: FSM, owner: str) -
                 frontier.append(transition.destination)
     for state in fsm.states:
         if state.name not in reachable:
+            into = [t for t in fsm.transitions if t.destination == state.name and t.source != state.name]
+            if not into:
+                hint = f"add a transition into `{state.name}`, or remove the state"
+            elif any(t.source in reachable for t in into):
+                dead_into = list(dict.fromkeys(named(t) for t in into if t.source in reachable))
+                its = "its condition" if len(dead_into) == 1 else "their conditions"
+                hint = (
+                    f"{', '.join(dead_into)} can never be taken: check {its}, the terminal conditions of the "
+                    "behaviours they leave and the `assume` formulas"
+                )
+            else:
+                hint = f"the states the transitions into `{state.name}` leave are unreachable too: reach one of them"
             findings["EARL-W020"].append(
                 Finding(
                     f"state `{state.name}` of {owner} is unreachable from the initial state `{fsm.initial}`",
                     state.location,
-                    f"add a transition into `{state.name}`, or remove the state",
+                    hint,
                 )
             )
     return Analysis(findings)
