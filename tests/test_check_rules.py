@@ -538,7 +538,7 @@ CASES: list[Case] = [
         edit(("run -> run when go/pp", "run -> run when go/pp and x/mi > 2.0")),
         16,
         13,
-        "`run/bb` can stop while no transition out of `run` holds (a1/a.cs), e.g. when go/pp = true, x/mi > 2.0 = false",
+        "`run/bb` can stop while no transition out of `run` holds (a1/a.cs), e.g. when go/pp = true, x/mi <= 2.0",
         BASE,
     ),
     Case(

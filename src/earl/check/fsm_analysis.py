@@ -71,7 +71,7 @@ from earl.model.expressions import (
     reads,
 )
 from earl.model.kinds import Kind
-from earl.model.text import expression_text, reference_text, subsystem_name
+from earl.model.text import expression_text, literal_text, reference_text, subsystem_name
 from earl.model.types import StructType
 
 
@@ -444,11 +444,33 @@ class _Encoder:
         assignment = self._first_path(shown)
         if not assignment:
             return "whatever the inputs"
-        parts = [
-            f"{self.names[name]} = {'true' if value else 'false'}"
-            for name, value in sorted(assignment.items(), key=lambda item: self.names[item[0]])
-        ]
-        return ", ".join(parts)
+        # a value compared with numbers is said as the range it lies in (`58.0 < v/ib <= 59.0`), not as
+        # each comparison's truth: 120 of them, sorted as text, was no example a person could read
+        compared: dict[str, tuple[str, str, Constant]] = {
+            variable.var: (value_text, operator, constant)
+            for value_text, atoms in self.comparisons.items()
+            for operator, constant, variable in atoms
+            if variable.var is not None
+            and _is_number(constant)
+            and not (isinstance(constant, float) and math.isnan(constant))
+        }
+        parts: list[tuple[str, str]] = []  # (what it is sorted by, what is said)
+        ranges: dict[str, list[tuple[str, Constant, bool]]] = {}
+        for name, value in assignment.items():
+            if name in compared:
+                value_text, operator, constant = compared[name]
+                ranges.setdefault(value_text, []).append((operator, constant, value))
+            else:
+                parts.append((self.names[name], f"{self.names[name]} = {'true' if value else 'false'}"))
+        for value_text, facts in ranges.items():
+            said = _range_text(value_text, facts)
+            if said is not None:
+                parts.append((value_text, said))
+            else:  # comparisons left unrelated (EARL's limit of 128): each as it is, in numeric order
+                for operator, constant, value in sorted(facts, key=lambda fact: (fact[1], fact[0])):
+                    text = f"{value_text} {operator} {literal_text(constant)}"
+                    parts.append((value_text, f"{text} = {'true' if value else 'false'}"))
+        return ", ".join(said for _, said in sorted(parts, key=lambda part: part[0]))
 
     def _first_path(self, formula: Function) -> dict[str, bool]:
         """One way to satisfy `formula` (not false), the same whatever the BDD library: from the top
@@ -483,6 +505,72 @@ def _member_read(expression: Expression) -> _Member | None:
         if whole:
             return _Member(read.target.name, whole)
     return None
+
+
+#: what `value OPERATOR constant` being true (or false) says of the value: (bound, strict) where bound is
+#: "lower", "upper", "equal" or "unequal"
+_BOUNDS: dict[tuple[str, bool], tuple[str, bool]] = {
+    (">", True): ("lower", True),
+    (">", False): ("upper", False),
+    (">=", True): ("lower", False),
+    (">=", False): ("upper", True),
+    ("<", True): ("upper", True),
+    ("<", False): ("lower", False),
+    ("<=", True): ("upper", False),
+    ("<=", False): ("lower", True),
+    ("==", True): ("equal", False),
+    ("==", False): ("unequal", False),
+    ("!=", True): ("unequal", False),
+    ("!=", False): ("equal", False),
+}
+
+
+def _range_text(value: str, facts: list[tuple[str, Constant, bool]]) -> str | None:
+    """`0.0 < v/ib <= 1.0`, `v/ib > 9.0`, `v/ib == 2.0`, `v/ib != 3.0`: the range of numbers in which each
+    comparison of `value` with a constant is as `facts` says (operator, constant, truth); None when there
+    is none (comparisons the analysis left unrelated can say what no number does)."""
+    lower: tuple[Any, bool] | None = None  # (constant, strict)
+    upper: tuple[Any, bool] | None = None
+    equal: set[Any] = set()
+    unequal: set[Any] = set()
+    for operator, constant, truth in facts:
+        bound, strict = _BOUNDS[(operator, truth)]
+        if bound == "lower" and (lower is None or (constant, strict) > lower):
+            lower = (constant, strict)
+        elif bound == "upper" and (upper is None or (constant, not strict) < (upper[0], not upper[1])):
+            upper = (constant, strict)
+        elif bound == "equal":
+            equal.add(constant)
+        elif bound == "unequal":
+            unequal.add(constant)
+
+    def within(number: Any) -> bool:
+        above = lower is None or number > lower[0] or (number == lower[0] and not lower[1])
+        below = upper is None or number < upper[0] or (number == upper[0] and not upper[1])
+        return above and below and number not in unequal
+
+    if equal:
+        [exactly, *others] = sorted(equal)
+        return f"{value} == {literal_text(exactly)}" if not others and within(exactly) else None
+    if lower is not None and upper is not None:
+        if lower[0] > upper[0] or (lower[0] == upper[0] and (lower[1] or upper[1])):
+            return None
+        if lower[0] == upper[0]:
+            return f"{value} == {literal_text(lower[0])}" if lower[0] not in unequal else None
+    if lower is not None and upper is not None:
+        said = (
+            f"{literal_text(lower[0])} {'<' if lower[1] else '<='} {value} {'<' if upper[1] else '<='} "
+            f"{literal_text(upper[0])}"
+        )
+    elif lower is not None:
+        said = f"{value} {'>' if lower[1] else '>='} {literal_text(lower[0])}"
+    elif upper is not None:
+        said = f"{value} {'<' if upper[1] else '<='} {literal_text(upper[0])}"
+    else:
+        said = ""
+    excluded = [c for c in sorted(unequal) if lower is None or upper is None or lower[0] < c < upper[0]]
+    said_excluded = [f"{value} != {literal_text(c)}" for c in excluded]
+    return ", ".join(part for part in [said, *said_excluded] if part) or None
 
 
 def _whole_number_samples(constants: list[Fraction], least: int, greatest: int) -> list[object]:
