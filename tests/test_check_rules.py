@@ -377,7 +377,7 @@ CASES: list[Case] = [
         edit(("tf = {take/pf}", "tf = {take/pf} then {take/pf}")),
         29,
         34,
-        "`take/pf` reads `inp/ib` in the last stage of `run/bb`",
+        "`take/pf` reads `inp/ib` in the last stage of `run/bb` in `a2/a.cs`",
         BASE,
     ),
     Case(
@@ -512,7 +512,7 @@ CASES: list[Case] = [
         edit(("        out/ob: double\n", "        out/ob: double\n        spare/ob: double\n")),
         6,
         9,
-        "output buffer `spare/ob` is never written by a function of any behaviour",
+        "output buffer `a1/a.cs.spare/ob` is never written by a function of any behaviour",
         BASE,
     ),
     Case(
@@ -1527,6 +1527,19 @@ def test_a_condition_reading_unwritten_memory_is_reported() -> None:
     assert "(the initial state of a1/a.cs)" in finding.message
     fixed = edit(("z/m: double\n", "z/m: double = 0.0\n"), text=text)
     assert findings(fixed, "EARL-W041") == []
+
+
+def test_a_condition_reading_unwritten_memory_itself_says_no_through() -> None:
+    """`tc = go/pp or z/mi > 0.0` reads `z/mi` directly: the message said "reads `z/mi` (through `z/mi`)"."""
+    text = edit(
+        ("        x/m: double = 0.0\n", "        x/m: double = 0.0\n        z/m: double\n"),
+        ("tc = go/pp\n", "tc = go/pp or z/mi > 0.0\n"),
+    )
+    (finding,) = findings(text, "EARL-W041")
+    assert finding.message == (
+        "the condition of `run/bb` reads `z/mi` after the first iteration (the initial state of a1/a.cs), "
+        "before anything wrote it"
+    )
 
 
 def test_an_inter_agent_link_from_a_receptor_is_said_once_at_the_end_it_starts_at() -> None:

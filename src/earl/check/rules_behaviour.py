@@ -227,7 +227,7 @@ def output_buffers_in_last_stage(context: CheckContext) -> Iterator[Finding]:
                                 if element.kind in (Kind.INPUT_BUFFER, Kind.MEMORY_OUTPUT):
                                     what = "reads" if element.kind is Kind.INPUT_BUFFER else "writes"
                                     yield Finding(
-                                        f"`{function.name}/pf` {what} `{reference_text(element)}` in the last stage of `{behaviour.name}/bb`",
+                                        f"`{function.name}/pf` {what} `{reference_text(element)}` in the last stage of `{behaviour.name}/bb` in `{subsystem_name(agent, subsystem)}`",
                                         function_reference.location,
                                         "Eq. (6): a second-stage function reads memory (`/mi`) and writes output buffers (`/ob`) only; "
                                         "move this work into a function of the first stage",
@@ -296,7 +296,8 @@ def output_buffers_written(context: CheckContext) -> Iterator[Finding]:
             for buffer in subsystem.output_buffers:
                 if buffer.name not in written:
                     yield Finding(
-                        f"output buffer `{buffer.name}/ob` is never written by a function of any behaviour, so it is never sent",
+                        f"output buffer `{subsystem_name(agent, subsystem)}.{buffer.name}/ob` is never written by a "
+                        "function of any behaviour, so it is never sent",
                         buffer.location,
                         f"add `{buffer.name}/ob` to the writes of a second-stage function",
                     )
@@ -392,8 +393,14 @@ def memory_read_before_written(context: CheckContext) -> Iterator[Finding]:
                             continue
                         for read_key, read in _memory_read(subsystem, condition.expression):
                             if read_key == key:
+                                # a read of the memory itself needs no "through": only a predicate's does
+                                through = (
+                                    f" (through `{reference_text(read.target)}`)"
+                                    if read.target.kind is Kind.PRIMITIVE_PREDICATE
+                                    else ""
+                                )
                                 yield Finding(
-                                    f"{what} reads `{key}/mi` (through `{reference_text(read.target)}`) after the first iteration {where}, before anything wrote it",
+                                    f"{what} reads `{key}/mi`{through} after the first iteration {where}, before anything wrote it",
                                     read.location or condition.location,
                                     hint,
                                 )
