@@ -576,6 +576,24 @@ def test_the_range_of_a_value_is_said_from_its_comparisons_truths(
     assert _range_text("v", facts) == said  # type: ignore[arg-type]
 
 
+@pytest.mark.parametrize(
+    ("first", "second", "found"),
+    [
+        ("v/ib > w/ib", "w/ib >= v/ib", set()),  # one the negation of the other, mirrored
+        ("v/ib == w/ib", "w/ib != v/ib", set()),
+        ("v/ib < w/ib", "w/ib < v/ib", {"EARL-W061"}),  # never both; neither when equal
+        ("v/ib < w/ib or v/ib == w/ib", "v/ib > w/ib", set()),
+        ("v/ib <= w/ib", "w/ib <= v/ib", {"EARL-E060"}),  # both when equal
+        ("v/ib == w/ib", "v/ib < w/ib or w/ib < v/ib", set()),
+    ],
+)
+def test_comparisons_of_two_values_are_related_however_they_are_written(
+    first: str, second: str, found: set[str]
+) -> None:
+    """`v/ib > x/mi` and `x/mi >= v/ib` were two unrelated Booleans: a false overlap and a false stuck state."""
+    assert set(probe_text(first, second, extra="        w/ib: double\n")) == found
+
+
 def test_two_predicates_computed_by_python_are_two_booleans_whatever_they_read() -> None:
     extra = '        pa/pp(v/ib) = python "m:f"\n        pb/pp(v/ib) = python "m:g"\n'
     found = probe_text("pa/pp", "not pb/pp", extra=extra)

@@ -51,7 +51,7 @@ from typing import TYPE_CHECKING, Any
 
 from earl.check.constants import ORDERINGS, Constant, constant_value, indices_folded
 from earl.check.context import CheckContext
-from earl.check.expression_types import BOOLEAN, UNKNOWN, ExpressionTyper
+from earl.check.expression_types import BOOLEAN, NUMBER, UNKNOWN, ExpressionTyper
 from earl.check.registry import Finding, rule
 from earl.check.rules_behaviour import followable_definitions
 from earl.diagnostics import Severity
@@ -166,6 +166,8 @@ class _Encoder:
         #: per compared value of an integer type: the whole numbers it may hold (`uint8`: 0 to 255)
         self.integer_ranges: dict[str, tuple[int, int]] = {}
         self.calls: dict[tuple[str, str], Function] = {}  # (function, argument text) → variable
+        #: per two numbers compared (their texts, in order): `<`, `<=`, `==` between them, as variables
+        self.relations: dict[tuple[str, str], dict[str, Function]] = {}
         self.call_arguments: dict[str, Read] = {}
         #: per predicate's variable: the variables its definition is written in (`order_variables`)
         self.defined_over: dict[str, set[str]] = {}
@@ -309,7 +311,37 @@ class _Encoder:
         ):
             same = self.encode(comparison.left).equiv(self.encode(comparison.right))
             return same if operator == "==" else ~same
+        if left is None and right is None:
+            relation = self._two_values(comparison)
+            if relation is not None:
+                return relation
         return self.variable(text, comparison)
+
+    def _two_values(self, comparison: Comparison) -> Function | None:
+        """`a > b` as `not (a <= b)`, `b >= a` as `not (a < b)`, `a != b` as `not (a == b)`: a comparison of
+        two values written as one of `a < b`, `a <= b`, `a == b`, its operands in the order of their text,
+        so that `v/ib > x/mi` and `x/mi >= v/ib` are seen to exclude each other (`constraints` relates the
+        three). Values are numbers, as with constants (a NaN is no value the analysis considers); `==` and
+        `!=` between two strings or structs of one type too. None for anything else."""
+        first, second, operator = comparison.left, comparison.right, comparison.operator
+        first_text, second_text = expression_text(first), expression_text(second)
+        if first_text == second_text:
+            return None
+        if first_text > second_text:
+            first, second, operator = second, first, _MIRRORED[operator]
+            first_text, second_text = second_text, first_text
+        kinds = {self.typer.type_of(first), self.typer.type_of(second)}
+        if len(kinds) != 1 or UNKNOWN in kinds or BOOLEAN in kinds:
+            return None
+        if kinds != {NUMBER} and operator not in ("==", "!="):
+            return None
+        written_as = {"<": ("<", False), "<=": ("<=", False), ">": ("<=", True), ">=": ("<", True)}
+        written_as.update({"==": ("==", False), "!=": ("==", True)})
+        relation, negated = written_as[operator]
+        variable = self.variable(f"{first_text} {relation} {second_text}", Comparison(relation, first, second))
+        if kinds == {NUMBER}:
+            self.relations.setdefault((first_text, second_text), {})[relation] = variable
+        return ~variable if negated else variable
 
     def order_variables(self) -> None:
         """Put the variables in an order that keeps the BDDs small (call once every formula is encoded,
@@ -371,6 +403,20 @@ class _Encoder:
             meaning &= definition
         for value_text, atoms in self.comparisons.items():
             meaning &= self._regions(atoms, self.integer_ranges.get(value_text))
+        for relations in self.relations.values():
+            # two numbers are one of below, equal, above: `a < b` and `a == b` each imply `a <= b`, which
+            # is one of them; never both
+            below, at_most, equal = relations.get("<"), relations.get("<="), relations.get("==")
+            if below is not None and equal is not None:
+                meaning &= ~(below & equal)
+            if at_most is not None:
+                either = self.bdd.false
+                for part in (below, equal):
+                    if part is not None:
+                        meaning &= part.implies(at_most)
+                        either |= part
+                if below is not None and equal is not None:
+                    meaning &= at_most.implies(either)
         depth, self._depth = self._depth, 1  # the buffer's own `newData` is no word of a condition
         try:
             for (function, _), variable in list(self.calls.items()):
