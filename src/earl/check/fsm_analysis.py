@@ -3,21 +3,24 @@
 A transition condition is a Boolean formula over *atoms*: each comparison, each call of
 `newData`/`timeout`/`stale`, each Boolean value read from a buffer or memory is a variable;
 `and`, `or`, `not` and `==`/`!=` between Booleans are the BDD's own operations, and a
-sub-formula of constants (`2 == 1` in member 2 of a family) is folded to its value.  A
-primitive predicate is a variable of its own, tied to its definition, so a message can say
-`hot/pp = true` while the analysis knows that `hot/pp` *is* `v/ib > 3.0`.  What the atoms
-mean adds constraints, conjoined with the FSM's `assume` formulas:
+sub-formula of constants (`2 == 1` in member 2 of a family), or an index (`arr/ib[N - 1]`), is
+folded to its value.  A primitive predicate is a variable of its own, tied to its definition, so a
+message can say `hot/pp = true` while the analysis knows that `hot/pp` *is* `v/ib > 3.0`.  What
+the atoms mean adds constraints, conjoined with the FSM's `assume` formulas:
 
 - comparisons of one value with constants (`v/ib > 5.0`, `v/ib < 3.0`, `mode/ib == "stop"`) are
   decided over the real numbers (or the distinct strings): `v/ib > 5.0 and v/ib < 3.0` never holds.
-  An `int` value is treated as a real, so `n/ib > 3 and n/ib < 4` is thought possible;
+  A value of an integer type holds only the whole numbers of its range, so `n/ib > 3 and n/ib < 4`
+  never holds for an `int`, nor `u/ib < 0` for a `uint8`;
+- two values compared with each other (`v/ib > x/mi`, `x/mi >= v/ib`) are one of below, equal, above;
 - `newData(x/ib.field)` holds only when `newData(x/ib)` does, and `timeout(x/ib)` only when it
   does not (docs/semantics.md);
 - per state, what receiving there makes true: a buffer the state waits for (`obligatory`) took a
   message or timed out, and with no `timeout` took one; one it does not wait for never times out,
   unless an inter-agent link feeds it (over Zenoh its sender may go stale, and a stale buffer reads
   as timed out in every state: a finding that needs this says so);
-- a primitive predicate defined through itself (EARL-E045) stays a free Boolean.
+- a primitive predicate defined through itself (EARL-E045) stays a free Boolean;
+- a state whose conditions have a type error (EARL-E030) is not analysed: what they mean is unknown.
 
 The transitions leaving a state are evaluated only when its behaviour stops (`tc or ec`, step 5
 of docs/semantics.md), in priority order.  With these, for every state of every FSM:
