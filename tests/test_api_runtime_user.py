@@ -587,3 +587,79 @@ def test_write_doc_writes_the_site_into_a_directory_named_by_a_str(tmp_path: Pat
         earl.write_doc(system, tmp_path / "file")
     with pytest.raises(TypeError, match="write_doc documents a System"):
         earl.write_doc("system.earl", tmp_path)  # type: ignore[arg-type]
+
+
+def test_a_struct_with_a_field_named_items_goes_to_json_through_plain(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """json.dumps calls a mapping's items() by name, which the field hides; earl.runtime.plain gives the value
+    as plain dicts and lists all the way down, which json takes."""
+    import json
+
+    from earl.runtime import plain
+
+    (tmp_path / "recordcode_for_test.py").write_text(RECORD_CODE)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    with earl.simulate(earl.loads(RECORDS)) as simulation:
+        simulation.advance_to(0.02)
+        reading = simulation.state_of("a/a.cs").memory["reading"]
+    with pytest.raises(TypeError):
+        json.dumps(reading)  # the reason plain exists: `items` is the field, 3
+    as_data = json.loads(json.dumps(plain(reading)))
+    assert as_data == {
+        "values": [1.0, 2.0],
+        "items": 3,
+        "keys": 4,
+        "get": 5,
+        "copy": 6,
+        "update": True,
+        "replace": 7,
+        "count": 8,
+    }
+    assert type(plain(reading)) is dict and type(plain(reading)["values"]) is list
+
+
+ABSENT_UNDER_GET = """\
+system absent
+struct Inner {
+    x: double
+}
+struct Bag {
+    get: boolean
+    inner: Inner?
+}
+a/a {
+    cs {
+        period 10 ms
+        bag/m: Bag
+        big/pp = bag/mi.inner.x > 5.0
+        go/bb {
+            tf = {}
+            tc = big/pp
+        }
+        fsm {
+            initial go
+            state go: go/bb
+        }
+    }
+}
+r/r {
+    a/a
+}
+"""
+
+
+def test_a_fault_through_an_absent_field_is_said_so_in_a_struct_with_a_field_named_get() -> None:
+    """The message finder called the Record's get, which a field named `get` hides: the fault fell back to
+    Python's "'NoneType' object is not subscriptable"."""
+    with earl.simulate(earl.loads(ABSENT_UNDER_GET), check=False) as simulation:
+        simulation.advance_to(0.0)
+        messages = [fault.message for fault in simulation.faults]
+    assert messages and "`bag/mi.inner` was absent" in messages[0], messages
+
+
+def test_read_trace_of_a_directory_or_of_no_file_is_said_at_once(tmp_path: Path) -> None:
+    with pytest.raises(IsADirectoryError, match="a directory, not a trace"):
+        earl.read_trace(tmp_path)
+    with pytest.raises(FileNotFoundError, match="no such trace file"):
+        earl.read_trace(tmp_path / "run.mcap")

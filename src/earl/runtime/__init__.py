@@ -17,7 +17,7 @@ if TYPE_CHECKING:
     from earl.runtime.events import Fault
     from earl.runtime.scheduler import ZeroTimeLoop
     from earl.runtime.simulation import RecordingWarning, Simulation, SubsystemState, UnknownSubsystem, simulate
-    from earl.runtime.values import Record
+    from earl.runtime.values import Record, plain
 
 __all__ = [
     "Fault",
@@ -27,6 +27,7 @@ __all__ = [
     "SubsystemState",
     "UnknownSubsystem",
     "ZeroTimeLoop",
+    "plain",
     "simulate",
 ]
 
@@ -39,6 +40,7 @@ _HOMES = {
     "SubsystemState": "earl.runtime.simulation",
     "simulate": "earl.runtime.simulation",
     "ZeroTimeLoop": "earl.runtime.scheduler",
+    "plain": "earl.runtime.values",
 }
 
 

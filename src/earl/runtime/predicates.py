@@ -246,7 +246,8 @@ def _absent_on_the_way(read: Read, use: str, values: Mapping[str, Any], error: B
                 return None if use == "equality" or not isinstance(error, TypeError) else _absent(said)
             if not isinstance(value, Mapping):
                 return None
-            value = value.get(accessor.name)
+            # dict's own get: a struct's field named `get` is the field, not the method (runtime.md)
+            value = dict.get(value, accessor.name) if isinstance(value, dict) else value.get(accessor.name)
             said += f".{accessor.name}"
             continue
         if value is None:

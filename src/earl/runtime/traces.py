@@ -14,6 +14,7 @@ the stream, never the copy.
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import tempfile
 import weakref
@@ -36,6 +37,15 @@ class Trace:
                 raise ValueError("read_trace takes the trace's file name, not an empty string")
             self.path = Path(source)
             self.name = str(source)
+            # said at once, as `open` says it, rather than at the first read (the CLI's usage errors)
+            if self.path.is_dir():
+                raise IsADirectoryError(
+                    errno.EISDIR,
+                    "a directory, not a trace: name the .mcap file (trace= of a run writes one)",
+                    self.name,
+                )
+            if not self.path.exists():
+                raise FileNotFoundError(errno.ENOENT, "no such trace file", self.name)
             return
         read = getattr(source, "read", None)
         if not callable(read):

@@ -562,6 +562,17 @@ def _coerce_primitive(value: Any, name: str, where: str) -> Value:
     raise ValueTypeError(f"unknown primitive type `{name}`")
 
 
+def plain(value: Any) -> Any:
+    """A value of a run as plain Python data: each struct a `dict`, each array a `list`, all the way
+    down; for libraries that call a mapping's `items()` by name (`json.dumps`, `msgpack.packb`), which a
+    struct's field named `items` hides on a Record."""
+    if isinstance(value, dict):
+        return {key: plain(item) for key, item in dict.items(value)}
+    if isinstance(value, (tuple, list)):
+        return [plain(item) for item in value]
+    return value
+
+
 def to_json(value: Value) -> Any:
     """A value as JSON data (bytes as a list of numbers), for traces."""
     if isinstance(value, tuple):
