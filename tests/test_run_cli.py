@@ -1741,7 +1741,7 @@ def _interrupted_early(
     exit code and what it said on stderr; None when it had ended before the signal."""
     child = subprocess.Popen(
         [sys.executable, "-X", "importtime", *command],
-        stdout=subprocess.DEVNULL,
+        stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         stdin=subprocess.DEVNULL,
         start_new_session=True,
@@ -1760,12 +1760,22 @@ def _interrupted_early(
         if child.poll() is not None:
             return None
         child.send_signal(stop)
-        rest = child.communicate(timeout=60)[1].decode(errors="replace")
+        printed, rest_bytes = child.communicate(timeout=60)
+        rest = rest_bytes.decode(errors="replace")
     finally:
         if child.poll() is None:
             child.kill()
             child.wait()
-    said = [line for line in "".join(lines).splitlines() + rest.splitlines() if not line.startswith("import time:")]
+    # -X importtime's lines, and the tail of one a write of the program's split under load (`1134 |   copy`)
+    said = [
+        line
+        for line in "".join(lines).splitlines() + rest.splitlines()
+        if not line.startswith("import time:") and re.match(r"\s*\d+ \|", line) is None
+    ]
+    if child.returncode == -stop and not said and printed.strip():
+        # done and said all, then ended by the signal as the interpreter shut down (CPython puts the default
+        # handlers back as it finalises): the command had ended before the signal
+        return None
     return child.returncode, said
 
 
