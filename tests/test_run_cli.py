@@ -1094,6 +1094,21 @@ def test_a_record_links_pattern_that_matches_no_link_is_said(tmp_path: Path) -> 
     assert "`counter/a:relay*`" not in traced.stderr
 
 
+def test_a_record_links_glob_with_a_character_class_records_the_links_it_matches(tmp_path: Path) -> None:
+    """`[mg]` is a shell glob's character class, `m` or `g`: it was taken for a link family's index
+    variable, so the pattern matched no link and the trace kept none (exit 0)."""
+    from earl.runtime.trace_reader import topics
+
+    trace = tmp_path / "t.mcap"
+    ran = earl_cli("run", str(EXAMPLE), "--duration", "0.2s", "--trace", str(trace), "--record-links", "task,[mg]*")
+    assert ran.returncode == 0, ran.stderr
+    assert "matches no link" not in ran.stderr
+    assert sorted(topic for topic in topics(trace) if topic.startswith("/link/")) == [
+        "/link/task,grip",
+        "/link/task,manip",
+    ]
+
+
 def test_a_plot_or_trace_into_a_directory_that_does_not_exist_is_refused_before_the_run(tmp_path: Path) -> None:
     """Whether the trace goes beside the plot or elsewhere: one line, exit 2, and no directory made."""
     missing = tmp_path / "nodir"

@@ -120,7 +120,8 @@ def register(commands: Any) -> None:
         default=None,
         metavar="PATTERN",
         help="with --trace (or --plot): record only messages on links matching a glob, e.g. 'task,*'; "
-        "brackets name a member of a link family, 'sorter,pusher[2]', or every one, 'sorter,pusher[*]' "
+        "brackets name a member of a link family, 'sorter,pusher[2]', or every one, 'sorter,pusher[*]' or with the "
+        "index variable the family declares, 'sorter,pusher[K]'; other brackets are a character class, 'task,[mg]*' "
         "(repeatable; default: all; to record none, write record_links = [] in run.toml)",
     )
     parser.add_argument(
@@ -366,7 +367,6 @@ def check_options(arguments: argparse.Namespace) -> CheckedOptions:
     anything runs, by `earl run` and by `earl launch` for each process's `args`. Fills in what follows from
     them: --signal from run.toml's `plot`, --trace from --plot, --realtime with --transport zenoh."""
     from earl.runtime.durations import parse_duration
-    from earl.runtime.link_patterns import link_pattern_problem
     from earl.runtime.run_settings import read_run_settings
 
     path = spec_path(arguments.spec)
@@ -390,10 +390,6 @@ def check_options(arguments: argparse.Namespace) -> CheckedOptions:
     ):
         for text in given or []:
             named(text, option, example, what)
-    for pattern in arguments.record_links or []:
-        problem = link_pattern_problem(pattern)
-        if problem is not None:
-            raise UsageError(f"--record-links {problem}")
     try:
         settings = read_run_settings(path)
     except ValueError as error:
@@ -473,15 +469,15 @@ def _say_what_is_not_recorded(
     """A line for each link pattern (of --record-links, or else of run.toml's `record_links`) that
     matches no link of the system: a misspelt glob would otherwise leave the trace quietly empty.
     (--record-links without a trace to record into is refused by `check_options`.)"""
-    from earl.runtime.link_patterns import matches, no_link_matched
+    from earl.runtime.link_patterns import matching, no_link_matched
 
-    links = sorted(simulation.network.link_types)
+    links = simulation.network.link_index_variables
     if arguments.record_links is not None:
         patterns, said = arguments.record_links, "--record-links `{}`"
     else:  # the command line wins over run.toml: only the patterns the run uses are checked
         patterns, said = record_links_of_run_toml or [], "record_links `{}` in run.toml"
     for pattern in patterns:
-        if not any(matches(pattern, link) for link in links):
+        if not matching(pattern, links):
             print(f"earl run: {said.format(pattern)} {no_link_matched(pattern, links)}", file=sys.stderr)
 
 

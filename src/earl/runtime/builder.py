@@ -89,6 +89,9 @@ class Network:
         self.input_types: dict[str, dict[str, DataType]] = {}
         #: link name -> `subsystem.outputBuffer` it carries, so a trace can be read by buffer name
         self.link_sources: dict[str, str] = {}
+        #: link name -> the index variables of the families it is a member of (`K` of
+        #: `link sorter,pusher[K in 1..N]` or of `pusher[K in 1..N]/a`): what `[K]` in a link pattern names
+        self.link_index_variables: dict[str, frozenset[str]] = {}
 
 
 def build_network(
@@ -586,6 +589,7 @@ def _connect(
         return
     name = _link_name(link, agent)
     network.links.append(name)
+    network.link_index_variables[name] = _index_variables(link, agent)
     source_buffer = reference_key(link.source.buffer)
     data_type = network.output_types.get(source.name, {}).get(source_buffer)
     if data_type is not None:
@@ -603,6 +607,11 @@ def _link_name(link: Link, agent: Agent | None) -> str:
     if link.index is not None and "[" not in name:
         name = f"{name}[{link.index}]"
     return name
+
+
+def _index_variables(link: Link, agent: Agent | None) -> frozenset[str]:
+    families = (link.family, agent.family if agent is not None else None)
+    return frozenset(family.index for family in families if family is not None)
 
 
 def _end_agent(end: LinkEnd, agent: Agent | None) -> str:
@@ -629,6 +638,7 @@ def _connect_remote(
             return  # the checker reports a link from a buffer that does not exist
         sink = remote.outgoing(name, data_type, network.types, source.name, _end_agent(link.destination, agent))
         network.links.append(name)
+        network.link_index_variables[name] = _index_variables(link, agent)
         network.link_types[name] = data_type
         network.link_sources[name] = f"{source.name}.{source_buffer}"
         source.destinations.setdefault(source_buffer, []).append(

@@ -1,41 +1,37 @@
 """Link patterns of `--record-links` and run.toml's `record_links`: globs over the links' names.
 
 A link is named as in the spec, with its members' indices in brackets: `sorter,pusher[2]`,
-`pusher[2]/a:cs,arm`. So brackets in a pattern name an index, as everywhere else in earl, not a
-character class as in a shell's globs: `[2]` is member 2, and `[*]` or the family's index variable
-(`[K]`) is every member. `*` is any run of characters and `?` any one, as in a glob.
+`pusher[2]/a:cs,arm`. So brackets holding a member's number name that member, and `[*]` or the
+index variable the family declares (`[K]` of `pusher[K in 1..N]`) every member. Brackets holding
+anything else are a glob's character class, as in a shell (`task,[mg]*` is `task,manip` and
+`task,gripper`), so the patterns written before families had names keep matching what they did.
+`*` is any run of characters and `?` any one.
 """
 
 from __future__ import annotations
 
 import re
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
+from fnmatch import translate
 from functools import lru_cache
 
 from earl.diagnostics import did_you_mean
 
-#: what is between a pattern's brackets: a member's number, `*`, or an index variable
-_INDEX = re.compile(r"[0-9]+|\*|[A-Za-z_]\w*")
+#: what is between a pattern's brackets when they name members whatever the family: a number or `*`
+_ANY_FAMILY_INDEX = re.compile(r"[0-9]+|\*")
 #: the links shown at most when a pattern matches none (families shown once, as `x[*]`)
 SHOWN = 12
 
 
-def link_pattern_problem(pattern: str) -> str | None:
-    """Why `pattern` is no link pattern (brackets that hold no index, or are not closed), or None."""
-    try:
-        _compiled(pattern)
-    except ValueError as error:
-        return str(error)
-    return None
+def matches(pattern: str, link: str, index_variables: frozenset[str] = frozenset()) -> bool:
+    """Whether `link` (`sorter,pusher[2]`) is one `pattern` names; `index_variables` are those of the
+    families `link` is a member of (`K` of `link sorter,pusher[K in 1..N]`, or of its agent's family)."""
+    return _compiled(pattern, index_variables).fullmatch(link) is not None
 
 
-def matches(pattern: str, link: str) -> bool:
-    """Whether `link` (`sorter,pusher[2]`) is one `pattern` names; a pattern that is no link pattern
-    (`link_pattern_problem`) names none."""
-    try:
-        return _compiled(pattern).fullmatch(link) is not None
-    except ValueError:
-        return False
+def matching(pattern: str, links: Mapping[str, frozenset[str]]) -> list[str]:
+    """The links (each with its families' index variables, `Network.link_index_variables`) `pattern` names."""
+    return [link for link, variables in links.items() if matches(pattern, link, variables)]
 
 
 def no_link_matched(pattern: str, links: Iterable[str]) -> str:
@@ -48,29 +44,38 @@ def no_link_matched(pattern: str, links: Iterable[str]) -> str:
     return "matches no link" + (f"; {hint}" if hint else "") + f" (the links: {shown or 'none'})"
 
 
-@lru_cache(maxsize=256)  # a pattern is matched against each link of the run
-def _compiled(pattern: str) -> re.Pattern[str]:
-    """`pattern` as a regular expression; a ValueError saying what is wrong with it."""
+@lru_cache(maxsize=256)  # a pattern is matched against each link of the run, with few sets of variables
+def _compiled(pattern: str, index_variables: frozenset[str]) -> re.Pattern[str]:
+    """`pattern` as a regular expression: the brackets that name members as an index, the rest as
+    `fnmatch` takes it (an unclosed `[` is itself, as there)."""
     parts: list[str] = []
-    position = 0
+    glob_from = position = 0
     while position < len(pattern):
-        character = pattern[position]
-        if character == "[":
-            end = pattern.find("]", position)
-            if end < 0:
-                raise ValueError(
-                    f"`{pattern}`: the `[` at character {position + 1} is not closed; brackets name a member, "
-                    "`pusher[2]`, or every one, `pusher[*]`"
-                )
-            index = pattern[position + 1 : end].strip()
-            if not _INDEX.fullmatch(index):
-                raise ValueError(
-                    f"`{pattern}`: `[{pattern[position + 1 : end]}]` is no index; brackets name a member by its "
-                    "number, `pusher[2]`, or every one, `pusher[*]` (or `pusher[K]`), as in the spec"
-                )
-            parts.append(rf"\[{int(index)}\]" if index.isdigit() else r"\[[0-9]+\]")
-            position = end + 1
+        end = _class_end(pattern, position) if pattern[position] == "[" else -1
+        if end < 0:
+            position += 1
             continue
-        parts.append({"*": ".*", "?": "."}.get(character) or re.escape(character))
-        position += 1
-    return re.compile("".join(parts), re.DOTALL)
+        index = pattern[position + 1 : end]
+        if _ANY_FAMILY_INDEX.fullmatch(index) or index in index_variables:
+            parts.append(_glob(pattern[glob_from:position]))
+            parts.append(rf"\[{int(index)}\]" if index.isdigit() else r"\[[0-9]+\]")
+            glob_from = end + 1
+        position = end + 1
+    parts.append(_glob(pattern[glob_from:]))
+    return re.compile("".join(parts))
+
+
+def _class_end(pattern: str, start: int) -> int:
+    """Where the `]` closing the `[` at `start` is, by fnmatch's rules (`[!]]`, `[]]`), or -1."""
+    end = start + 1
+    if end < len(pattern) and pattern[end] == "!":
+        end += 1
+    if end < len(pattern) and pattern[end] == "]":
+        end += 1
+    end = pattern.find("]", end)
+    return end
+
+
+def _glob(text: str) -> str:
+    """A glob without member indices as a regular expression to join with others (fnmatch's, unanchored)."""
+    return translate(text).removesuffix(r"\Z") if text else ""

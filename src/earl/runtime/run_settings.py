@@ -136,12 +136,6 @@ def read_run_settings(spec: Path) -> RunSettings:
                 f"{where(key)}: `{key}` has an empty string in {as_written(data[key])}: each names a {what}, "
                 f"e.g. {example}"
             )
-    from earl.runtime.link_patterns import link_pattern_problem
-
-    for pattern in data.get("record_links") or []:
-        problem = link_pattern_problem(pattern)
-        if problem is not None:  # brackets that name no member: refused here, as on the command line
-            raise ValueError(f"{where('record_links')}: `record_links`: {problem}")
     return RunSettings(
         environment=data.get("environment"),
         duration=duration,

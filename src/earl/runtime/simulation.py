@@ -104,7 +104,6 @@ class Simulation:
     ) -> None:
         _refuse_wrong_arguments(system, trace, record_memory=record_memory, record_links=record_links, agents=agents)
         _refuse_wrong_arguments(system, trace, record_outputs=record_outputs)
-        _refuse_wrong_link_patterns(record_links)
         refuse_wrong_parameters(parameters)
         parameters = dict(parameters or {})
         if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
@@ -161,7 +160,7 @@ class Simulation:
             self.transport = transport
             memory = _memory_recorded(record_memory or [], list(self.network.by_name))
             _refuse_unknown_outputs(record_outputs, self.expanded)
-            _warn_of_patterns_matching_nothing(record_links, self.network.link_types)
+            _warn_of_patterns_matching_nothing(record_links, self.network.link_index_variables)
             if transport is not None:
                 # last of what the spec and the options can get wrong (its code bound, the environment started):
                 # only now does this process open its links and show itself to its peers
@@ -174,6 +173,7 @@ class Simulation:
                     self.network.memory_types,
                     record_links,
                     self.network.link_sources,
+                    self.network.link_index_variables,
                 )
                 # the links leaving these output buffers (`manip/a.cs.manipulatorState`), whatever record_links
                 # says: what `earl run --plot` draws of an output buffer is the messages on its links
@@ -391,14 +391,15 @@ def _refuse_unknown_outputs(outputs: list[str] | None, expanded: System) -> None
             raise ValueError(f"record_outputs: `{name}` is no output buffer of this run; {hint}")
 
 
-def _warn_of_patterns_matching_nothing(patterns: list[str] | None, links: Mapping[str, object]) -> None:
-    """A misspelt glob would leave the trace quietly without the links meant (`earl run` says the same)."""
+def _warn_of_patterns_matching_nothing(patterns: list[str] | None, links: Mapping[str, frozenset[str]]) -> None:
+    """A misspelt glob would leave the trace quietly without the links meant (`earl run` says the same);
+    `links` are the run's, each with its families' index variables."""
     import warnings
 
-    from earl.runtime.link_patterns import matches, no_link_matched
+    from earl.runtime.link_patterns import matching, no_link_matched
 
     for pattern in patterns or []:
-        if not any(matches(pattern, link) for link in links):
+        if not matching(pattern, links):
             warnings.warn(
                 f"record_links: `{pattern}` {no_link_matched(pattern, links)}", RecordingWarning, stacklevel=3
             )
@@ -427,17 +428,6 @@ def _memory_recorded(named: list[str], subsystems: list[str]) -> set[str]:
             f"{', '.join(sorted(unknown))} ({f'{hint} ' if hint else ''}subsystems are named like {example})"
         )
     return memory
-
-
-def _refuse_wrong_link_patterns(patterns: list[str] | None) -> None:
-    """A pattern whose brackets hold no index (`pusher[1-3]`): said before anything runs, not warned
-    of as matching no link (brackets name a member, not a character class)."""
-    from earl.runtime.link_patterns import link_pattern_problem
-
-    for pattern in patterns or []:
-        problem = link_pattern_problem(pattern)
-        if problem is not None:
-            raise ValueError(f"record_links: {problem}")
 
 
 def _refuse_wrong_arguments(system: object, trace: object, **lists: object) -> None:

@@ -385,6 +385,7 @@ class TraceWriter(Recorder):
         memory_types: dict[str, dict[str, DataType]],
         links: list[str] | None = None,
         link_sources: dict[str, str] | None = None,
+        link_index_variables: dict[str, frozenset[str]] | None = None,
     ) -> None:
         self._sink: McapSink | BackgroundSink
         if isinstance(output, (str, Path)):
@@ -396,6 +397,8 @@ class TraceWriter(Recorder):
         self.memory_types = memory_types
         self.link_patterns = links
         self.link_sources = link_sources or {}
+        #: link -> its families' index variables: what `[K]` in a link pattern names
+        self.link_index_variables = link_index_variables or {}
         #: subsystem -> the output buffers links leave (`push[1]`, `beltSpeed`), for its FSM channel's
         #: metadata: a link's channel is made at its first message, so the trace alone could not tell
         #: a member of a family that never sent from one the family does not have (earl plot)
@@ -492,7 +495,10 @@ class TraceWriter(Recorder):
         return (
             self.link_patterns is None
             or link in self.links_also_recorded
-            or any(link_patterns.matches(p, link) for p in self.link_patterns)
+            or any(
+                link_patterns.matches(p, link, self.link_index_variables.get(link, frozenset()))
+                for p in self.link_patterns
+            )
         )
 
     def _link(self, link: str) -> int | None:
