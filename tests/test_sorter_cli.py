@@ -426,6 +426,17 @@ def test_earl_plot_draws_a_window_of_the_run_where_a_10_ms_state_shows(sorter_tr
             ["--from", "1s", "--to", "1000ms"],
             "earl: error: --from 1s is not before --to 1000ms: the window would be empty\n",
         ),
+        # --from left out is the run's start: `--to 0` drew an empty window, exit 0, with a Matplotlib
+        # UserWarning naming earl's source (`plot.py:278: … axis.set_xlim(...)`)
+        (
+            ["--to", "0"],
+            "earl: error: --to 0 is not after --from (the run's start, 0 s, when not given): the window would be empty\n",
+        ),
+        (
+            ["--to", "0ms"],
+            "earl: error: --to 0ms is not after --from (the run's start, 0 s, when not given): "
+            "the window would be empty\n",
+        ),
     ],
 )
 def test_a_window_that_is_no_time_or_empty_is_a_usage_error(
@@ -434,6 +445,23 @@ def test_a_window_that_is_no_time_or_empty_is_a_usage_error(
     picture = tmp_path / "x.png"
     plot = earl_cli("plot", str(sorter_trace), "--signal", "sorter/a.cs.sorted", *window, "-o", str(picture))
     assert plot.returncode == 2 and plot.stderr == said and not picture.exists()
+
+
+def test_an_empty_window_from_python_is_a_value_error(sorter_trace: Path) -> None:
+    from earl.runtime.trace_reader import read_signals, within
+
+    whole = read_signals(sorter_trace, ["sorter/a.cs.sorted"])
+    with pytest.raises(ValueError, match="the window from 0 s to 0 s is empty"):
+        within(whole, None, 0.0)
+
+
+def test_no_matplotlib_warning_reaches_the_user(sorter_trace: Path, tmp_path: Path) -> None:
+    """A title too tall for the figure: Matplotlib warned `plot.py:282: UserWarning: Tight layout not
+    applied…` twice, with the source line, on earl plot's stderr."""
+    title = "\n".join(f"line {number}" for number in range(60))
+    picture = tmp_path / "t.png"
+    plot = earl_cli("plot", str(sorter_trace), "--signal", "sorter/a.cs.sorted", "--title", title, "-o", str(picture))
+    assert plot.returncode == 0 and plot.stderr == "" and picture.stat().st_size > 0
 
 
 def test_a_window_after_the_trace_s_end_or_without_values_is_said(sorter_trace: Path, tmp_path: Path) -> None:

@@ -64,8 +64,8 @@ def register(commands: Any) -> None:
         "  earl plot run.mcap --signal manip/a.cs.windingCurrent[1] --from 2.99 --to 3.02   (a window of 30 ms)\n\n"
         "exit codes: 0 written, 1 the file is not a readable earl trace or lacks a signal (or has none\n"
         "in the --from/--to window, or ends before --from), 2 usage error (no such file, a malformed\n"
-        "signal, an empty or unwritable -o, a --from or --to that is no time of 0 or more, --from not\n"
-        "before --to), 130 interrupted (Ctrl-C)",
+        "signal, an empty or unwritable -o, a --from or --to that is no time of 0 or more, --from (0\n"
+        "if not given) not before --to), 130 interrupted (Ctrl-C)",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     plot.add_argument("file", metavar="FILE.mcap")
@@ -201,7 +201,12 @@ def run_plot(arguments: argparse.Namespace) -> int:
         stop = _time_of("--to", arguments.stop)
     except UsageError as error:
         return usage_error(str(error))
-    if start is not None and stop is not None and not start < stop:
+    if stop is not None and not (start or 0.0) < stop:
+        if start is None:  # --from is the run's start, 0
+            return usage_error(
+                f"--to {arguments.stop} is not after --from (the run's start, 0 s, when not given): "
+                "the window would be empty"
+            )
         return usage_error(f"--from {arguments.start} is not before --to {arguments.stop}: the window would be empty")
     for signal in arguments.signal:
         # a signal not written as one is a usage error, not one the trace lacks

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+import warnings
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -197,7 +198,8 @@ def plot_signals(
     Each panel's legend is to the right of it, outside the axes, so that it hides no data: the figure
     is as much wider as the widest legend needs.
 
-    `start` and `stop` (seconds; None: the run's start or end) draw a window of the run (`within`).
+    `start` and `stop` (seconds; None: the run's start or end) draw a window of the run (`within`; a
+    ValueError when it is empty).
 
     Returns a line for each signal left out because it had no value in the run, or the window
     (`Signals.empty`)."""
@@ -207,8 +209,13 @@ def plot_signals(
     import matplotlib.pyplot as plt
 
     data = within(read_signals(trace, signals), start, stop)
-    figure = draw_signals(data, title)
-    figure.savefig(output, dpi=110)
+    # Matplotlib warns of what it draws (an axis of no width, a layout it cannot fit) at the line of this
+    # module that called it: the user would see a Python warning with earl's source path, and can do
+    # nothing with it; what earl knows to be wrong it says itself (`within`, `Signals.empty`)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        figure = draw_signals(data, title)
+        figure.savefig(output, dpi=110)
     plt.close(figure)
     return [f"{line}; drawn without it" for line in data.empty] + ([CUT] if data.cut else [])
 

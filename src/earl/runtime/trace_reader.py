@@ -528,10 +528,12 @@ def within(data: Signals, start: float | None, stop: float | None) -> Signals:
     A value holds until the next, so each signal starts the window with the value it held at `start`;
     a signal with no value in the window is left out with a line that says so (`Signals.empty`), and
     the states are cut to the window. A TraceError when the window begins at or after the trace's end,
-    or no signal has a value in it."""
+    or no signal has a value in it; a ValueError when `stop` is not after `start` (the window is empty)."""
     if start is None and stop is None:
         return data
     begin = start or 0.0
+    if stop is not None and not begin < stop:
+        raise ValueError(f"the window from {begin:g} s to {stop:g} s is empty: the start must be before the stop")
     if begin >= data.end:
         raise TraceError(f"the trace ends at {data.end:.6f} s, by --from {begin:g} s: nothing to draw after it")
     end = data.end if stop is None else min(stop, data.end)
