@@ -433,6 +433,10 @@ def test_earl_plot_draws_a_window_of_the_run_where_a_10_ms_state_shows(sorter_tr
             "earl: error: --to 0 is not after --from (the run's start, 0 s, when not given): the window would be empty\n",
         ),
         (
+            ["--from", "1", "--to", "1.0000000001"],  # one nanosecond of the trace, as the window is compared
+            "earl: error: --from 1 is not before --to 1.0000000001: the window would be empty\n",
+        ),
+        (
             ["--to", "0ms"],
             "earl: error: --to 0ms is not after --from (the run's start, 0 s, when not given): "
             "the window would be empty\n",
@@ -445,6 +449,20 @@ def test_a_window_that_is_no_time_or_empty_is_a_usage_error(
     picture = tmp_path / "x.png"
     plot = earl_cli("plot", str(sorter_trace), "--signal", "sorter/a.cs.sorted", *window, "-o", str(picture))
     assert plot.returncode == 2 and plot.stderr == said and not picture.exists()
+
+
+def test_the_window_s_edges_are_in_it_whatever_the_float_rounding(sorter_trace: Path) -> None:
+    """A trace's times are nanoseconds times 1e-9: the sample at 1.4 s is 1.4000000000000001, so
+    `--to 1.4` ended at 1.39 s, and the one at 1.2 s (1.2000000000000002) got a held point at 1.2 too."""
+    from earl.runtime.trace_reader import nanoseconds, read_signals, within
+
+    whole = read_signals(sorter_trace, ["sorter/a.cs.sorted"])  # its memory every 10 ms
+    [series] = within(whole, 1.2, 1.4).series
+    stamps = [nanoseconds(time) for time in series.times]
+    assert stamps == list(range(1_200_000_000, 1_400_000_001, 10_000_000))  # both edges, each once
+    assert not series.held  # the first is the message sent at 1.2 s, marked as one
+    [between] = within(whole, 1.205, 1.4).series
+    assert between.held and nanoseconds(between.times[0]) == 1_205_000_000
 
 
 def test_an_empty_window_from_python_is_a_value_error(sorter_trace: Path) -> None:

@@ -184,7 +184,7 @@ def run_faults(arguments: argparse.Namespace) -> int:
 def run_plot(arguments: argparse.Namespace) -> int:
     from earl.runtime.plot import plot_output_problem, plot_signals
     from earl.runtime.signal_syntax import signal_text_problem
-    from earl.runtime.trace_reader import TraceError
+    from earl.runtime.trace_reader import TraceError, nanoseconds
 
     path = Path(arguments.file)
     if not path.is_file():
@@ -201,7 +201,8 @@ def run_plot(arguments: argparse.Namespace) -> int:
         stop = _time_of("--to", arguments.stop)
     except UsageError as error:
         return usage_error(str(error))
-    if stop is not None and not (start or 0.0) < stop:
+    # in the trace's nanoseconds, as `within` compares: `--from 1 --to 1.0000000001` is one instant
+    if stop is not None and not nanoseconds(start or 0.0) < nanoseconds(stop):
         if start is None:  # --from is the run's start, 0
             return usage_error(
                 f"--to {arguments.stop} is not after --from (the run's start, 0 s, when not given): "

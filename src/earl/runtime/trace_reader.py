@@ -531,17 +531,25 @@ def within(data: Signals, start: float | None, stop: float | None) -> Signals:
     or no signal has a value in it; a ValueError when `stop` is not after `start` (the window is empty)."""
     if start is None and stop is None:
         return data
-    begin = start or 0.0
-    if stop is not None and not begin < stop:
-        raise ValueError(f"the window from {begin:g} s to {stop:g} s is empty: the start must be before the stop")
-    if begin >= data.end:
-        raise TraceError(f"the trace ends at {data.end:.6f} s, by --from {begin:g} s: nothing to draw after it")
-    end = data.end if stop is None else min(stop, data.end)
+    # a trace's times are its integer nanoseconds times 1e-9: compared as nanoseconds, a sample at an
+    # edge of the window is in it (`--to 1.4` keeps the one at 1.4 s, which is 1.4000000000000001 s)
+    first = nanoseconds(start or 0.0)
+    if stop is not None and not first < nanoseconds(stop):
+        raise ValueError(
+            f"the window from {start or 0.0:g} s to {stop:g} s is empty: the start must be before the stop"
+        )
+    last_of_trace = nanoseconds(data.end)
+    if first >= last_of_trace:
+        raise TraceError(f"the trace ends at {data.end:.6f} s, by --from {start or 0.0:g} s: nothing to draw after it")
+    last = last_of_trace if stop is None else min(nanoseconds(stop), last_of_trace)
+    # the window's ends as the trace's own times are written: a message at `begin` is the value held there
+    begin, end = first * 1e-9, last * 1e-9
     series: list[Series] = []
     empty = list(data.empty)
     for found in data.series:
-        before = [i for i, time in enumerate(found.times) if time <= begin]
-        inside = [i for i, time in enumerate(found.times) if begin < time <= end]
+        stamps = [nanoseconds(time) for time in found.times]
+        before = [i for i, stamp in enumerate(stamps) if stamp <= first]
+        inside = [i for i, stamp in enumerate(stamps) if first < stamp <= last]
         times = [found.times[i] for i in inside]
         values = [found.values[i] for i in inside]
         if before:  # the value held at the window's start
@@ -550,15 +558,25 @@ def within(data: Signals, start: float | None, stop: float | None) -> Signals:
         if not times or all(math.isnan(value) for value in values):
             empty.append(f"`{found.subsystem}.{found.name}` had no value from {begin:g} s to {end:g} s")
             continue
-        held = bool(before) and found.times[before[-1]] < begin  # not a message sent at `begin` itself
+        held = bool(before) and stamps[before[-1]] < first  # not a message sent at `begin` itself
         series.append(Series(found.subsystem, found.name, times, values, found.boolean, held))
     if not series:
         raise TraceError(f"no signal has a value from {begin:g} s to {end:g} s: {'; '.join(empty)}")
     bands = {
-        subsystem: [(max(a, begin), min(b, end), state) for a, b, state in stays if b > begin and a < end]
+        subsystem: [
+            (max(a, begin), min(b, end), state)
+            for a, b, state in stays
+            if nanoseconds(b) > first and nanoseconds(a) < last
+        ]
         for subsystem, stays in data.bands.items()
     }
     return Signals(series, bands, end, empty, data.cut, begin, True)
+
+
+def nanoseconds(seconds: float) -> int:
+    """`seconds` of run time as the integer nanoseconds a trace stamps its messages with: a time read
+    from a trace (its nanoseconds times 1e-9) gives back the nanoseconds it was written with."""
+    return round(seconds * 1e9)
 
 
 def read_signals(path: Path, names: list[str]) -> Signals:
