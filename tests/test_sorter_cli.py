@@ -375,6 +375,33 @@ def test_a_fault_s_time_is_seconds_as_the_python_api_s_other_times_and_the_trace
     assert faults[0]["time"] == 950_000_000 and faults[0]["message"] == first.message
 
 
+def test_a_trace_of_some_agents_knows_every_member_of_a_family_of_output_buffers(tmp_path: Path) -> None:
+    """A run of `sorter` and `pusher[1]` has a link from `push[1]` only: the trace's metadata listed only it
+    (`buffers`), so `earl plot` refused `push[2]`, a member of the spec's family of 3, with "`push` has
+    members 1..1, not 2" (exit 1). The metadata lists what the subsystem declares; `push[7]` is refused."""
+    import json
+
+    from earl.runtime.trace_reader import _channels
+
+    trace = tmp_path / "sub.mcap"
+    ran = earl_cli("run", str(SORTER), "--agents", "sorter,pusher[1]", "--duration", "1s", "--trace", str(trace))
+    assert ran.returncode == 0, ran.stderr
+    metadata = _channels(trace)["/sorter/a.cs/fsm"][0]
+    assert json.loads(metadata["outputs"]) == ["beltSpeed", "push[1]", "push[2]", "push[3]"]
+    picture = tmp_path / "p.png"
+    signals = ["--signal", "sorter/a.cs.push[2].abort", "--signal", "sorter/a.cs.sorted"]
+    plot = earl_cli("plot", str(trace), *signals, "-o", str(picture))
+    assert plot.returncode == 0, plot.stderr
+    assert plot.stderr == (
+        "earl plot: `sorter/a.cs.push[2].abort` had no value in this run (`push[2]` sent no message the trace "
+        "recorded); drawn without it\n"
+    )
+    assert picture.stat().st_size > 0
+    beyond = earl_cli("plot", str(trace), "--signal", "sorter/a.cs.push[7].abort", "-o", str(picture))
+    assert beyond.returncode == 1
+    assert beyond.stderr == "earl plot: `sorter/a.cs.push[7].abort`: `push` has members 1..3, not 7\n"
+
+
 def test_earl_plot_draws_a_window_of_the_run_where_a_10_ms_state_shows(sorter_trace: Path, tmp_path: Path) -> None:
     """`dispatching` lasts one 10 ms period of `sorter/a.cs`: too narrow to see in a plot of the whole
     run. `--from`/`--to` draw the window around it: the axis is the window, each signal starts it with

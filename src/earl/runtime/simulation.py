@@ -174,6 +174,7 @@ class Simulation:
                     record_links,
                     self.network.link_sources,
                     self.network.link_index_variables,
+                    self.network.output_types,
                 )
                 # the links leaving these output buffers (`manip/a.cs.manipulatorState`), whatever record_links
                 # says: what `earl run --plot` draws of an output buffer is the messages on its links

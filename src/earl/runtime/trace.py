@@ -386,6 +386,7 @@ class TraceWriter(Recorder):
         links: list[str] | None = None,
         link_sources: dict[str, str] | None = None,
         link_index_variables: dict[str, frozenset[str]] | None = None,
+        output_types: dict[str, dict[str, DataType]] | None = None,
     ) -> None:
         self._sink: McapSink | BackgroundSink
         if isinstance(output, (str, Path)):
@@ -399,14 +400,11 @@ class TraceWriter(Recorder):
         self.link_sources = link_sources or {}
         #: link -> its families' index variables: what `[K]` in a link pattern names
         self.link_index_variables = link_index_variables or {}
-        #: subsystem -> the output buffers links leave (`push[1]`, `beltSpeed`), for its FSM channel's
-        #: metadata: a link's channel is made at its first message, so the trace alone could not tell
-        #: a member of a family that never sent from one the family does not have (earl plot)
-        self._buffers: dict[str, list[str]] = {}
-        for source in self.link_sources.values():
-            subsystem, _, buffer = source.rpartition(".")
-            if subsystem and buffer not in self._buffers.setdefault(subsystem, []):
-                self._buffers[subsystem].append(buffer)
+        #: subsystem -> every output buffer it declares (`push[1]`, `push[2]`, `beltSpeed`), for its FSM
+        #: channel's metadata: a link's channel is made at its first message, so the trace alone could not
+        #: tell a member of a family that never sent from one the family does not have (earl plot). Not
+        #: the buffers links leave: a run of some agents (`--agents`) has no link to the others' members
+        self._outputs = {subsystem: sorted(buffers) for subsystem, buffers in (output_types or {}).items()}
         #: links recorded whatever the patterns say: those leaving an output buffer a plot draws
         self.links_also_recorded: set[str] = set()
         #: topic -> channel number; None for a link that is not recorded
@@ -440,8 +438,8 @@ class TraceWriter(Recorder):
         self, time: int, subsystem: str, source: str | None, destination: str, transition: str | None
     ) -> None:
         metadata = {"subsystem": subsystem}
-        if self._buffers.get(subsystem):
-            metadata["buffers"] = json.dumps(sorted(self._buffers[subsystem]), separators=(",", ":"))
+        if self._outputs.get(subsystem):
+            metadata["outputs"] = json.dumps(self._outputs[subsystem], separators=(",", ":"))
         channel = self._channel(trace_topics.fsm(subsystem), "earl.StateChange", _STATE_SCHEMA, metadata)
         change = {"from": source, "to": destination, "transition": None if transition is None else str(transition)}
         declared = getattr(transition, "declared", transition)

@@ -30,8 +30,8 @@ def path_problem(
 
     `memory` is the subsystem's memory schema with its families' first indices (None when its memory
     is not recorded); `buffers` the schema of each recorded output buffer (`push[2]`, `beltSpeed`) by
-    the link leaving it; `declared` every output buffer a link leaves, recorded or not (the FSM
-    channel's metadata; None in a trace written before it said); `has_leaves(prefix)` whether the
+    the link leaving it; `declared` every output buffer the subsystem declares, recorded or not (the
+    FSM channel's metadata `outputs`; None in a trace written before it said); `has_leaves(prefix)` whether the
     messages held a value under `prefix` (a field the schema leaves out, an array of arrays, is known
     only from them)."""
     steps = [(match.group(1), match.group(2)) for match in _STEP.finditer(inner)]
@@ -75,6 +75,21 @@ def path_problem(
         return None if declared is None else _no_member(element, index, indices)
     member = f"{element}[{index}]"
     return _walk(_unwrapped(recorded[member]) if member in recorded else sibling, member, steps, has_leaves)
+
+
+def declared_buffer(inner: str, declared: list[str]) -> str | None:
+    """The output buffer of `declared` (the FSM channel's `outputs`) that `inner` (`push[2].abort`,
+    `push[*].abort`, `beltSpeed`) is a value of: `push[2]`, `push[*]`, `beltSpeed`; None when it names none."""
+    element = _element(inner)
+    if element in declared:
+        return element
+    member = re.match(r"\[([0-9]+|\*)\]", inner[len(element) :])
+    if member is None:
+        return None
+    named = f"{element}[{member.group(1)}]"
+    if member.group(1) == "*":
+        return named if any(_element(name) == element for name in declared) else None
+    return named if named in declared else None
 
 
 def _element(name: str) -> str:

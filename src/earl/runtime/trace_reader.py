@@ -406,7 +406,7 @@ def _unschemed(metadata: dict[str, str]) -> list[str]:
 
 def _listed(metadata: dict[str, str], key: str) -> list[str] | None:
     """The names a channel's metadata lists under `key` (a JSON list): a memory channel's `unschemed`,
-    an FSM channel's `buffers` (the output buffers links leave); None when it has none (a trace written
+    an FSM channel's `outputs` (every output buffer its subsystem declares); None when it has none (a trace written
     before it did, or a damaged entry)."""
     try:
         found = json.loads(metadata[key])
@@ -787,6 +787,14 @@ def read_signals(path: Path, names: list[str]) -> Signals:
                 empty.append(f"`{name}` had no value in this run (an optional field never sent, or an empty array)")
                 leaf_hints.append(f"`{name}` had no value in this run ({hint})")
                 continue
+            declared = _listed(channels[by_kind[("fsm", subsystem)]][0], "outputs") or []
+            silent = trace_paths.declared_buffer(inner, declared)
+            if silent is not None:
+                # an output buffer the subsystem declares (the trace's metadata says so) that sent nothing the
+                # trace holds: in a run of some agents (`--agents`), no link may leave it in this process
+                empty.append(f"`{name}` had no value in this run (`{silent}` sent no message the trace recorded)")
+                leaf_hints.append(empty[-1])
+                continue
             if subsystem not in memory_topics:
                 hint = (
                     f"if it is memory, record it with `--record-memory {subsystem}`; an output buffer is in the "
@@ -827,7 +835,9 @@ def _trace_path_problem(
     if memory_topic is not None:
         metadata, schema = channels[memory_topic]
         memory = (schema, _families(metadata) or {})
-    declared = _listed(channels[by_kind[("fsm", subsystem)]][0], "buffers")
+    # every output buffer the subsystem declares; not `buffers`, which a trace of this earl's first days
+    # has instead: the buffers links left in that process, of a run of some agents not every member
+    declared = _listed(channels[by_kind[("fsm", subsystem)]][0], "outputs")
     buffers: dict[str, Any] = {}
     for topic, metadata in links:
         source = metadata.get("source", "")
