@@ -1256,3 +1256,15 @@ def test_table_1_and_the_links_table_say_what_they_count_and_where_each_belongs(
     assert "robot" not in _table(html, "links")[0]  # no robot lists a link: no robot column
     negated = '<span class="whole">-<a href="#parameters-base-a-cs-STANDSTILL">STANDSTILL</a></span>'
     assert negated in html and ".whole { white-space: nowrap; }" in html.replace("td.rule, ", "")
+
+
+def test_a_computed_double_is_shown_without_the_noise_of_binary_arithmetic(tmp_path: Path) -> None:
+    """`param STATION: double = 0.4 + 0.3 * K` showed `1.2999999999999998 (K = 3)` in its parameters table:
+    a computed double is rounded to 12 significant digits and written in its shortest form."""
+    sorter = ROOT / "tests" / "runtime_specs" / "sorter"
+    assert main(["doc", str(sorter), "-o", str(tmp_path / "site")]) in (0, 1)
+    html = (tmp_path / "site" / "index.html").read_text(encoding="utf-8")
+    row = re.search(r'id="[^"]*-STATION">.*?</tr>', html)
+    assert row is not None
+    said = re.sub(r"<[^>]+>", "", row.group())
+    assert "0.7 (K = 1), 1.0 (K = 2), 1.3 (K = 3)" in said and "99999" not in said

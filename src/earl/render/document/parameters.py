@@ -7,6 +7,7 @@ int = K`): its value is then given for each member.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -92,11 +93,24 @@ def parameter_rows(
 def _values_text(values: list[Value | None], family: Family | None, members: list[Environment]) -> str:
     if any(value is None for value in values):
         return "—"
-    texts = [literal_text(value) for value in values if value is not None]
+    texts = [_value_text(value) for value in values if value is not None]
     if family is None or len(set(texts)) == 1:
         return texts[0] if texts else "—"
     indices = [environment[family.index] for environment in members]
-    pairs = [f"{text} ({family.index} = {literal_text(index)})" for text, index in zip(texts, indices, strict=True)]
+    pairs = [f"{text} ({family.index} = {_value_text(index)})" for text, index in zip(texts, indices, strict=True)]
     if len(pairs) > LISTED_MEMBERS:
         pairs = [*pairs[: LISTED_MEMBERS - 2], "…", pairs[-1]]
     return ", ".join(pairs)
+
+
+#: A computed double is shown to this many significant digits: `0.4 + 0.3 * K` at K = 3 is 1.3, where
+#: its binary value's repr said 1.2999999999999998.
+SIGNIFICANT_DIGITS = 12
+
+
+def _value_text(value: Value) -> str:
+    """A parameter's value as the spec would write it; a double rounded to `SIGNIFICANT_DIGITS`, then in its
+    shortest form (`1.3`, `0.25`, `1e-09`), so the noise of binary arithmetic does not show."""
+    if isinstance(value, float) and math.isfinite(value):
+        value = float(f"{value:.{SIGNIFICANT_DIGITS}g}")
+    return literal_text(value)
