@@ -146,15 +146,7 @@ class DocumentBuilder:
             return table
         table.header[0].append(cell("comment", rowspan=len(table.header)))
         for row, remark in zip(table.rows, said, strict=False):
-            row.append(cell(with_code(remark) if remark else ()))
-        return table
-        table.header[-1].append(
-            cell("comment", rowspan=len(table.header)) if len(table.header) > 1 else cell("comment")
-        )
-        if len(table.header) > 1:
-            table.header[0].append(table.header[-1].pop())
-        for row, remark in zip(table.rows, said, strict=False):
-            row.append(cell(with_code(remark) if remark else ()))
+            row.append(cell(with_code(remark) if remark else (), css="comment"))
         return table
 
     # ------------------------------------------------------------------ inline helpers
@@ -526,7 +518,7 @@ class DocumentBuilder:
                     cell(value),
                     cell(code(row.given) if row.given.startswith("--param") else text(row.given)),
                 ]
-                + ([cell(with_code(" ".join(row.comments)))] if commented else [])
+                + ([cell(with_code(" ".join(row.comments)), css="comment")] if commented else [])
             )
         return Table(text(caption), header, body, anchor)
 

@@ -58,6 +58,7 @@ table.matrix td.bullet { font-size: 18px; line-height: 1; min-width: 34px; }
 td.error { color: #b00020; font-weight: 600; }
 td.warning { color: #9a6700; font-weight: 600; }
 td.note { color: var(--muted); }
+td.comment { min-width: 12em; max-width: 32em; }  /* prose: wraps in a column of a readable width */
 td.rule, .whole { white-space: nowrap; }  /* `EARL-I063` broke after its hyphen */
 wbr { display: none; }  /* a long name breaks only in a narrow window (below), not where a wide one has room */
 p.notice { padding: 8px 12px; border-left: 4px solid; background: var(--shade); font-weight: 600; }
@@ -156,8 +157,100 @@ def _cell(tag: str, item: Cell) -> str:
     return f"<{tag}{attributes}>{content(item.content)}</{tag}>"
 
 
+#: What a character takes, in px, in the fonts of a table (13 px DejaVu Sans Mono for code, 13.5 px text,
+#: DejaVu Sans where Helvetica and Arial are missing: its widest), and a cell's padding and border: enough
+#: to tell, before a browser draws it, how wide a table is whose names do not break.
+_CODE_CHARACTER = 7.9
+_TEXT_CHARACTER = 8.6
+_CELL_EDGES = 18
+#: A window is this much wider than the text beside the sidebar (280 px sidebar, 2 × 40 px padding),
+#: and the text never wider than `_WIDEST_TEXT` (main's max-width less its padding).
+_BESIDE_TEXT = 360
+#: What the estimate may miss (it was 1 px short for a buffers table of manip/a).
+_MARGIN = 16
+_WIDEST_TEXT = 1220
+#: Thresholds are rounded up to this step, so the page has a few rules, not one per table.
+_STEP = 80
+
+
+def _characters(parts: Content, monospace: bool = False) -> list[tuple[str, bool]]:
+    out: list[tuple[str, bool]] = []
+    for part in parts:
+        if isinstance(part, Text):
+            out += [(character, monospace) for character in part.text]
+        elif isinstance(part, Code):
+            out += [(character, True) for character in part.text]
+        elif isinstance(part, Link | Strong):
+            out += _characters(part.content, monospace)
+        elif isinstance(part, Monospace):
+            out += _characters(part.content, True)
+    return out
+
+
+def _narrowest(parts: Content) -> float:
+    """How wide a cell is at least with its names whole: its longest word, code or text."""
+    widest = 0.0
+    word = 0.0
+    for character, monospace in [*_characters(parts), (" ", False)]:
+        if character.isspace():
+            widest = max(widest, word)
+            word = 0.0
+        else:
+            word += _CODE_CHARACTER if monospace else _TEXT_CHARACTER
+    return widest + _CELL_EDGES
+
+
+def unbroken_width(item: Table) -> float:
+    """About how wide `item` is at least while no name breaks at its `<wbr>`: the sum of its columns'
+    longest words (a cell spanning columns is left out)."""
+    columns: dict[int, float] = {}
+    pending: dict[int, int] = {}  # column → rows still covered by a cell above
+    for row in [*item.header, *item.rows]:
+        column = 0
+        for entry in row:
+            while pending.get(column, 0) > 0:
+                pending[column] -= 1
+                column += 1
+            if entry.colspan == 1:
+                columns[column] = max(columns.get(column, 0.0), _narrowest(entry.content))
+            for spanned in range(column, column + entry.colspan):
+                pending[spanned] = entry.rowspan - 1
+            column += entry.colspan
+        for later in [c for c in pending if c >= column and pending[c] > 0]:
+            pending[later] -= 1
+    return sum(columns.values())
+
+
+def breaks_below(item: Table) -> int | None:
+    """The widest window in which `item`'s names may break at their `<wbr>`: a table that fits with its names
+    whole keeps them whole (a wide window had split NavigationGoal in a column with room), and one that
+    would not fits by breaking them rather than scrolling sideways (the comment column pushed the buffers
+    table to 1122 px in a 1040 px text at 1400 px).  None: below 960 px only, as every table."""
+    needed = unbroken_width(item) + _MARGIN
+    if needed <= _WIDEST_TEXT:
+        window = needed + _BESIDE_TEXT
+        if window <= NARROW:
+            return None
+        return int(-(-window // _STEP) * _STEP)
+    return WIDEST
+
+
+#: Below this window width the contents go above the text and every table's names may break.
+NARROW = 960
+#: A table too wide for the widest text breaks its names in every window.
+WIDEST = 100000
+
+
+def _class(*names: str) -> str:
+    names = tuple(name for name in names if name)
+    return f' class="{" ".join(names)}"' if names else ""
+
+
 def table(item: Table) -> str:
-    attributes = (f' id="{escape(item.anchor)}"' if item.anchor else "") + (f' class="{item.css}"' if item.css else "")
+    below = None if item.css == "matrix" else breaks_below(item)
+    attributes = (f' id="{escape(item.anchor)}"' if item.anchor else "") + _class(
+        item.css, f"breaks-{below}" if below else ""
+    )
     head = "".join("<tr>" + "".join(_cell("th", c) for c in row) + "</tr>" for row in item.header)
     body = "".join("<tr>" + "".join(_cell("td", c) for c in row) + "</tr>" for row in item.rows)
     notes = "".join(f'<div class="note">{content(note)}</div>' for note in item.notes)
@@ -223,6 +316,10 @@ def _navigation(sections: list[Section]) -> str:
 def render_html(document: Document, widths: Mapping[str, float] | None = None) -> str:
     """The page; `widths` gives the natural width in CSS pixels of the diagrams drawn, by path."""
     body = "\n".join(section(s, widths) for s in document.sections)
+    thresholds = sorted({int(found) for found in re.findall(r'class="[^"]*\bbreaks-(\d+)', body)})
+    css = CSS + "".join(
+        f"@media (max-width: {below}px) {{ table.breaks-{below} wbr {{ display: inline; }} }}\n" for below in thresholds
+    )
     notice = ""
     if document.notice:
         notice = f'<p class="notice {document.notice_css}" id="check-summary">{content(document.notice)}</p>\n'
@@ -231,7 +328,7 @@ def render_html(document: Document, widths: Mapping[str, float] | None = None) -
         '<html lang="en">\n<head>\n<meta charset="utf-8">\n'
         '<meta name="viewport" content="width=device-width, initial-scale=1">\n'
         '<meta name="generator" content="earl doc">\n'
-        f"<title>{escape(document.title)}</title>\n<style>{CSS}</style>\n</head>\n<body>\n"
+        f"<title>{escape(document.title)}</title>\n<style>{css}</style>\n</head>\n<body>\n"
         f"{_navigation(document.sections)}\n<main>\n<h1>{escape(document.title)}</h1>\n"
         f'<p class="subtitle">{escape(document.subtitle)}</p>\n{notice}{body}\n</main>\n</body>\n</html>\n'
     )
