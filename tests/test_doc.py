@@ -512,7 +512,8 @@ def test_no_table_scrolls_sideways_in_a_wide_window(site: Path, tmp_path: Path, 
     """The comment and keeps columns pushed tables past the text in a wide window: at 1400 px the buffers
     table of manip/a.cs was 1122 px in a 1040 px box (its comment cut), the pf table 1241 px, still
     scrolling at 1920 px.  A comment wraps at a readable width, and a table that would not fit with its
-    names whole breaks them at their `<wbr>`; one that fits keeps every name on one line."""
+    names whole breaks them at their `<wbr>`, not in its first column; one that fits keeps every name on one
+    line."""
     sync_api, executable = _chromium()
     mobile = tmp_path / "mobile_robot"
     assert main(["doc", str(ROOT / "examples" / "mobile_robot"), "-o", str(mobile)]) == 0
@@ -529,16 +530,22 @@ def test_no_table_scrolls_sideways_in_a_wide_window(site: Path, tmp_path: Path, 
                         .filter(box => box.scrollWidth > box.clientWidth + 1)
                         .map(box => box.querySelector('caption').innerText.slice(0, 60));
                       // in a table that fits with its names whole, no name is broken
-                      const broken = Array.from(document.querySelectorAll('.wide table'))
-                        .filter(table => table.querySelector('wbr') && getComputedStyle(table.querySelector('wbr')).display === 'none')
+                      const keeps = table => {  // whether a table keeps its names whole (its first column always does)
+                        const wbr = table.querySelector('td:not(:first-child) wbr');
+                        return wbr !== null && getComputedStyle(wbr).display === 'none';
+                      };
+                      const broken = Array.from(document.querySelectorAll('.wide table')).filter(keeps)
                         .flatMap(table => Array.from(table.querySelectorAll('td code, th code')))
+                        .filter(code => !/\\s/.test(code.textContent) && code.getClientRects().length > 1)
+                        .map(code => code.textContent);
+                      // the name a row is about stays whole in every table (`calculate`/`Position/pf` split)
+                      const first = Array.from(document.querySelectorAll('.wide td:first-child code'))
                         .filter(code => !/\\s/.test(code.textContent) && code.getClientRects().length > 1)
                         .map(code => code.textContent);
                       const comments = Array.from(document.querySelectorAll('td.comment'))
                         .map(cell => cell.getBoundingClientRect().width);
-                      const whole = Array.from(document.querySelectorAll('.wide table')).filter(table =>
-                        table.querySelector('wbr') && getComputedStyle(table.querySelector('wbr')).display === 'none').length;
-                      return {scrolling, broken, widest: Math.max(...comments), whole};
+                      const whole = Array.from(document.querySelectorAll('.wide table')).filter(keeps).length;
+                      return {scrolling, broken, first, widest: Math.max(...comments), whole};
                     })()"""
                 )
         finally:
@@ -546,6 +553,7 @@ def test_no_table_scrolls_sideways_in_a_wide_window(site: Path, tmp_path: Path, 
     for name, layout in found.items():
         assert layout["scrolling"] == [], name
         assert layout["broken"] == [], name
+        assert layout["first"] == [], name
         assert layout["whole"] > 10, name  # most tables keep their names whole in a wide window
         assert layout["widest"] <= 32 * 13.5 + 2 * 8 + 1, name  # a comment wraps at 32em
 

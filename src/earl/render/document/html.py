@@ -237,6 +237,9 @@ def breaks_below(item: Table) -> int | None:
 
 #: Below this window width the contents go above the text and every table's names may break.
 NARROW = 960
+#: From this window width on, the first column's names (what each row is about) stay whole: a table that
+#: must break names breaks them in its other columns (`calculate`/`Position/pf` had split at 1400 px).
+WHOLE_FIRST_COLUMN = 1200
 #: A table too wide for the widest text breaks its names in every window.
 WIDEST = 100000
 
@@ -320,6 +323,8 @@ def render_html(document: Document, widths: Mapping[str, float] | None = None) -
     css = CSS + "".join(
         f"@media (max-width: {below}px) {{ table.breaks-{below} wbr {{ display: inline; }} }}\n" for below in thresholds
     )
+    # in a wide window the name a row is about stays whole: the other columns give way first
+    css += f"@media (min-width: {WHOLE_FIRST_COLUMN}px) {{ .wide td:first-child wbr {{ display: none; }} }}\n"
     notice = ""
     if document.notice:
         notice = f'<p class="notice {document.notice_css}" id="check-summary">{content(document.notice)}</p>\n'
