@@ -381,7 +381,7 @@ def test_a_family_range_emptied_by_a_param_is_one_error_at_the_param_naming_wher
     assert err.count("error[") == 1
     assert (
         "error[EARL-R016]: `N` = 0, given from outside the spec (`--param`, or `parameters=` in Python), leaves "
-        "the family range 1..0 empty: `1..N` at lines 200, 204, 210, 211, 290, 344, 370, 371, 372 and 373"
+        "the family range 1..0 empty: `1..N` at lines 200, 204, 211, 212, 294, 348, 374, 375, 376 and 377"
     ) in err
     assert "system.earl:8:16" in err  # `param N: int = 6`: the value the spec itself gives
     assert "= hint: give `N` a value of at least 1" in err

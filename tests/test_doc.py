@@ -1319,3 +1319,64 @@ def test_a_computed_double_is_shown_without_the_noise_of_binary_arithmetic(tmp_p
     assert row is not None
     said = re.sub(r"<[^>]+>", "", row.group())
     assert "0.7 (K = 1), 1.0 (K = 2), 1.3 (K = 3)" in said and "99999" not in said
+
+
+def test_a_comment_heading_a_group_of_declarations_is_a_caption_of_their_rows(site: Path, tmp_path: Path) -> None:
+    """`// Table 3: manip/a.cs.m`, written above five memories, was shown as motionFinished/m's comment, and
+    `// §3.2: the partial transition functions; …` began calculatePosition/pf's.  A comment block that a
+    blank line parts from the declaration heads the rows from it on and is a caption row across the table;
+    a row's own comment is the block right above its declaration and the one on its line."""
+    html = (site / "index.html").read_text(encoding="utf-8")
+    memory = _table_by_caption(html, "Table 3: manip/a.cs.m dataTypes")
+    assert memory[:3] == [
+        ["m", "dataType", "initial value"],  # no row has a comment of its own: no comment column
+        ["Table 3: manip/a.cs.m"],
+        ["motionFinished/m", "boolean", "true"],
+    ]
+    predicates = _table_by_caption(html, "Table 4: definitions of manip/a.cs.pp.fun")
+    assert predicates[1] == ["Table 4: manip/a.cs.pp.fun"] and predicates[2][0] == "emergencyStop/pp"
+    assert "Table 4" not in "".join(predicates[2])
+    functions = _table_by_caption(html, "Partial transition functions of manip/a.cs (§2.2, Figure 6; Eq. 4 and 6)")
+    assert functions[1] == ["§3.2: the partial transition functions; Table 6 says what each writes."]
+    assert functions[2][0] == "calculatePosition/pf"
+    assert functions[2][-1] == "calculates manipulator joint positions and the end-effector's operational space pose"
+    assert '<td colspan="6" class="group"><div>§3.2: the partial transition functions;' in html
+
+    mobile = ROOT / "examples" / "mobile_robot"
+    assert main(["doc", str(mobile), "-o", str(tmp_path / "mr")]) == 0
+    html = (tmp_path / "mr" / "index.html").read_text(encoding="utf-8")
+    rows = _table_by_caption(html, "Partial transition functions of base/a.cs (§2.2, Figure 6; Eq. 4 and 6)")
+    named = {row[0]: row for row in rows}
+    assert named["initialise/pf"][-1] == "The odometry origin is wherever the base is switched on."
+    assert named["outputWheelCommands/pf"][-1] == "Inverse kinematics: desiredTwist to one angular velocity per wheel."
+    assert [row[0] for row in rows if len(row) == 1] == [
+        "First stage, Eq. (4): read input buffers (and memory), write memory only.",
+        "Second stage, Eq. (6): read memory only, compose the output buffers.",
+    ]
+    memory = _table_by_caption(html, "Table 3: base/a.cs.m dataTypes")
+    assert memory[1][0].startswith("Eq. (5) for this subsystem") and memory[2][:2] == ["pose/m", "Pose2D"]
+    assert memory[2][-1] == ""  # pose/m has no comment of its own; goalWayClear/m has
+    parameters = _table(html, "parameters-base-a-cs")
+    assert parameters[1][0].startswith("Distances in metres.") and len(parameters[1]) == 1
+    assert parameters[2][0] == "STOP_DISTANCE" and parameters[2][-1] == ""
+    # the comment types.earl opens with is the file's, not a heading of the parameters
+    assert all(len(row) > 1 for row in _table(html, "parameters"))
+
+    # without the blank line, the block right above is the declaration's own, and so is one on its line
+    spec = tmp_path / "tight" / "system.earl"
+    spec.parent.mkdir()
+    spec.write_text(
+        EXAMPLE.read_text(encoding="utf-8")
+        .replace(
+            "// Table 3: manip/a.cs.m\n\n        motionFinished/m: boolean = true\n",
+            "// Table 3: manip/a.cs.m\n        motionFinished/m: boolean = true\n"
+            "        currentOperationalPos/m: OperPosition  // from calculatePosition/pf\n",
+        )
+        .replace("        currentOperationalPos/m: OperPosition\n        currentJointPos", "        currentJointPos"),
+        encoding="utf-8",
+    )
+    assert main(["doc", str(spec), "-o", str(tmp_path / "tight-site")]) == 0
+    html = (tmp_path / "tight-site" / "index.html").read_text(encoding="utf-8")
+    memory = _table_by_caption(html, "Table 3: manip/a.cs.m dataTypes")
+    assert memory[1] == ["motionFinished/m", "boolean", "true", "Table 3: manip/a.cs.m"]
+    assert memory[2] == ["currentOperationalPos/m", "OperPosition", "—", "from calculatePosition/pf"]

@@ -27,7 +27,7 @@ from earl.model.types import type_text
 from earl.render.build import Subject
 from earl.render.diagram import Diagram
 from earl.render.document.parameters import Environment, ParameterRow, parameter_rows
-from earl.render.document.remarks import Remarks
+from earl.render.document.remarks import Remark, Remarks
 from earl.render.document.tree import (
     BulletList,
     Cell,
@@ -140,14 +140,9 @@ class DocumentBuilder:
 
     def commented(self, table: Table, elements: Sequence[object]) -> Table:
         """`table` with a last column of the comments written at `elements` (one a row, in order), when any
-        has one: units and explanations ("in radians") the SysML export carries, shown with their rows."""
-        said = [self.remarks.of(element) for element in elements]
-        if not any(said):
-            return table
-        table.header[0].append(cell("comment", rowspan=len(table.header)))
-        for row, remark in zip(table.rows, said, strict=False):
-            row.append(cell(with_code(remark) if remark else (), css="comment"))
-        return table
+        has one: units and explanations ("in radians") the SysML export carries, shown with their rows; a
+        comment heading a group of them (`// Table 3: manip/a.cs.m`) is a caption row above the group."""
+        return _with_remarks(table, self.remarks.of_rows(elements))
 
     # ------------------------------------------------------------------ inline helpers
     def figure(self, diagram: Diagram, caption: str) -> Figure:
@@ -501,11 +496,7 @@ class DocumentBuilder:
     def parameters_table(self, rows: Sequence[ParameterRow], caption: str, anchor: str) -> Table:
         """Name, type, the spec's expression where it is more than a value, the value, where it was given,
         and a person's comments on it where any has one."""
-        commented = any(row.comments for row in rows)
-        header = [
-            [cell("parameter"), cell("type"), cell("value"), cell("given by")]
-            + ([cell("comment")] if commented else [])
-        ]
+        header = [[cell("parameter"), cell("type"), cell("value"), cell("given by")]]
         body = []
         for row in rows:
             value: Content = code(row.value) if row.value != "—" else text("—")
@@ -518,9 +509,8 @@ class DocumentBuilder:
                     cell(value),
                     cell(code(row.given) if row.given.startswith("--param") else text(row.given)),
                 ]
-                + ([cell(with_code(" ".join(row.comments)), css="comment")] if commented else [])
             )
-        return Table(text(caption), header, body, anchor)
+        return _with_remarks(Table(text(caption), header, body, anchor), [row.remark for row in rows])
 
     def subsystem_section(
         self, agent: Agent, subsystem: Subsystem, links: BufferLinks, environment: Environment | None = None
@@ -906,6 +896,20 @@ class DocumentBuilder:
 
 
 # ---------------------------------------------------------------------- helpers
+def _with_remarks(table: Table, remarks: Sequence[Remark]) -> Table:
+    """`table` with a comment column when a row's element has a comment of its own, and a caption row,
+    across the table, above the rows a comment heads (where it was written in the spec)."""
+    if any(remark.own for remark in remarks):
+        table.header[0].append(cell("comment", rowspan=len(table.header)))
+        for row, remark in zip(table.rows, remarks, strict=False):
+            row.append(cell(with_code(remark.own) if remark.own else (), css="comment"))
+    columns = sum(entry.colspan for entry in table.header[0])
+    for position in reversed(range(min(len(table.rows), len(remarks)))):
+        if remarks[position].heading:
+            table.rows.insert(position, [cell(with_code(remarks[position].heading), colspan=columns, css="group")])
+    return table
+
+
 BufferLinks = dict[tuple[int, str, str], list[tuple[str, str, str]]]
 
 

@@ -58,6 +58,8 @@ table.matrix td.bullet { font-size: 18px; line-height: 1; min-width: 34px; }
 td.error { color: #b00020; font-weight: 600; }
 td.warning { color: #9a6700; font-weight: 600; }
 td.note { color: var(--muted); }
+td.group { font-style: italic; color: var(--muted); background: #fafbfc; }  /* a comment heading rows */
+td.group > div { width: 0; min-width: 100%; }
 td.comment { min-width: 12em; max-width: 32em; }  /* prose: wraps in a column of a readable width */
 td.rule, .whole { white-space: nowrap; }  /* `EARL-I063` broke after its hyphen */
 wbr { display: none; }  /* a long name breaks only in a narrow window (below), not where a wide one has room */
@@ -154,7 +156,10 @@ def _cell(tag: str, item: Cell) -> str:
         attributes += f' id="{escape(item.anchor)}"'
     if item.css:
         attributes += f' class="{item.css}"'
-    return f"<{tag}{attributes}>{content(item.content)}</{tag}>"
+    inner = content(item.content)
+    if item.css == "group":  # a heading's prose wraps at the table's width and never widens it
+        inner = f"<div>{inner}</div>"
+    return f"<{tag}{attributes}>{inner}</{tag}>"
 
 
 #: What a character takes, in px, in the fonts of a table (13 px DejaVu Sans Mono for code, 13.5 px text,

@@ -102,7 +102,10 @@ def content(parts: Sequence[Inline], in_table: bool = False) -> str:
 
 def _cell(item: Cell) -> str:
     anchor = f'<a id="{item.anchor}"></a>' if item.anchor else ""
-    return anchor + content(item.content, in_table=True)
+    said = content(item.content, in_table=True)
+    if item.css == "group":  # a comment heading the rows below, in its first column: set apart as in HTML
+        said = f"*{said}*"
+    return anchor + said
 
 
 def _header(item: Table) -> list[str]:

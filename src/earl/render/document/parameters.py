@@ -12,12 +12,12 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from earl.model.comment_paragraphs import comment_paragraphs
 from earl.model.elements import Family, Parameter
 from earl.model.expand import family_members
 from earl.model.expressions import ConstantError, Literal, evaluate_constant
 from earl.model.text import expression_text, literal_text
 from earl.model.types import type_text
+from earl.render.document.remarks import Remark, row_remarks
 
 Value = bool | int | float | str
 Environment = dict[str, Value]
@@ -34,7 +34,8 @@ class ParameterRow:
     written: str
     value: str
     given: str  # `--param N=3`, or `spec, line 5`
-    comments: list[str] = field(default_factory=list)
+    #: the comment written at it, and one above it heading the parameters from it on
+    remark: Remark = field(default_factory=Remark)
 
 
 def parameter_rows(
@@ -58,7 +59,8 @@ def parameter_rows(
             except ConstantError:
                 members = [dict(outer)]
     rows = []
-    for parameter in parameters:
+    remarks = row_remarks(parameters, [parameter.comments for parameter in parameters])
+    for parameter, remark in zip(parameters, remarks, strict=True):
         values: list[Value | None] = []
         for environment in members:
             try:
@@ -84,7 +86,7 @@ def parameter_rows(
                 written,
                 _values_text(values, family if len(members) > 1 else None, members),
                 where,
-                comment_paragraphs(parameter.comments),
+                remark,
             )
         )
     return rows, members[0] if len(members) == 1 else dict(outer)
