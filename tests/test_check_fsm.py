@@ -10,6 +10,7 @@ import random
 import re
 from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -783,26 +784,12 @@ def test_each_value_s_comparisons_sit_side_by_side_in_the_bdd_by_their_constants
     """The order of first use interleaved the values' comparisons, and a BDD then carries every value's
     region at once (8 values of 10 comparisons, 40 prioritised transitions: a minute). Each predicate
     follows the comparison it is defined by."""
-    from earl.check.fsm_analysis import _Encoder
-
     extra = (
         "        w/ib: double\n"
         "        v2/pp = v/ib > 2.0\n        w1/pp = w/ib < 1.0\n        v1/pp = v/ib > 1.0\n"
         "        w3/pp = w/ib < 3.0\n        both/pp = v1/pp and w3/pp\n"
     )
-    system = earl.loads(
-        PROBE.replace("TC", "true")
-        .replace("FIRST", "v2/pp and w1/pp")
-        .replace("SECOND", "both/pp")
-        .replace("        false/pp = false\n", "        false/pp = false\n" + extra),
-        "probe.earl",
-    )
-    context = context_for(system)
-    subsystem = next(s for _, s in context.subsystems())
-    assert subsystem.fsm is not None
-    encoder = _Encoder(context, subsystem)
-    for transition in subsystem.fsm.transitions:
-        encoder.encode(transition.condition.expression)
+    encoder = _probe_encoded(extra, "v2/pp and w1/pp", "both/pp")
     encoder.order_variables()
     levels = encoder.bdd.var_levels
     order = [encoder.names[name] for name in sorted(levels, key=levels.__getitem__)]
@@ -816,27 +803,13 @@ def test_members_of_two_families_are_interleaved_by_index_while_the_bdds_are_bui
     """With every `a[K]/ib` above every `b[K]/ib` (the order of first use), `any(K in 1..N: a[K]/ib and
     b[K]/ib)` has 2^N nodes: N = 20 took a minute, N = 24 minutes. The members are placed by index as they
     are declared, so the BDD built is small, and `order_variables` keeps them so."""
-    from earl.check.fsm_analysis import _Encoder
-
     members = 14
     extra = (
         f"        a[K in 1..{members}]/ib: boolean\n        b[K in 1..{members}]/ib: boolean\n"
         f"        anyA/pp = any(K in 1..{members}: a[K]/ib)\n        anyB/pp = any(K in 1..{members}: b[K]/ib)\n"
         f"        pair/pp = any(K in 1..{members}: a[K]/ib and b[K]/ib)\n"
     )
-    system = earl.loads(
-        PROBE.replace("TC", "true")
-        .replace("FIRST", "anyA/pp or anyB/pp")
-        .replace("SECOND", "pair/pp")
-        .replace("        false/pp = false\n", "        false/pp = false\n" + extra),
-        "probe.earl",
-    )
-    context = context_for(system)
-    subsystem = next(s for _, s in context.subsystems())
-    assert subsystem.fsm is not None
-    encoder = _Encoder(context, subsystem)
-    for transition in subsystem.fsm.transitions:
-        encoder.encode(transition.condition.expression)
+    encoder = _probe_encoded(extra, "anyA/pp or anyB/pp", "pair/pp")
     built = encoder.definitions_met  # `pair/pp` is its variable, tied to its definition here
     assert max(formula.dag_size for formula in built) < 4 * members  # 2^N in the order of first use
     encoder.order_variables()
@@ -938,3 +911,23 @@ def test_a_transition_never_taken_is_told_apart_from_another_between_the_same_st
         f"transition `n,t/t` #2 (line {line}) of solo/a.cs can never be taken: its condition never holds when "
         "`nothing/bb` stops"
     ]
+
+
+def _probe_encoded(extra: str, first: str, second: str) -> Any:
+    """PROBE's subsystem with `extra` declarations and its two transitions' conditions encoded (not yet ordered)."""
+    from earl.check.fsm_analysis import _Encoder
+
+    system = earl.loads(
+        PROBE.replace("TC", "true")
+        .replace("FIRST", first)
+        .replace("SECOND", second)
+        .replace("        false/pp = false\n", "        false/pp = false\n" + extra),
+        "probe.earl",
+    )
+    context = context_for(system)
+    subsystem = next(s for _, s in context.subsystems())
+    assert subsystem.fsm is not None
+    encoder = _Encoder(context, subsystem)
+    for transition in subsystem.fsm.transitions:
+        encoder.encode(transition.condition.expression)
+    return encoder
